@@ -1,0 +1,10 @@
+#pragma once
+// Each `strata` subcommand registers itself on the app. A command that fails prints one line
+// on stderr and throws CLI::RuntimeError(exit code).
+#include <CLI/CLI.hpp>
+
+namespace strata::app {
+
+void addGpuInfoCommand(CLI::App& app);
+
+}  // namespace strata::app

@@ -1,0 +1,10 @@
+// strata: the command-line front end.
+#include "commands.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"Strata: GIS terrain visualisation and what-if erosion and flood simulation on the GPU"};
+  app.require_subcommand(1);
+  strata::app::addGpuInfoCommand(app);
+  CLI11_PARSE(app, argc, argv);
+  return 0;
+}

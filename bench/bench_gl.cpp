@@ -1,0 +1,89 @@
+// GL layer baselines: the device's copy bandwidth (the floor every memory-bound kernel is
+// measured against) and a 5-point r32f stencil pass, timed with GPU timer queries.
+//   build/bench/strata_bench_gl [--benchmark_filter=...]
+#include <benchmark/benchmark.h>
+
+#include <epoxy/gl.h>
+
+#include <cstdio>
+#include <optional>
+
+#include <strata/render/gl/context.hpp>
+#include <strata/render/gl/objects.hpp>
+#include <strata/render/gpu_layouts.hpp>
+
+namespace {
+using namespace strata::render;
+
+gl::HeadlessContext& ctx() {
+  static std::optional<gl::HeadlessContext> c = [] {
+    auto r = gl::HeadlessContext::create({.debugOutput = false});
+    if (!r) {
+      std::fprintf(stderr, "%s\n", r.message().c_str());
+      std::exit(1);
+    }
+    return std::optional<gl::HeadlessContext>(std::move(r).value());
+  }();
+  return *c;
+}
+
+// Device-to-device copy: bytes read + bytes written per second.
+void BM_BufferCopy(benchmark::State& state) {
+  ctx();
+  const size_t bytes = size_t(state.range(0)) << 20;
+  gl::Buffer a(bytes), b(bytes);
+  a.fill(0x3f800000u);
+  for (auto _ : state) {
+    gl::GpuTimer t;
+    t.begin();
+    glCopyNamedBufferSubData(a.id(), b.id(), 0, 0, GLsizeiptr(bytes));
+    t.end();
+    state.SetIterationTime(t.milliseconds() * 1e-3);
+  }
+  state.SetBytesProcessed(int64_t(state.iterations()) * int64_t(2 * bytes));
+}
+BENCHMARK(BM_BufferCopy)->Arg(64)->Arg(256)->UseManualTime()->Unit(benchmark::kMillisecond);
+
+void BM_LaplacianStencil(benchmark::State& state) {
+  ctx();
+  const int n = int(state.range(0));
+  auto src = gl::Texture::create2D(gl::kR32F, n, n), dst = gl::Texture::create2D(gl::kR32F, n, n);
+  std::vector<float> zeros(size_t(n) * size_t(n), 1.0f);
+  src.upload(zeros.data());
+  GridParams g;
+  g.size = {n, n};
+  gl::Buffer params(sizeof g, &g);
+  auto prog = gl::Program::compute("test/laplacian.comp");
+  if (!prog) {
+    state.SkipWithError(prog.message().c_str());
+    return;
+  }
+  src.bindImage(0, GL_READ_ONLY);
+  dst.bindImage(1, GL_WRITE_ONLY);
+  params.bindBase(GL_SHADER_STORAGE_BUFFER, 2);
+  for (auto _ : state) {
+    gl::GpuTimer t;
+    t.begin();
+    prog->dispatchCovering(n, n);
+    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+    t.end();
+    state.SetIterationTime(t.milliseconds() * 1e-3);
+  }
+  // Floor: one read and one write of each cell (neighbours come from cache).
+  state.SetBytesProcessed(int64_t(state.iterations()) * int64_t(n) * n * 8);
+  state.counters["cells/s"] =
+      benchmark::Counter(double(n) * n * double(state.iterations()), benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_LaplacianStencil)->Arg(256)->Arg(1024)->Arg(2048)->UseManualTime()->Unit(benchmark::kMillisecond);
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  benchmark::Initialize(&argc, argv);
+  const auto& i = ctx().info();
+  benchmark::AddCustomContext("gl_renderer", i.renderer);
+  benchmark::AddCustomContext("gl_version", i.version);
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

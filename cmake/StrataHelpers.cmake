@@ -1,0 +1,47 @@
+# strata_add_library(NAME SOURCES ... DEPS ...): a library with public headers in include/.
+# strata_add_test(NAME SOURCES ... DEPS ... [LABELS ...]): one GoogleTest binary, registered with ctest.
+
+set(CMAKE_CXX_STANDARD 20)
+set(CMAKE_CXX_STANDARD_REQUIRED ON)
+set(CMAKE_CXX_EXTENSIONS OFF)
+
+add_library(strata_options INTERFACE)
+target_compile_options(strata_options INTERFACE -Wall -Wextra -Wpedantic -Wshadow=local)
+if(STRATA_WERROR)
+  target_compile_options(strata_options INTERFACE -Werror)
+endif()
+# GLM: radians everywhere, depth range [0,1] for reversed-Z, no implicit experimental warnings.
+target_compile_definitions(strata_options INTERFACE GLM_FORCE_RADIANS GLM_FORCE_DEPTH_ZERO_TO_ONE
+                                                    GLM_ENABLE_EXPERIMENTAL)
+if(STRATA_SANITIZE)
+  target_compile_options(strata_options INTERFACE -fsanitize=${STRATA_SANITIZE} -fno-omit-frame-pointer
+                                                  -fno-sanitize-recover=undefined)
+  target_link_options(strata_options INTERFACE -fsanitize=${STRATA_SANITIZE})
+endif()
+
+function(strata_add_library name)
+  cmake_parse_arguments(ARG "" "" "SOURCES;DEPS;PRIVATE_DEPS" ${ARGN})
+  add_library(${name} STATIC ${ARG_SOURCES})
+  target_include_directories(${name} PUBLIC ${CMAKE_CURRENT_SOURCE_DIR}/include
+                                     PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/src)
+  target_link_libraries(${name} PUBLIC strata_options ${ARG_DEPS} PRIVATE ${ARG_PRIVATE_DEPS})
+endfunction()
+
+function(strata_add_executable name)
+  cmake_parse_arguments(ARG "" "" "SOURCES;DEPS" ${ARGN})
+  add_executable(${name} ${ARG_SOURCES})
+  target_link_libraries(${name} PRIVATE strata_options ${ARG_DEPS})
+endfunction()
+
+# Tests get STRATA_SOURCE_DIR / STRATA_DATA_DIR (../shared/data) / STRATA_BINARY_DIR compiled in.
+set(STRATA_DATA_DIR "${PROJECT_SOURCE_DIR}/../shared/data" CACHE PATH "Shared real DEMs")
+function(strata_add_test name)
+  cmake_parse_arguments(ARG "" "" "SOURCES;DEPS;LABELS" ${ARGN})
+  add_executable(${name} ${ARG_SOURCES})
+  target_link_libraries(${name} PRIVATE strata_options ${ARG_DEPS} GTest::gtest GTest::gmock strata_test_main)
+  target_compile_definitions(${name} PRIVATE
+    STRATA_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
+    STRATA_DATA_DIR="${STRATA_DATA_DIR}"
+    STRATA_TEST_OUTPUT_DIR="${PROJECT_BINARY_DIR}/test-output")
+  gtest_discover_tests(${name} PROPERTIES LABELS "${ARG_LABELS}" DISCOVERY_TIMEOUT 60)
+endfunction()

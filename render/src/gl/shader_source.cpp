@@ -1,0 +1,139 @@
+// Shader preprocessing shared by the build-time embedder and the runtime loader.
+#include <strata/render/gl/shader_source.hpp>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+
+namespace strata::render::gl {
+namespace {
+
+std::string parentDir(const std::string& path) {
+  const auto slash = path.find_last_of('/');
+  return slash == std::string::npos ? std::string() : path.substr(0, slash + 1);
+}
+
+std::string normalise(const std::string& path) {
+  return std::filesystem::path(path).lexically_normal().generic_string();
+}
+
+// Returns the quoted file name of an `#include "x"` line, or nullopt.
+std::optional<std::string> includeTarget(std::string_view line) {
+  size_t i = line.find_first_not_of(" \t");
+  if (i == std::string_view::npos || line[i] != '#') return std::nullopt;
+  i = line.find_first_not_of(" \t", i + 1);
+  if (i == std::string_view::npos || line.substr(i, 7) != "include") return std::nullopt;
+  const size_t open = line.find('"', i + 7);
+  const size_t close = open == std::string_view::npos ? open : line.find('"', open + 1);
+  if (close == std::string_view::npos) return std::nullopt;
+  return std::string(line.substr(open + 1, close - open - 1));
+}
+
+bool isVersionLine(std::string_view line) {
+  const size_t i = line.find_first_not_of(" \t");
+  return i != std::string_view::npos && line.substr(i, 8) == "#version";
+}
+
+struct Expander {
+  const ShaderFileReader& read;
+  ShaderSource out;
+
+  int fileIndex(const std::string& path) {
+    auto it = std::find(out.files.begin(), out.files.end(), path);
+    if (it != out.files.end()) return -1;  // already included: include-once
+    out.files.push_back(path);
+    return int(out.files.size()) - 1;
+  }
+
+  Status expand(const std::string& path, const std::string& text, int index, bool top) {
+    std::istringstream in(text);
+    std::string line;
+    int lineNo = 0;
+    bool sawVersion = !top;
+    while (std::getline(in, line)) {
+      ++lineNo;
+      if (!sawVersion) {
+        if (line.find_first_not_of(" \t\r") == std::string::npos) {
+          out.text += '\n';
+          continue;
+        }
+        if (!isVersionLine(line))
+          return fail(path + ":" + std::to_string(lineNo) + ": the first line must be #version");
+        out.text += line + '\n';
+        out.text += "#line " + std::to_string(lineNo + 1) + " " + std::to_string(index) + '\n';
+        sawVersion = true;
+        continue;
+      }
+      if (auto target = includeTarget(line)) {
+        std::string resolved = normalise(parentDir(path) + *target);
+        auto content = read(resolved);
+        if (!content) {
+          resolved = normalise(*target);
+          content = read(resolved);
+        }
+        if (!content) {
+          return fail(path + ":" + std::to_string(lineNo) + ": cannot find included file \"" + *target + "\"");
+        }
+        const int child = fileIndex(resolved);
+        if (child >= 0) {
+          out.text += "#line 1 " + std::to_string(child) + '\n';
+          STRATA_TRY_STATUS(expand(resolved, *content, child, false));
+        }
+        out.text += "#line " + std::to_string(lineNo + 1) + " " + std::to_string(index) + '\n';
+        continue;
+      }
+      out.text += line + '\n';
+    }
+    if (!sawVersion) return fail(path + ": empty shader (no #version line)");
+    return {};
+  }
+};
+
+}  // namespace
+
+Result<ShaderSource> preprocessShader(const std::string& name, const ShaderFileReader& read) {
+  auto text = read(name);
+  if (!text) return fail("shader '" + name + "' not found");
+  Expander ex{read, {}};
+  ex.out.name = name;
+  ex.out.files.push_back(name);
+  STRATA_TRY_STATUS(ex.expand(name, *text, 0, true));
+  return std::move(ex.out);
+}
+
+ShaderFileReader directoryReader(std::string root) {
+  return [root = std::move(root)](const std::string& path) -> std::optional<std::string> {
+    std::ifstream f(root + "/" + path, std::ios::binary);
+    if (!f) return std::nullopt;
+    std::ostringstream s;
+    s << f.rdbuf();
+    return s.str();
+  };
+}
+
+std::string mapInfoLog(std::string_view log, const std::vector<std::string>& files) {
+  // Mesa: "S:L(C): ..."; NVIDIA: "S(L) : ...". Only rewrite at the start of a line.
+  static const std::regex kMesa(R"(^(\d+):(\d+)\()");
+  static const std::regex kNvidia(R"(^(\d+)\((\d+)\))");
+  std::string out;
+  std::istringstream in{std::string(log)};
+  std::string line;
+  while (std::getline(in, line)) {
+    std::smatch m;
+    auto name = [&](const std::string& idx) {
+      const size_t i = std::stoul(idx);
+      return i < files.size() ? files[i] : idx;
+    };
+    if (std::regex_search(line, m, kMesa)) {
+      line = name(m[1]) + ":" + m[2].str() + "(" + m.suffix().str();
+    } else if (std::regex_search(line, m, kNvidia)) {
+      line = name(m[1]) + ":" + m[2].str() + m.suffix().str();
+    }
+    out += line + '\n';
+  }
+  return out;
+}
+
+}  // namespace strata::render::gl

@@ -1,0 +1,72 @@
+#!/usr/bin/env bash
+# Strata set-up: installs the Debian 12 packages the project needs (only the missing ones),
+# then configures and builds. Idempotent: a second run with nothing changed takes seconds.
+#
+#   scripts/setup.sh [--build-dir DIR] [--asan] [--no-build]
+#
+# Environment: STRATA_BUILD_TYPE (default RelWithDebInfo), STRATA_WERROR (ON in CI).
+set -euo pipefail
+
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+build_dir="$root/build"
+sanitize=""
+do_build=1
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --build-dir) build_dir=$2; shift 2 ;;
+    --asan) sanitize="address,undefined"; shift ;;
+    --no-build) do_build=0; shift ;;
+    *) echo "setup.sh: unknown option '$1'" >&2; exit 2 ;;
+  esac
+done
+
+# Keep this list the single source of what Strata needs from Debian.
+packages=(
+  # toolchain
+  cmake ninja-build g++ pkg-config clang clang-format libclang-rt-14-dev
+  # gis: raster I/O, CRS, reprojection, geodesy
+  libgdal-dev gdal-bin libgeographiclib-dev
+  # images, float fields, tiled storage
+  libopenimageio-dev openimageio-tools libopenexr-dev
+  # GL 4.5 through EGL (Mesa llvmpipe without a GPU), windows through GLFW (X11 -> Xvfb in tests)
+  libegl-dev libegl-mesa0 libgl1-mesa-dri libepoxy-dev libglfw3-dev libglm-dev xvfb
+  # command line, scenario files
+  libcli11-dev libtomlplusplus-dev
+  # tests and benchmarks
+  libgtest-dev libgmock-dev libbenchmark-dev
+  # plots in reports
+  python3-matplotlib python3-numpy
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  status=$(dpkg-query -W -f='${Status}' "$p" 2>/dev/null || true)
+  [ "$status" = "install ok installed" ] || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "setup: installing ${#missing[@]} Debian packages: ${missing[*]}" >&2
+  sudo=""
+  [ "$(id -u)" -eq 0 ] || sudo="sudo"
+  export DEBIAN_FRONTEND=noninteractive
+  $sudo apt-get update -qq
+  $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+
+[ "$do_build" -eq 1 ] || exit 0
+
+build_type=${STRATA_BUILD_TYPE:-RelWithDebInfo}
+werror=${STRATA_WERROR:-OFF}
+[ "${CI:-}" = "true" ] && werror=ON
+
+# Configure only when the build folder is new or its settings changed (cmake re-runs itself
+# when a CMakeLists.txt changes).
+want="type=$build_type werror=$werror sanitize=$sanitize"
+stamp="$build_dir/.strata-setup"
+if [ ! -f "$build_dir/build.ninja" ] || [ "$(cat "$stamp" 2>/dev/null)" != "$want" ]; then
+  cmake -S "$root" -B "$build_dir" -G Ninja \
+    -DCMAKE_BUILD_TYPE="$build_type" \
+    -DSTRATA_WERROR="$werror" \
+    -DSTRATA_SANITIZE="$sanitize" >/dev/null
+  echo "$want" > "$stamp"
+fi
+cmake --build "$build_dir" -j "$(nproc)"
