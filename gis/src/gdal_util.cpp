@@ -42,6 +42,14 @@ std::string GdalErrorCapture::last(const std::string& fallback) const {
   return m;
 }
 
+std::string withoutPath(std::string message, const std::string& path) {
+  // libtiff prefixes its messages with the file name; ours already starts with it.
+  for (const std::string& p : {path + ": ", path + ":", path}) {
+    for (size_t at = message.find(p); at != std::string::npos; at = message.find(p)) message.erase(at, p.size());
+  }
+  return message;
+}
+
 Result<DatasetPtr> openRaster(const std::string& path) {
   ensureGdal();
   const bool virtualPath = path.rfind("/vsi", 0) == 0;
@@ -62,7 +70,7 @@ Result<DatasetPtr> openRaster(const std::string& path) {
     if (why.empty() || why.find("not recognized as a supported file format") != std::string::npos) {
       return fail(path + ": not a raster GDAL can read");
     }
-    return fail(path + ": cannot open as a raster (corrupt or truncated?): " + why);
+    return fail(path + ": cannot open as a raster (corrupt or truncated?): " + withoutPath(why, path));
   }
   DatasetPtr ds(GDALDataset::FromHandle(h));
   if (ds->GetRasterCount() < 1) return fail(path + ": not a raster (no bands)");

@@ -37,6 +37,9 @@ struct DatasetCloser {
 };
 using DatasetPtr = std::unique_ptr<GDALDataset, DatasetCloser>;
 
+/// `message` with every mention of `path` removed (GDAL and libtiff repeat the file name).
+std::string withoutPath(std::string message, const std::string& path);
+
 /// Opens a raster read-only; errors name the file: missing, not a raster, corrupt.
 Result<DatasetPtr> openRaster(const std::string& path);
 
