@@ -8,6 +8,7 @@
 #include <GeographicLib/PolygonArea.hpp>
 #include <GeographicLib/UTMUPS.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <vector>
@@ -37,10 +38,12 @@ double wrap180(double dLonDeg) {
   return d;
 }
 
-// Latitudes within 1e-9 degree (0.1 mm) beyond a pole are the pole: geotransforms stored in text
-// round 90 - n * (1/3) that much; anything further out is not on the body (NaN).
+// Latitudes beyond a pole by at most 1e-4 degree (0.36", 11 m on Earth) are the pole: labels
+// that round the pixel size put the grid edge slightly past it (LOLA's LDEM_4: 0.1" past).
+// Anything further out is not on the body (NaN).
+constexpr double kPoleSnapDeg = 1e-4;
 double poleSnap(double latDeg) {
-  if (std::abs(latDeg) > 90.0 && std::abs(latDeg) <= 90.0 + 1e-9) return std::copysign(90.0, latDeg);
+  if (std::abs(latDeg) > 90.0 && std::abs(latDeg) <= 90.0 + kPoleSnapDeg) return std::copysign(90.0, latDeg);
   return latDeg;
 }
 
@@ -221,7 +224,25 @@ Result<Grid<double>> cellAreasM2(const Georef& georef) {
   }
   if (!georef.geographic) {
     STRATA_TRY(CrsTransform ct, CrsTransform::toGeographic(georef));
-    ct.transform(lon.size(), lon.data(), lat.data());
+    if (!ct.transform(lon.size(), lon.data(), lat.data())) {
+      // Corners on the edge of the projection's domain (the poles of the Moon's equirectangular
+      // grid, stored with 1e-16 rounding beyond 90 degrees) fail in PROJ: retry them moved 1e-9
+      // pixel towards the grid centre, which changes a cell's area by ~1e-9 of one edge strip.
+      const double cx = georef.width / 2.0, cy = georef.height / 2.0;
+      for (int r = 0; r < ch; ++r) {
+        for (int c = 0; c < cw; ++c) {
+          const size_t i = size_t(r) * cw + c;
+          if (!std::isnan(lon[i])) continue;
+          const double pc = c + (cx - c) * 1e-9 / std::max(1.0, std::abs(cx - c)),
+                       pr = r + (cy - r) * 1e-9 / std::max(1.0, std::abs(cy - r));
+          double x = t.x(pc, pr), y = t.y(pc, pr);
+          if (ct.transform(1, &x, &y)) {
+            lon[i] = x;
+            lat[i] = y;
+          }
+        }
+      }
+    }
   }
   const double e = eccentricity(georef.body);
   const double b = georef.body.semiMinorM();
