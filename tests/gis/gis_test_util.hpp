@@ -12,14 +12,14 @@
 
 namespace strata::gis::test {
 
-/// Runs a shell command and returns its stdout (stderr discarded) and exit status.
+/// Runs a shell command and returns its stdout (stderr discarded unless merged) and exit status.
 struct CommandOutput {
   std::string out;
   int status = -1;
 };
-inline CommandOutput runCommand(const std::string& command) {
+inline CommandOutput runCommand(const std::string& command, bool mergeStderr = false) {
   CommandOutput r;
-  FILE* pipe = ::popen((command + " 2>/dev/null").c_str(), "r");
+  FILE* pipe = ::popen((command + (mergeStderr ? " 2>&1" : " 2>/dev/null")).c_str(), "r");
   if (!pipe) return r;
   std::array<char, 4096> buf{};
   size_t n = 0;
