@@ -70,3 +70,58 @@ inline terrain::sim::SimInput sloshingBox(int n) {
 }
 
 }  // namespace strata::test
+
+namespace strata::test {
+
+/// A valley draining north to south with four layers (rock, soil, sand, sediment), rain and
+/// a spring at its head: water keeps flowing, so erosion, transport and deposition stay busy.
+inline terrain::sim::SimInput erodingValley(int n) {
+  terrain::sim::SimInput in;
+  in.baseM = gis::Grid<float>(n, n);
+  in.rowDxM = {4.0};
+  in.dyM = 4.0;
+  in.datumM = 2600.0;
+  in.materials = terrain::defaultMaterials();
+  in.layersM = {gis::Grid<float>(n, n), gis::Grid<float>(n, n), gis::Grid<float>(n, n), gis::Grid<float>(n, n)};
+  in.waterDepthM = gis::Grid<float>(n, n);
+  for (int y = 0; y < n; ++y) {
+    for (int x = 0; x < n; ++x) {
+      const double fx = double(x) / n - 0.5, fy = double(y) / n;
+      in.baseM.at(x, y) = float(2600.0 + 20.0 * (1.0 - fy) + 30.0 * fx * fx + 0.3 * std::sin(13.0 * fx + 7.0 * fy));
+      in.layersM[0].at(x, y) = 2.0f;
+      in.layersM[1].at(x, y) = float(0.5 + 0.4 * std::sin(5.0 * fy));
+      in.layersM[2].at(x, y) = float(0.3 + 0.3 * std::cos(9.0 * fx));
+      in.layersM[3].at(x, y) = (x + y) % 3 == 0 ? 0.1f : 0.0f;
+      in.waterDepthM.at(x, y) = fy > 0.8 ? 0.5f : 0.0f;
+    }
+  }
+  return in;
+}
+
+/// Erosion parameters for erodingValley (pipes, erosion and thermal weathering on).
+inline terrain::sim::SimParams erosionParams() {
+  terrain::sim::SimParams p;
+  p.waterModel = int32_t(terrain::sim::WaterModel::kVirtualPipes);
+  p.maxDtS = 0.05f;
+  p.pipeAreaM2 = 16.0f;
+  p.rainMmPerHour = 50.0f;
+  p.erosionEnabled = 1;
+  p.thermalEnabled = 1;
+  p.capacityK = 0.05f;
+  p.erosionRate = 0.5f;
+  p.depositionRate = 0.3f;
+  p.deepWaterM = 2.0f;
+  p.slowWaterMS = 0.05f;
+  p.dryDepthM = 1e-3f;  // no velocities (and so no erosion) from films of rain
+  return p;
+}
+
+/// A spring at the valley head feeding erodingValley.
+inline terrain::sim::Source valleySpring(int n) {
+  terrain::sim::Source s;
+  for (int x = n / 2 - 2; x <= n / 2 + 2; ++x) s.cells.push_back({x, 1});
+  s.hydrographM3S = {{0.0, 2.0}, {200.0, 5.0}};
+  return s;
+}
+
+}  // namespace strata::test

@@ -570,13 +570,16 @@ void CpuSimulation::thermalFluxPass() {
         sumEx += excess[d];
       }
       if (sumEx <= 0.0f) continue;
-      const float moved = std::min(layers_[size_t(top) * n + i], p_.thermalRate * 0.5f * maxEx);
+      float stack = 0.0f;
+      for (int l = 0; l < p_.layerCount; ++l) stack += layers_[size_t(l) * n + i];
+      const float moved = std::min(stack, p_.thermalRate * 0.5f * maxEx);
       for (int d = 0; d < 4; ++d) out[d] = moved * (excess[d] / sumEx);
     }
   }
 }
 
 // shaders/sim/thermal_apply.comp: E7, the receiving side; shed material lands as the top layer.
+// What a cell sheds comes off its stack top-down (E7b).
 void CpuSimulation::thermalApplyPass() {
   const size_t n = size_t(p_.width) * size_t(p_.height);
   const int sedimentLayer = p_.layerCount - 1;
@@ -591,7 +594,15 @@ void CpuSimulation::thermalApplyPass() {
         if (nx < 0 || ny < 0 || nx >= p_.width || ny >= p_.height) continue;
         received += thermal_[4 * idx(nx, ny) + size_t(d ^ 1)] * area(ny);
       }
-      if (shed > 0.0f) layers_[size_t(topLayer(i)) * n + i] -= shed;
+      // Shed material comes off the top of the stack, layer by layer; the last layer touched
+      // takes the float rounding remainder so the transfer is exact.
+      float remaining = shed;
+      for (int l = p_.layerCount - 1; l >= 0 && remaining > 0.0f; --l) {
+        float& layer = layers_[size_t(l) * n + i];
+        const float take = l == 0 ? remaining : std::min(layer, remaining);
+        layer -= take;
+        remaining -= take;
+      }
       layers_[size_t(sedimentLayer) * n + i] += received / area(y);
       recomputeBed(i);
     }

@@ -136,7 +136,8 @@ double integrate(const std::vector<float>& values, const std::vector<double>& ro
   for (int y = 0; y < height; ++y) {
     double row = 0;
     for (int x = 0; x < width; ++x) row += double(values[offset + size_t(y) * size_t(width) + size_t(x)]);
-    sum += row * (rowDxM.size() == 1 ? rowDxM[0] : rowDxM[size_t(y)]) * dyM;
+    // Layer stacks are several grids one after the other: row y of the stack is row y % rows.
+    sum += row * (rowDxM.size() == 1 ? rowDxM[0] : rowDxM[size_t(y) % rowDxM.size()]) * dyM;
   }
   return sum;
 }

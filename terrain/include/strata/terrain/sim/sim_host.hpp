@@ -30,7 +30,8 @@ double minCellSize(const std::vector<double>& rowDxM, double dyM);
 double rainVolumeRate(const SimParams& params, const std::vector<float>& rainRasterMmH,
                       const std::vector<double>& rowDxM, int width);
 
-/// sum over cells of value * cell area (m^3), in double; `values` is row-major width x rows.
+/// sum over cells of value * cell area (m^3), in double; `values` is row-major width x rows, or
+/// several such grids one after another (a layer stack).
 double integrate(const std::vector<float>& values, const std::vector<double>& rowDxM, double dyM, int width,
                  size_t offset = 0);
 
