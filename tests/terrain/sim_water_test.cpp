@@ -24,7 +24,7 @@ SimParams pipeParams() {
 
 SimParams floodParams() {
   SimParams p;
-  p.waterModel = int32_t(WaterModel::kLocalInertial);
+  p.waterModel = int32_t(WaterModel::kFiniteVolume);
   p.maxDtS = 10.0f;
   p.cflAlpha = 0.45f;
   return p;

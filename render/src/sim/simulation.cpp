@@ -232,7 +232,7 @@ Result<Simulation> Simulation::create(const SimInput& input, const SimParams& pa
   s.stage = gl::Buffer::from(std::span<const float>(state));
   s.flux = gl::Buffer(16 * n);
   s.flux.fill(0u);
-  const bool flood = s.p.waterModel == int32_t(ts::WaterModel::kLocalInertial);
+  const bool flood = s.p.waterModel == int32_t(ts::WaterModel::kFiniteVolume);
   s.faceX = gl::Buffer(flood ? 16 * size_t(w + 1) * size_t(h) : 16);
   s.faceX.fill(0u);
   s.faceY = gl::Buffer(flood ? 16 * size_t(w) * size_t(h + 1) : 16);

@@ -72,10 +72,10 @@ Status validate(const SimInput& input, const SimParams& params) {
   if (!(params.maxDtS > 0)) return fail("sim params: maxDtS must be positive");
   if (!(params.gravityMS2 > 0)) return fail("sim params: gravityMS2 must be positive");
   if (params.waterModel != int32_t(WaterModel::kVirtualPipes) &&
-      params.waterModel != int32_t(WaterModel::kLocalInertial)) {
+      params.waterModel != int32_t(WaterModel::kFiniteVolume)) {
     return fail("sim params: waterModel " + std::to_string(params.waterModel) + " is not 0 (pipes) or 1 (flood)");
   }
-  if (params.waterModel == int32_t(WaterModel::kLocalInertial) && !(params.cflAlpha > 0 && params.cflAlpha <= 0.5f)) {
+  if (params.waterModel == int32_t(WaterModel::kFiniteVolume) && !(params.cflAlpha > 0 && params.cflAlpha <= 0.5f)) {
     return fail("sim params: flood mode needs cflAlpha in (0, 0.5] (positivity of the finite-volume scheme)");
   }
   if (params.thermalRate <= 0 || params.thermalRate > 1) return fail("sim params: thermalRate must be in (0, 1]");

@@ -21,8 +21,8 @@ namespace strata::terrain::sim {
 
 /// Which shallow-water model moves the water.
 enum class WaterModel : int32_t {
-  kVirtualPipes = 0,   ///< Mei et al. 2007 / Stava et al. 2008 outflow pipes (W1-W5)
-  kLocalInertial = 1,  ///< Bates et al. 2010 / de Almeida et al. 2012 flood mode (W6-W9)
+  kVirtualPipes = 0,  ///< Mei et al. 2007 / Stava et al. 2008 outflow pipes (W1-W4)
+  kFiniteVolume = 1,  ///< flood mode: Godunov finite volumes, HLL + hydrostatic reconstruction (W13-W24)
 };
 
 /// Bits of SimParams::openEdges: an open edge lets water flow out freely (and counts it);
@@ -43,10 +43,10 @@ struct SimParams {
   float gravityMS2 = 9.81f;           ///< g (m/s^2)
   float dtS = 0.0f;                   ///< the current step (s); written by the solver each step
   float maxDtS = 0.05f;               ///< fixed step, or the upper bound of the adaptive one (s)
-  float cflAlpha = 0.0f;              ///< > 0: dt = min(maxDtS, alpha * min(dx,dy) / sqrt(g h_max)) (W10)
+  float cflAlpha = 0.0f;              ///< > 0: dt = min(maxDtS, alpha * min(dx,dy) / max(|u| + sqrt(g h))) (W10)
   float dryDepthM = 1e-6f;            ///< below this depth a cell or face counts as dry (m)
   float pipeAreaM2 = 1.0f;            ///< cross-section of a virtual pipe (m^2) (W1)
-  float manningN = 0.0f;              ///< Manning's n (s m^-1/3); 0 = frictionless (W6)
+  float manningN = 0.0f;              ///< Manning's n (s m^-1/3), flood mode; 0 = frictionless (W19)
   float rainMmPerHour = 0.0f;         ///< uniform rain (mm/h), added to the rain raster
   float evaporationMmPerHour = 0.0f;  ///< evaporation from wet cells (mm/h) (W11)
   float capacityK = 0.0f;             ///< sediment capacity constant Kc (s) (E1)
