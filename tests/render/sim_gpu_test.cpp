@@ -1,0 +1,210 @@
+// The GPU simulation (shaders/sim/*.comp) on whatever GL the machine has (llvmpipe in CI):
+// the invariants the CPU reference is held to, and agreement with the CPU reference on the
+// same inputs (tests/terrain/sim_*_test.cpp pin the reference to analytic solutions).
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+
+#include <strata/render/sim/simulation.hpp>
+#include <strata/terrain/sim/cpu_simulation.hpp>
+
+#include "gl_fixture.hpp"
+#include "sim_scenes.hpp"
+#include "strata_test.hpp"
+
+namespace strata::render::sim {
+namespace {
+
+using terrain::sim::CpuSimulation;
+using terrain::sim::WaterModel;
+using test::GlTest;
+
+SimParams pipeParams() {
+  SimParams p;
+  p.waterModel = int32_t(WaterModel::kVirtualPipes);
+  p.maxDtS = 0.1f;
+  p.pipeAreaM2 = 25.0f;
+  return p;
+}
+
+SimParams floodParams() {
+  SimParams p;
+  p.waterModel = int32_t(WaterModel::kFiniteVolume);
+  p.maxDtS = 10.0f;
+  p.cflAlpha = 0.45f;
+  return p;
+}
+
+double maxAbsDiff(const gis::Grid<float>& a, const gis::Grid<float>& b) {
+  double m = 0;
+  for (size_t i = 0; i < a.size(); ++i) m = std::max(m, std::abs(double(a.data[i]) - double(b.data[i])));
+  return m;
+}
+
+double seconds(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+TEST_F(GlTest, SimLakeAtRestStaysFlat) {
+  for (const auto& params : {pipeParams(), floodParams()}) {
+    auto sim = Simulation::create(test::lakeAtRest(48, 2000.0), params);
+    ASSERT_TRUE(sim) << sim.message();
+    sim->step(1000);
+    const auto h = sim->readWaterDepth();
+    const auto bed = sim->readBed();
+    const auto vel = sim->readVelocity();
+    double maxDev = 0, maxSpeed = 0;
+    for (size_t i = 0; i < h.size(); ++i) {
+      maxSpeed = std::max(maxSpeed, double(std::hypot(vel.uMS.data[i], vel.vMS.data[i])));
+      if (h.data[i] > 0.0f) maxDev = std::max(maxDev, std::abs(double(bed.data[i]) + double(h.data[i]) - 3.0));
+    }
+    std::printf("GPU lake at rest (model %d): max surface deviation %.3g m, max speed %.3g m/s\n", params.waterModel,
+                maxDev, maxSpeed);
+    // Issue 5's bounds (see the CPU test for why they leave room for rounding only).
+    EXPECT_LT(maxDev, 1e-5);
+    EXPECT_LT(maxSpeed, 1e-5);
+  }
+}
+
+TEST_F(GlTest, SimClosedBoxConservesVolume) {
+  // llvmpipe spends ~1 ms per dispatch whatever the grid, so the GPU runs issue 5's 10,000
+  // steps with pipes (2 passes a step) and 2,000 in flood mode (5 passes and a read-back a
+  // step); the CPU reference runs 10,000 of both.
+  for (auto [params, n, steps] : {std::tuple{pipeParams(), 32, 10000}, std::tuple{floodParams(), 32, 2000}}) {
+    auto sim = Simulation::create(test::sloshingBox(n), params);
+    ASSERT_TRUE(sim) << sim.message();
+    const double v0 = sim->stats().storedWaterM3;
+    const auto t0 = std::chrono::steady_clock::now();
+    sim->step(steps);
+    const auto st = sim->stats();
+    const double rel = std::abs(st.storedWaterM3 - v0) / v0;
+    std::printf(
+        "GPU closed box (model %d, %dx%d): %lld steps in %.2f s wall, %.1f s simulated, relative volume "
+        "change %.3g\n",
+        params.waterModel, n, n, st.steps, seconds(t0), st.timeS, rel);
+    // Issue 5's bound; the CPU reference measures 1e-8 (pipes) and 1.4e-7 (flood).
+    EXPECT_LT(rel, 1e-6);
+  }
+}
+
+TEST_F(GlTest, SimRainAndSourcesBalance) {
+  auto in = test::sloshingBox(32);
+  in.rainMmPerHour = gis::Grid<float>(32, 32, 30.0f);
+  auto params = pipeParams();
+  params.rainMmPerHour = 100.0f;
+  params.openEdges = terrain::sim::kEdgeSouth;
+  params.evaporationMmPerHour = 20.0f;
+  auto sim = Simulation::create(in, params);
+  ASSERT_TRUE(sim) << sim.message();
+  terrain::sim::Source spring;
+  spring.cells = {{3, 3}, {4, 3}};
+  spring.hydrographM3S = {{0.0, 1.0}, {50.0, 4.0}};
+  ASSERT_TRUE(sim->addSource(spring));
+  EXPECT_FALSE(sim->addSource(terrain::sim::Source{{{-1, 0}}, {}}));
+  sim->advance(200.0);
+  const auto st = sim->stats();
+  const double moved = st.initialWaterM3 + st.rainM3 + st.inflowM3 + st.outflowM3 + st.evaporatedM3;
+  std::printf(
+      "GPU balance: rain %.3f inflow %.3f outflow %.3f evaporated %.3f stored %.3f -> %.3f, imbalance %.3g m3\n",
+      st.rainM3, st.inflowM3, st.outflowM3, st.evaporatedM3, st.initialWaterM3, st.storedWaterM3, st.waterBalanceM3());
+  EXPECT_NEAR(st.timeS, 200.0, 1e-9);
+  EXPECT_NEAR(st.inflowM3, 0.5 * 5.0 * 50.0 + 4.0 * 150.0, 1e-6);  // the hydrograph's integral
+  EXPECT_GT(st.outflowM3, 1.0);
+  EXPECT_GT(st.evaporatedM3, 0.1);
+  // Float32 depth updates of ~2e4 m3 over 2000 steps; same bound as the CPU reference (1e-5).
+  EXPECT_LT(std::abs(st.waterBalanceM3()), 1e-5 * moved);
+}
+
+// GPU and CPU run the same passes in float32; they differ only where the GPU compiler fuses a
+// multiply-add or orders a sum differently (~1 ulp per operation), which the dynamics then
+// amplify a little each step.
+void expectAgreement(const terrain::sim::SimInput& in, const SimParams& params, int steps, double depthTol,
+                     double layerTol, const terrain::sim::Source* source) {
+  auto gpu = Simulation::create(in, params);
+  ASSERT_TRUE(gpu) << gpu.message();
+  auto cpu = CpuSimulation::create(in, params);
+  ASSERT_TRUE(cpu) << cpu.message();
+  if (source) {
+    ASSERT_TRUE(gpu->addSource(*source));
+    ASSERT_TRUE(cpu->addSource(*source));
+  }
+  gpu->step(steps);
+  cpu->step(steps);
+  const double dh = maxAbsDiff(gpu->readWaterDepth(), cpu->readWaterDepth());
+  const double ds = maxAbsDiff(gpu->readSuspended(), cpu->readSuspended());
+  double dl = 0;
+  const auto lg = gpu->readLayers(), lc = cpu->readLayers();
+  for (size_t l = 0; l < lg.size(); ++l) dl = std::max(dl, maxAbsDiff(lg[l], lc[l]));
+  const auto sg = gpu->stats(), sc = cpu->stats();
+  std::printf(
+      "GPU vs CPU (model %d, erosion %u, %d steps, t %.2f / %.2f s): max |dh| %.3g m, |ds| %.3g m, |dlayer| "
+      "%.3g m, stored %.6f / %.6f m3\n",
+      params.waterModel, params.erosionEnabled, steps, sg.timeS, sc.timeS, dh, ds, dl, sg.storedWaterM3,
+      sc.storedWaterM3);
+  EXPECT_NEAR(sg.timeS, sc.timeS, 1e-3 * sc.timeS);
+  EXPECT_LT(dh, depthTol);
+  EXPECT_LT(ds, layerTol);
+  EXPECT_LT(dl, layerTol);
+  EXPECT_NEAR(sg.storedWaterM3, sc.storedWaterM3, 1e-5 * sc.storedWaterM3);
+  EXPECT_NEAR(sg.materialM3, sc.materialM3, 1e-6 * sc.materialM3);
+}
+
+TEST_F(GlTest, SimPipesAgreeWithCpuReference) {
+  // 300 steps of a sloshing box with a spring, rain and an open edge: depths of ~1.5 m agree
+  // to 1e-4 m (measured ~1e-6; rounding differences grow slowly in this undamped model).
+  auto in = test::sloshingBox(32);
+  auto p = pipeParams();
+  p.openEdges = terrain::sim::kEdgeEast;
+  p.rainMmPerHour = 40.0f;
+  terrain::sim::Source spring{{{5, 5}}, {{0.0, 2.0}, {30.0, 0.5}}};
+  expectAgreement(in, p, 300, 1e-4, 1e-6, &spring);
+}
+
+TEST_F(GlTest, SimFloodAgreesWithCpuReference) {
+  // A dam break in the sloshing box (wet/dry fronts, adaptive dt read back from the GPU).
+  auto in = test::sloshingBox(32);
+  for (int y = 0; y < 32; ++y) {
+    for (int x = 0; x < 32; ++x) in.waterDepthM.at(x, y) = x < 10 ? 2.0f : 0.0f;
+  }
+  expectAgreement(in, floodParams(), 150, 1e-4, 1e-6, nullptr);
+}
+
+TEST_F(GlTest, SimErosionAgreesWithCpuReference) {
+  // Erosion, transport, deposition and thermal weathering on. Step by step the two agree to an
+  // ulp, but thresholds (a layer present or not, load above or below capacity) flip on 1-ulp
+  // differences and the flips grow: after 50 steps the measured gaps are ~1e-6 m.
+  const int n = 32;
+  auto spring = test::valleySpring(n);
+  expectAgreement(test::erodingValley(n), test::erosionParams(), 50, 1e-4, 1e-4, &spring);
+}
+
+TEST_F(GlTest, SimErosionConservesMaterial) {
+  // 3,000 steps on the GPU (4 passes a step at ~1 ms each on llvmpipe); the CPU reference runs
+  // issue 5's 10,000.
+  const int n = 32;
+  auto sim = Simulation::create(test::erodingValley(n), test::erosionParams());
+  ASSERT_TRUE(sim) << sim.message();
+  ASSERT_TRUE(sim->addSource(test::valleySpring(n)));
+  const auto before = sim->readLayers();
+  const auto t0 = std::chrono::steady_clock::now();
+  sim->step(3000);
+  const auto st = sim->stats();
+  const auto after = sim->readLayers();
+  double moved = 0;
+  for (size_t l = 0; l < after.size(); ++l) {
+    for (size_t i = 0; i < after[l].size(); ++i)
+      moved += std::abs(double(after[l].data[i]) - double(before[l].data[i])) * 16.0;
+  }
+  const double rel = std::abs(st.materialM3 - st.initialMaterialM3) / st.initialMaterialM3;
+  std::printf(
+      "GPU erosion: %lld steps in %.2f s wall, material rel change %.3g, suspended %.3f m3, layers changed by "
+      "%.1f m3\n",
+      st.steps, seconds(t0), rel, st.suspendedM3, moved);
+  EXPECT_GT(moved, 10.0);
+  // Issue 5's bound; pure float transfers (the CPU reference measures 3e-7 over 10,000 steps).
+  EXPECT_LT(rel, 1e-5);
+}
+
+}  // namespace
+}  // namespace strata::render::sim
