@@ -35,7 +35,7 @@ packages=(
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev
   # plots in reports
-  python3-matplotlib python3-numpy
+  python3-matplotlib python3-numpy python3-gdal
 )
 
 missing=()

@@ -279,7 +279,7 @@ Status readRegion(const Reader& r, const toml::table& root, Scenario& s) {
 Status readModel(const Reader& r, const toml::table& root, Scenario& s) {
   const auto* t = root["model"].as_table();
   if (!t) return {};
-  STRATA_TRY_STATUS(r.onlyKeys(*t, "model", {"kind", "manning_n", "cfl", "boundary", "diagonal_pipes"}));
+  STRATA_TRY_STATUS(r.onlyKeys(*t, "model", {"kind", "manning_n", "cfl", "boundary"}));
   if (const auto* k = t->get("kind")) {
     STRATA_TRY(auto v, r.string(*k, "model.kind"));
     if (v == "flood") {
@@ -299,9 +299,9 @@ Status readModel(const Reader& r, const toml::table& root, Scenario& s) {
   if (const auto* c = t->get("cfl")) {
     STRATA_TRY(s.model.cfl, r.number(*c, "model.cfl"));
     if (s.model.cfl <= 0 || s.model.cfl > 1) return r.error(*c, "model.cfl", "must be in (0, 1]");
-  }
-  if (const auto* d = t->get("diagonal_pipes")) {
-    STRATA_TRY(s.model.diagonalPipes, r.boolean(*d, "model.diagonal_pipes"));
+    if (s.model.kind == WaterModel::Flood && s.model.cfl > 0.5) {
+      return r.error(*c, "model.cfl", "flood mode needs cfl <= 0.5 (positivity of the finite-volume scheme)");
+    }
   }
   if (const auto* b = t->get("boundary")) {
     auto parse = [&](const toml::node& n, const std::string& key) -> Result<Boundary> {
@@ -355,7 +355,7 @@ Status readErosion(const Reader& r, const toml::table& root, Scenario& s) {
 Status readWater(const Reader& r, const toml::table& root, Scenario& s) {
   const auto* t = root["water"].as_table();
   if (!t) return {};
-  STRATA_TRY_STATUS(r.onlyKeys(*t, "water", {"inflow", "rain", "dam_break", "level", "evaporation"}));
+  STRATA_TRY_STATUS(r.onlyKeys(*t, "water", {"inflow", "rain", "dam_break", "evaporation"}));
   if (const auto* e = t->get("evaporation")) {
     STRATA_TRY(s.water.evaporationMPerS, r.quantity(*e, "water.evaporation", "rate"));
     if (s.water.evaporationMPerS < 0) return r.error(*e, "water.evaporation", "must not be negative");
@@ -424,27 +424,6 @@ Status readWater(const Reader& r, const toml::table& root, Scenario& s) {
       STRATA_TRY(d.surfaceElevationM, r.quantity(*dt->get("surface"), key + ".surface", "length"));
       s.water.damBreaks.push_back(std::move(d));
     }
-  }
-  if (const auto* lv = t->get("level")) {
-    const auto* lt = lv->as_table();
-    if (!lt) return r.error(*lv, "water.level", "expected a table");
-    STRATA_TRY_STATUS(r.onlyKeys(*lt, "water.level", {"polygon_lonlat", "polygon_xy", "from", "to", "start", "end"}));
-    LevelRise l;
-    STRATA_TRY(auto poly, r.placeKey(*lt, "water.level", "polygon", false));
-    if (!poly || poly->points.size() < 3)
-      return r.errorAt(int(lt->source().begin.line), "water.level.polygon_lonlat",
-                       "a polygon of at least 3 points is needed");
-    l.polygon = *poly;
-    for (const char* k : {"from", "to", "start", "end"}) {
-      if (!lt->get(k)) return r.errorAt(int(lt->source().begin.line), std::string("water.level.") + k, "missing");
-    }
-    STRATA_TRY(l.startElevationM, r.quantity(*lt->get("from"), "water.level.from", "length"));
-    STRATA_TRY(l.endElevationM, r.quantity(*lt->get("to"), "water.level.to", "length"));
-    STRATA_TRY(l.startS, r.quantity(*lt->get("start"), "water.level.start", "time"));
-    STRATA_TRY(l.endS, r.quantity(*lt->get("end"), "water.level.end", "time"));
-    if (l.startS < 0) return r.error(*lt->get("start"), "water.level.start", "negative time");
-    if (l.endS <= l.startS) return r.error(*lt->get("end"), "water.level.end", "must be after start");
-    s.water.level = l;
   }
   return {};
 }
@@ -577,8 +556,8 @@ Result<Scenario> parseScenario(std::string_view text, const std::filesystem::pat
   STRATA_TRY_STATUS(readWater(r, root, s));
   STRATA_TRY_STATUS(readTime(r, root, s));
   STRATA_TRY_STATUS(readOutputs(r, root, s));
-  if (s.water.inflows.empty() && !s.water.rain && s.water.damBreaks.empty() && !s.water.level) {
-    return fail(r.file + ": [water] has no source: add an inflow, rain, a dam_break or a level");
+  if (s.water.inflows.empty() && !s.water.rain && s.water.damBreaks.empty()) {
+    return fail(r.file + ": [water] has no source: add an inflow, rain or a dam_break");
   }
   if (std::find(s.outputs.maps.begin(), s.outputs.maps.end(), "terrain_change") != s.outputs.maps.end() &&
       !s.erosion.enabled) {

@@ -126,7 +126,7 @@ TEST(Scenario, NeedsASource) {
   text = text.substr(0, text.find("[[water.inflow]]")) + text.substr(text.find("[time]"));
   auto s = parse(text);
   ASSERT_FALSE(s);
-  EXPECT_EQ(s.message(), "/data/runs/gc.toml: [water] has no source: add an inflow, rain, a dam_break or a level");
+  EXPECT_EQ(s.message(), "/data/runs/gc.toml: [water] has no source: add an inflow, rain or a dam_break");
 }
 
 TEST(Scenario, MissingFile) {

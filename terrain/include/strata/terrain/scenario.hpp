@@ -54,12 +54,6 @@ struct DamBreak {
   double surfaceElevationM = 0;  ///< water surface inside the polygon
 };
 
-/// A fixed water level rising at a boundary or over an area (e.g. a reservoir filling).
-struct LevelRise {
-  Place polygon;
-  double startElevationM = 0, endElevationM = 0, startS = 0, endS = 0;
-};
-
 enum class WaterModel { Pipe, Flood };
 enum class Boundary { Closed, Open };
 
@@ -88,9 +82,8 @@ struct Scenario {
   struct {
     WaterModel kind = WaterModel::Flood;
     double manningN = 0.035;  ///< s/m^(1/3)
-    double cfl = 0.7;
+    double cfl = 0.45;  ///< flood mode needs <= 0.5 (positivity of the finite-volume scheme)
     std::array<Boundary, 4> boundaries{Boundary::Open, Boundary::Open, Boundary::Open, Boundary::Open};  ///< W E S N
-    bool diagonalPipes = false;
   } model;
 
   struct {
@@ -103,7 +96,6 @@ struct Scenario {
     std::vector<Inflow> inflows;
     std::optional<Rain> rain;
     std::vector<DamBreak> damBreaks;
-    std::optional<LevelRise> level;
     double evaporationMPerS = 0;
   } water;
 

@@ -1,0 +1,59 @@
+// strata flood SCENARIO / strata erode SCENARIO: run a what-if scenario on the GPU and write its
+// run folder (maps, series, plots, report). Ctrl-C stops cleanly; --resume continues.
+#include <cstdio>
+#include <memory>
+
+#include <strata/render/scenario/flood_run.hpp>
+#include <strata/terrain/scenario.hpp>
+
+#include "commands.hpp"
+
+namespace strata::app {
+namespace {
+
+struct FloodArgs {
+  std::string scenario, outDir;
+  bool resume = false, noPictures = false, noPlots = false;
+};
+
+void addRunCommand(CLI::App& app, const char* name, const char* help, bool erosion) {
+  auto* cmd = app.add_subcommand(name, help);
+  auto args = std::make_shared<FloodArgs>();
+  cmd->add_option("scenario", args->scenario, "Scenario file (TOML, see docs/scenario.md)")->required();
+  cmd->add_option("-o,--out", args->outDir, "Run folder (default: runs/<scenario name>)");
+  cmd->add_flag("--resume", args->resume, "Continue an interrupted run from its checkpoint");
+  cmd->add_flag("--no-pictures", args->noPictures, "Do not render pictures");
+  cmd->add_flag("--no-plots", args->noPlots, "Do not draw plots");
+  cmd->callback([args, name, erosion] {
+    auto scenario = terrain::loadScenario(args->scenario);
+    if (!scenario) {
+      std::fprintf(stderr, "strata %s: %s\n", name, scenario.message().c_str());
+      throw CLI::RuntimeError(1);
+    }
+    if (erosion && !scenario->erosion.enabled) {
+      scenario->erosion.enabled = true;
+      scenario->outputs.maps.push_back("terrain_change");
+    }
+    render::scenario::RunOptions opt;
+    opt.outDir = args->outDir.empty() ? std::filesystem::path("runs") / scenario->file.stem() : args->outDir;
+    opt.resume = args->resume;
+    opt.pictures = !args->noPictures && scenario->outputs.pictures;
+    opt.plots = !args->noPlots && scenario->outputs.plots;
+    auto run = render::scenario::runScenario(*scenario, opt);
+    if (!run) {
+      std::fprintf(stderr, "strata %s: %s\n", name, run.message().c_str());
+      throw CLI::RuntimeError(1);
+    }
+    std::printf("%s: %s\n", run->completed ? "finished" : "stopped", (opt.outDir / "report.md").c_str());
+    if (!run->completed) throw CLI::RuntimeError(130);
+  });
+}
+
+}  // namespace
+
+void addFloodCommands(CLI::App& app) {
+  addRunCommand(app, "flood", "Run a flood what-if scenario and write maps, series, plots and a report", false);
+  addRunCommand(app, "erode", "Run a scenario with erosion and deposition switched on", true);
+}
+
+}  // namespace strata::app

@@ -1,0 +1,308 @@
+#include <strata/terrain/scenario_domain.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+#include <strata/gis/dem_io.hpp>
+#include <strata/gis/geodesy.hpp>
+#include <strata/gis/mosaic.hpp>
+#include <strata/terrain/material.hpp>
+
+namespace strata::terrain {
+namespace {
+
+// "file:line: key 'k': message" for a place read from the scenario.
+Error placeError(const Scenario& s, const Place& p, const std::string& message) {
+  return fail(s.file.string() + ":" + std::to_string(p.line) + ": key '" + p.key + "': " + message);
+}
+
+// Converts places of the scenario to pixel coordinates of a georef (fractional, (0,0) = top-left
+// corner of the top-left cell).
+class PixelMapper {
+ public:
+  static Result<PixelMapper> create(const gis::Georef& g) {
+    if (!g.transform.isNorthUp()) return fail("the DEM is not north-up (rotated geotransforms are not supported)");
+    PixelMapper m;
+    m.g_ = g;
+    if (!g.geographic) {
+      if (g.body.name != gis::Body::wgs84().name) {
+        m.lonLatError_ = "lon/lat places on a projected CRS of " + g.body.name + " are not supported; use *_xy";
+      } else {
+        auto t = gis::CrsTransform::create("EPSG:4326", g.crsWkt);
+        if (!t) return t.error();
+        m.toCrs_ = std::make_shared<gis::CrsTransform>(std::move(t).value());
+      }
+    }
+    return m;
+  }
+
+  // Pixel coordinates of a place's points.
+  Result<std::vector<std::array<double, 2>>> pixels(const Scenario& s, const Place& p) const {
+    std::vector<std::array<double, 2>> out;
+    for (auto pt : p.points) {
+      double x = pt[0], y = pt[1];
+      if (p.frame == CoordFrame::LonLat) {
+        if (!lonLatError_.empty()) return placeError(s, p, lonLatError_);
+        if (g_.geographic) {
+          // Longitudes 0..360 and -180..180 both: move x into the DEM's longitude range.
+          const double west = g_.transform.c[0], east = west + g_.width * g_.transform.c[1];
+          while (x < west && x + 360 <= east + 1e-9) x += 360;
+          while (x > east && x - 360 >= west - 1e-9) x -= 360;
+        } else if (!toCrs_->transform(1, &x, &y)) {
+          return placeError(s, p, "cannot transform [" + std::to_string(pt[0]) + ", " + std::to_string(pt[1]) +
+                                      "] to the DEM's CRS");
+        }
+      }
+      out.push_back({(x - g_.transform.c[0]) / g_.transform.c[1], (y - g_.transform.c[3]) / g_.transform.c[5]});
+    }
+    return out;
+  }
+
+ private:
+  gis::Georef g_;
+  std::shared_ptr<gis::CrsTransform> toCrs_;
+  std::string lonLatError_;
+};
+
+std::string describeExtent(const gis::Georef& g) {
+  char buf[160];
+  const double x0 = g.transform.c[0], y0 = g.transform.c[3];
+  const double x1 = x0 + g.width * g.transform.c[1], y1 = y0 + g.height * g.transform.c[5];
+  std::snprintf(buf, sizeof buf, "[%.6g, %.6g, %.6g, %.6g]", std::min(x0, x1), std::min(y0, y1), std::max(x0, x1),
+                std::max(y0, y1));
+  return buf;
+}
+
+}  // namespace
+
+std::vector<std::pair<int, int>> cellsAlong(const std::vector<std::array<double, 2>>& pts, int width, int height) {
+  std::vector<std::pair<int, int>> cells;
+  std::set<std::pair<int, int>> seen;
+  auto add = [&](double x, double y) {
+    const int cx = int(std::floor(x)), cy = int(std::floor(y));
+    if (cx < 0 || cy < 0 || cx >= width || cy >= height) return;
+    if (seen.insert({cx, cy}).second) cells.push_back({cx, cy});
+  };
+  if (pts.size() == 1) add(pts[0][0], pts[0][1]);
+  for (size_t i = 1; i < pts.size(); ++i) {
+    const double dx = pts[i][0] - pts[i - 1][0], dy = pts[i][1] - pts[i - 1][1];
+    const int n = std::max(1, int(std::ceil(4 * std::hypot(dx, dy))));
+    for (int k = 0; k <= n; ++k) add(pts[i - 1][0] + dx * k / n, pts[i - 1][1] + dy * k / n);
+  }
+  return cells;
+}
+
+bool insidePolygon(const std::vector<std::array<double, 2>>& poly, double x, double y) {
+  bool in = false;
+  for (size_t i = 0, j = poly.size() - 1; i < poly.size(); j = i++) {
+    const auto &a = poly[i], &b = poly[j];
+    if ((a[1] > y) != (b[1] > y) && x < (b[0] - a[0]) * (y - a[1]) / (b[1] - a[1]) + a[0]) in = !in;
+  }
+  return in;
+}
+
+Result<ScenarioDomain> buildDomain(const Scenario& s) {
+  if (!s.terrain.store.empty()) {
+    return fail(s.file.string() + ": key 'terrain.store': runs from a tile store are not supported by strata flood yet; "
+                                  "export a window (strata export) and give it as terrain.dem");
+  }
+  const std::string& demPath = s.terrain.dems.front();
+  STRATA_TRY(auto info, gis::probeDem(demPath));
+  const gis::Georef& full = info.georef;
+  STRATA_TRY(auto mapper, PixelMapper::create(full));
+
+  // The window: the region's pixel bounding box, which must lie inside the DEM.
+  gis::PixelWindow window{0, 0, full.width, full.height};
+  std::vector<std::array<double, 2>> polygonPx;
+  if (s.region.kind != decltype(s.region)::Whole) {
+    STRATA_TRY(auto px, mapper.pixels(s, s.region.place));
+    double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300;
+    for (const auto& p : px) {
+      x0 = std::min(x0, p[0]);
+      x1 = std::max(x1, p[0]);
+      y0 = std::min(y0, p[1]);
+      y1 = std::max(y1, p[1]);
+    }
+    if (x0 < -1e-6 || y0 < -1e-6 || x1 > full.width + 1e-6 || y1 > full.height + 1e-6) {
+      return placeError(s, s.region.place, "the region is not inside the DEM " + demPath + " (extent " +
+                                               describeExtent(full) + " in its CRS)");
+    }
+    window.x = std::clamp(int(std::floor(x0 + 1e-6)), 0, full.width - 1);
+    window.y = std::clamp(int(std::floor(y0 + 1e-6)), 0, full.height - 1);
+    window.width = std::clamp(int(std::ceil(x1 - 1e-6)), window.x + 1, full.width) - window.x;
+    window.height = std::clamp(int(std::ceil(y1 - 1e-6)), window.y + 1, full.height) - window.y;
+    if (window.width < 4 || window.height < 4) {
+      return placeError(s, s.region.place, "the region covers fewer than 4x4 cells of the DEM");
+    }
+    if (s.region.kind == decltype(s.region)::Polygon) {
+      for (auto p : px) polygonPx.push_back({p[0] - window.x, p[1] - window.y});
+    }
+  }
+
+  ScenarioDomain d;
+  gis::ReadOptions ro;
+  ro.window = window;
+  STRATA_TRY(d.bed, gis::readDem(demPath, ro));
+  if (s.terrain.dems.size() > 1) {
+    std::vector<gis::MosaicInput> inputs;
+    for (const auto& p : s.terrain.dems) inputs.push_back({p, std::nullopt, gis::BlendMode::Replace});
+    STRATA_TRY(auto layer, gis::buildMosaic("bedrock", d.bed.georef, inputs));
+    d.bed = std::move(layer.raster);
+  }
+  const gis::Georef& g = d.bed.georef;
+  const int w = g.width, h = g.height;
+  for (size_t i = 0; i < d.bed.values.size(); ++i) {
+    if (gis::isNoData(d.bed.values.data[i])) {
+      return fail(demPath + ": the region has cells without data (nodata); choose a region the DEM covers");
+    }
+  }
+
+  // Region mask: a polygon's outside becomes a wall.
+  d.inside = gis::Grid<uint8_t>(w, h, 1);
+  if (!polygonPx.empty()) {
+    for (int y = 0; y < h; ++y) {
+      for (int x = 0; x < w; ++x) d.inside.at(x, y) = insidePolygon(polygonPx, x + 0.5, y + 0.5) ? 1 : 0;
+    }
+  }
+
+  // Cell sizes: geodesic areas per cell; dy the geodesic length of a column cell; per-row dx so
+  // that dx * dy is the row's true cell area.
+  STRATA_TRY(d.cellAreaM2, gis::cellAreasM2(g));
+  STRATA_TRY(auto top, gis::pixelToLonLat(g, w * 0.5, 0));
+  STRATA_TRY(auto bottom, gis::pixelToLonLat(g, w * 0.5, h));
+  const double dy = gis::geodesicDistanceM(top, bottom, g.body) / h;
+  d.input.dyM = dy;
+  d.input.rowDxM.resize(size_t(h));
+  for (int y = 0; y < h; ++y) d.input.rowDxM[size_t(y)] = d.cellAreaM2.at(w / 2, y) / dy;
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      if (d.inside.at(x, y)) d.totalAreaM2 += d.cellAreaM2.at(x, y);
+    }
+  }
+
+  // Bed and layers. The datum is the region's lowest point, so float32 keeps millimetres.
+  float lo = 1e30f;
+  for (size_t i = 0; i < d.bed.values.size(); ++i) {
+    if (d.inside.data[i]) lo = std::min(lo, d.bed.values.data[i]);
+  }
+  d.input.datumM = std::floor(double(lo));
+  d.input.baseM = d.bed.values;
+  for (size_t i = 0; i < d.input.baseM.size(); ++i) {
+    if (!d.inside.data[i]) d.input.baseM.data[i] = kWallElevationM;
+  }
+  const auto table = defaultMaterials();
+  if (s.terrain.layers.empty()) {
+    // Bare rock: one layer of zero thickness so erosion has a material to read.
+    d.input.layersM.push_back(gis::Grid<float>(w, h, 0.0f));
+    d.input.materials.push_back(table[size_t(findMaterial(table, "rock"))]);
+  }
+  for (size_t l = 0; l < s.terrain.layers.size(); ++l) {
+    const auto& spec = s.terrain.layers[l];
+    const int m = findMaterial(table, spec.material);
+    if (m < 0) {
+      return fail(s.file.string() + ": key 'terrain.layer[" + std::to_string(l) + "].material': unknown material \"" +
+                  spec.material + "\" (rock, soil, sand, sediment)");
+    }
+    gis::Grid<float> thickness(w, h, float(spec.thicknessM));
+    if (!spec.raster.empty()) {
+      STRATA_TRY(auto r, gis::warpToGrid({spec.raster, std::nullopt}, g));
+      for (size_t i = 0; i < thickness.size(); ++i) {
+        const float v = r.values.data[i];
+        thickness.data[i] = gis::isNoData(v) ? 0.0f : std::max(0.0f, v);
+      }
+    }
+    d.input.layersM.push_back(std::move(thickness));
+    d.input.materials.push_back(table[size_t(m)]);
+  }
+
+  // Parameters.
+  auto& p = d.params;
+  p.waterModel = int32_t(s.model.kind == WaterModel::Flood ? sim::WaterModel::kFiniteVolume
+                                                           : sim::WaterModel::kVirtualPipes);
+  p.cflAlpha = float(s.model.cfl);
+  p.maxDtS = 60.0f;
+  p.manningN = float(s.model.manningN);
+  const uint32_t bits[4] = {sim::kEdgeWest, sim::kEdgeEast, sim::kEdgeSouth, sim::kEdgeNorth};
+  p.openEdges = 0;
+  for (int e = 0; e < 4; ++e) {
+    if (s.model.boundaries[size_t(e)] == Boundary::Open) p.openEdges |= bits[e];
+  }
+  p.evaporationMmPerHour = float(s.water.evaporationMPerS * 3.6e6);
+  if (s.erosion.enabled) {
+    p.erosionEnabled = 1;
+    p.thermalEnabled = s.erosion.thermal ? 1 : 0;
+    p.capacityK = float(s.erosion.capacity);
+    p.erosionRate = float(s.erosion.erosionRate);
+    p.depositionRate = float(s.erosion.depositionRate);
+  }
+
+  // Sources.
+  for (size_t i = 0; i < s.water.inflows.size(); ++i) {
+    const auto& in = s.water.inflows[i];
+    STRATA_TRY(auto px, mapper.pixels(s, in.place));
+    for (auto& pt : px) {
+      pt[0] -= window.x;
+      pt[1] -= window.y;
+      const int cx = int(std::floor(pt[0])), cy = int(std::floor(pt[1]));
+      if (cx < 0 || cy < 0 || cx >= w || cy >= h || !d.inside.at(cx, cy)) {
+        return placeError(s, in.place, "the source \"" + in.name + "\" is outside the region");
+      }
+    }
+    sim::Source src;
+    src.cells = cellsAlong(px, w, h);
+    std::erase_if(src.cells, [&](auto c) { return !d.inside.at(c.first, c.second); });
+    // Zero outside the curve's span (the solver holds the end values): pad with zeros.
+    const auto& pts = in.hydrograph.points;
+    if (pts.front()[0] > 0) src.hydrographM3S.push_back({0.0, 0.0});
+    if (pts.front()[1] != 0 && pts.front()[0] > 0) src.hydrographM3S.push_back({pts.front()[0] * (1 - 1e-9), 0.0});
+    for (const auto& q : pts) src.hydrographM3S.push_back({q[0], q[1]});
+    if (pts.back()[1] != 0) src.hydrographM3S.push_back({pts.back()[0] * (1 + 1e-9) + 1e-6, 0.0});
+    d.sources.push_back(std::move(src));
+    d.sourceNames.push_back(in.name);
+  }
+
+  // Rain.
+  if (s.water.rain) {
+    d.rainMmPerHour = s.water.rain->rateMPerS * 3.6e6;
+    d.rainStartS = s.water.rain->startS;
+    d.rainEndS = s.water.rain->endS < 0 ? s.durationS : s.water.rain->endS;
+    if (!s.water.rain->raster.empty()) {
+      STRATA_TRY(auto r, gis::warpToGrid({s.water.rain->raster, std::nullopt}, g));
+      d.input.rainMmPerHour = gis::Grid<float>(w, h, 0.0f);
+      for (size_t i = 0; i < r.values.size(); ++i) {
+        const float v = r.values.data[i];
+        d.input.rainMmPerHour.data[i] = gis::isNoData(v) ? 0.0f : float(std::max(0.0f, v) * d.rainMmPerHour);
+      }
+      d.rainMmPerHour = 0;  // the raster carries the rate
+    }
+  }
+
+  // Dam breaks: water standing up to the given surface inside each polygon.
+  for (const auto& db : s.water.damBreaks) {
+    STRATA_TRY(auto px, mapper.pixels(s, db.polygon));
+    for (auto& pt : px) {
+      pt[0] -= window.x;
+      pt[1] -= window.y;
+    }
+    if (d.input.waterDepthM.size() == 0) d.input.waterDepthM = gis::Grid<float>(w, h, 0.0f);
+    bool any = false;
+    for (int y = 0; y < h; ++y) {
+      for (int x = 0; x < w; ++x) {
+        if (!d.inside.at(x, y) || !insidePolygon(px, x + 0.5, y + 0.5)) continue;
+        any = true;
+        const float depth = std::max(0.0f, float(db.surfaceElevationM) - d.bed.values.at(x, y));
+        d.input.waterDepthM.at(x, y) = std::max(d.input.waterDepthM.at(x, y), depth);
+      }
+    }
+    if (!any) return placeError(s, db.polygon, "the dam-break polygon covers no cell of the region");
+  }
+  if (d.input.waterDepthM.size() > 0) {
+    for (int y = 0; y < h; ++y) {
+      for (int x = 0; x < w; ++x) d.damBreakVolumeM3 += double(d.input.waterDepthM.at(x, y)) * d.cellAreaM2.at(x, y);
+    }
+  }
+  return d;
+}
+
+}  // namespace strata::terrain
