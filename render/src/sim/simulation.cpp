@@ -348,6 +348,41 @@ size_t Simulation::gpuBytes() const {
   return total;
 }
 
+Simulation::RawState Simulation::readRaw() const {
+  const Impl& s = *impl_;
+  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+  return {s.cur().read<float>(), s.flux.read<float>(), s.layers.read<float>(), s.accum.read<float>()};
+}
+
+void Simulation::writeRaw(const RawState& raw) {
+  Impl& s = *impl_;
+  STRATA_CHECK(raw.state.size() == 4 * s.n && raw.flux.size() == 4 * s.n &&
+               raw.layers.size() == size_t(s.p.layerCount) * s.n)
+      << "writeRaw: sizes do not match the grid";
+  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+  (s.aIsCurrent ? s.stateA : s.stateB).upload(0, raw.state.size() * 4, raw.state.data());
+  s.flux.upload(0, raw.flux.size() * 4, raw.flux.data());
+  s.layers.upload(0, raw.layers.size() * 4, raw.layers.data());
+  const auto base = s.base.read<float>();
+  std::vector<float> bed(s.n);
+  for (size_t i = 0; i < s.n; ++i) {
+    float b = base[i];
+    for (int l = 0; l < s.p.layerCount; ++l) b += raw.layers[size_t(l) * s.n + i];
+    bed[i] = b;
+  }
+  s.bed.upload(0, bed.size() * 4, bed.data());
+}
+
+double Simulation::maxWaveSpeedMS() {
+  const float alpha = impl_->p.cflAlpha;
+  impl_->p.cflAlpha = 1.0f;  // force the reduction even for a fixed-step run
+  const double v = impl_->maxWaveSpeed();
+  impl_->p.cflAlpha = alpha;
+  return v;
+}
+
+void Simulation::stepWithDt(double dtS) { impl_->takeStep(dtS); }
+
 SimStats Simulation::stats() const {
   const Impl& s = *impl_;
   const auto st = s.readState();

@@ -48,6 +48,21 @@ class Simulation {
   /// Bytes of GPU buffers this simulation holds.
   size_t gpuBytes() const;
 
+  /// For tiled runs (TiledSimulation): the persistent per-cell state as stored on the GPU.
+  struct RawState {
+    std::vector<float> state;   ///< 4 per cell: h, s, hu, hv
+    std::vector<float> flux;    ///< 4 per cell: pipe outflows W, E, N, S
+    std::vector<float> layers;  ///< layer-major: layers[l * cells + cell]
+    std::vector<float> accum;   ///< 8 per cell: (sum, error) of outflow, evaporation, sediment outflow
+  };
+  RawState readRaw() const;
+  /// Replaces state, flux and layers (accum is kept) and recomputes the bed from them.
+  void writeRaw(const RawState& raw);
+  /// max over cells of |u| + sqrt(g h) (m/s), as the adaptive step uses it (W10).
+  double maxWaveSpeedMS();
+  /// One step of exactly `dtS` seconds (tiles must all take the same step).
+  void stepWithDt(double dtS);
+
  private:
   struct Impl;
   explicit Simulation(std::unique_ptr<Impl> impl);
