@@ -35,7 +35,8 @@ void addRunCommand(CLI::App& app, const char* name, const char* help, bool erosi
       scenario->outputs.maps.push_back("terrain_change");
     }
     render::scenario::RunOptions opt;
-    opt.outDir = args->outDir.empty() ? std::filesystem::path("runs") / scenario->file.stem() : args->outDir;
+    opt.outDir = args->outDir.empty() ? std::filesystem::path("runs") / scenario->file.stem()
+                                      : std::filesystem::path(args->outDir);
     opt.resume = args->resume;
     opt.pictures = !args->noPictures && scenario->outputs.pictures;
     opt.plots = !args->noPlots && scenario->outputs.plots;

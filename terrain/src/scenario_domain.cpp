@@ -50,8 +50,8 @@ class PixelMapper {
           while (x < west && x + 360 <= east + 1e-9) x += 360;
           while (x > east && x - 360 >= west - 1e-9) x -= 360;
         } else if (!toCrs_->transform(1, &x, &y)) {
-          return placeError(s, p, "cannot transform [" + std::to_string(pt[0]) + ", " + std::to_string(pt[1]) +
-                                      "] to the DEM's CRS");
+          return placeError(
+              s, p, "cannot transform [" + std::to_string(pt[0]) + ", " + std::to_string(pt[1]) + "] to the DEM's CRS");
         }
       }
       out.push_back({(x - g_.transform.c[0]) / g_.transform.c[1], (y - g_.transform.c[3]) / g_.transform.c[5]});
@@ -69,7 +69,7 @@ std::string describeExtent(const gis::Georef& g) {
   char buf[160];
   const double x0 = g.transform.c[0], y0 = g.transform.c[3];
   const double x1 = x0 + g.width * g.transform.c[1], y1 = y0 + g.height * g.transform.c[5];
-  std::snprintf(buf, sizeof buf, "[%.6g, %.6g, %.6g, %.6g]", std::min(x0, x1), std::min(y0, y1), std::max(x0, x1),
+  std::snprintf(buf, sizeof buf, "[%.8g, %.8g, %.8g, %.8g]", std::min(x0, x1), std::min(y0, y1), std::max(x0, x1),
                 std::max(y0, y1));
   return buf;
 }
@@ -104,8 +104,9 @@ bool insidePolygon(const std::vector<std::array<double, 2>>& poly, double x, dou
 
 Result<ScenarioDomain> buildDomain(const Scenario& s) {
   if (!s.terrain.store.empty()) {
-    return fail(s.file.string() + ": key 'terrain.store': runs from a tile store are not supported by strata flood yet; "
-                                  "export a window (strata export) and give it as terrain.dem");
+    return fail(s.file.string() +
+                ": key 'terrain.store': runs from a tile store are not supported by strata flood yet; "
+                "export a window (strata export) and give it as terrain.dem");
   }
   const std::string& demPath = s.terrain.dems.front();
   STRATA_TRY(auto info, gis::probeDem(demPath));
@@ -124,9 +125,10 @@ Result<ScenarioDomain> buildDomain(const Scenario& s) {
       y0 = std::min(y0, p[1]);
       y1 = std::max(y1, p[1]);
     }
-    if (x0 < -1e-6 || y0 < -1e-6 || x1 > full.width + 1e-6 || y1 > full.height + 1e-6) {
-      return placeError(s, s.region.place, "the region is not inside the DEM " + demPath + " (extent " +
-                                               describeExtent(full) + " in its CRS)");
+    if (x0 < -1e-3 || y0 < -1e-3 || x1 > full.width + 1e-3 || y1 > full.height + 1e-3) {  // 1e-3 pixel: rounding of the corners
+      return placeError(
+          s, s.region.place,
+          "the region is not inside the DEM " + demPath + " (extent " + describeExtent(full) + " in its CRS)");
     }
     window.x = std::clamp(int(std::floor(x0 + 1e-6)), 0, full.width - 1);
     window.y = std::clamp(int(std::floor(y0 + 1e-6)), 0, full.height - 1);
@@ -135,15 +137,34 @@ Result<ScenarioDomain> buildDomain(const Scenario& s) {
     if (window.width < 4 || window.height < 4) {
       return placeError(s, s.region.place, "the region covers fewer than 4x4 cells of the DEM");
     }
-    if (s.region.kind == decltype(s.region)::Polygon) {
-      for (auto p : px) polygonPx.push_back({p[0] - window.x, p[1] - window.y});
-    }
+    if (s.region.kind == decltype(s.region)::Polygon) polygonPx = px;
   }
 
   ScenarioDomain d;
   gis::ReadOptions ro;
   ro.window = window;
   STRATA_TRY(d.bed, gis::readDem(demPath, ro));
+  // Optional resampling to a coarser (or finer) grid of about region.cell_size metres.
+  double scale = 1.0;  // region cells per DEM cell, along each axis
+  if (s.region.cellSizeM > 0) {
+    const auto& g0 = d.bed.georef;
+    STRATA_TRY(auto a, gis::pixelToLonLat(g0, g0.width * 0.5, g0.height * 0.5));
+    STRATA_TRY(auto b, gis::pixelToLonLat(g0, g0.width * 0.5, g0.height * 0.5 + 1));
+    const double nativeM = gis::geodesicDistanceM(a, b, g0.body);
+    scale = nativeM / s.region.cellSizeM;
+    gis::Georef target = g0;
+    target.width = std::max(4, int(std::floor(g0.width * scale)));
+    target.height = std::max(4, int(std::floor(g0.height * scale)));
+    target.transform.c[1] = g0.transform.c[1] * g0.width / target.width;
+    target.transform.c[5] = g0.transform.c[5] * g0.height / target.height;
+    scale = double(target.width) / g0.width;
+    STRATA_TRY(d.bed, gis::warpToGrid({demPath, std::nullopt}, target));
+  }
+  auto toRegion = [&](std::vector<std::array<double, 2>> px) {
+    for (auto& p : px) p = {(p[0] - window.x) * scale, (p[1] - window.y) * scale};
+    return px;
+  };
+  if (!polygonPx.empty()) polygonPx = toRegion(polygonPx);
   if (s.terrain.dems.size() > 1) {
     std::vector<gis::MosaicInput> inputs;
     for (const auto& p : s.terrain.dems) inputs.push_back({p, std::nullopt, gis::BlendMode::Replace});
@@ -218,10 +239,12 @@ Result<ScenarioDomain> buildDomain(const Scenario& s) {
 
   // Parameters.
   auto& p = d.params;
-  p.waterModel = int32_t(s.model.kind == WaterModel::Flood ? sim::WaterModel::kFiniteVolume
-                                                           : sim::WaterModel::kVirtualPipes);
+  p.waterModel =
+      int32_t(s.model.kind == WaterModel::Flood ? sim::WaterModel::kFiniteVolume : sim::WaterModel::kVirtualPipes);
   p.cflAlpha = float(s.model.cfl);
-  p.maxDtS = 60.0f;
+  // The CFL step (W10) is computed before the sources pour in, so on a dry domain it would be
+  // unbounded: cap it. 10 s keeps a source's first steps small against the output interval.
+  p.maxDtS = 2.0f;
   p.manningN = float(s.model.manningN);
   const uint32_t bits[4] = {sim::kEdgeWest, sim::kEdgeEast, sim::kEdgeSouth, sim::kEdgeNorth};
   p.openEdges = 0;
@@ -240,10 +263,9 @@ Result<ScenarioDomain> buildDomain(const Scenario& s) {
   // Sources.
   for (size_t i = 0; i < s.water.inflows.size(); ++i) {
     const auto& in = s.water.inflows[i];
-    STRATA_TRY(auto px, mapper.pixels(s, in.place));
-    for (auto& pt : px) {
-      pt[0] -= window.x;
-      pt[1] -= window.y;
+    STRATA_TRY(auto demPx, mapper.pixels(s, in.place));
+    const auto px = toRegion(demPx);
+    for (const auto& pt : px) {
       const int cx = int(std::floor(pt[0])), cy = int(std::floor(pt[1]));
       if (cx < 0 || cy < 0 || cx >= w || cy >= h || !d.inside.at(cx, cy)) {
         return placeError(s, in.place, "the source \"" + in.name + "\" is outside the region");
@@ -280,11 +302,8 @@ Result<ScenarioDomain> buildDomain(const Scenario& s) {
 
   // Dam breaks: water standing up to the given surface inside each polygon.
   for (const auto& db : s.water.damBreaks) {
-    STRATA_TRY(auto px, mapper.pixels(s, db.polygon));
-    for (auto& pt : px) {
-      pt[0] -= window.x;
-      pt[1] -= window.y;
-    }
+    STRATA_TRY(auto demPx, mapper.pixels(s, db.polygon));
+    const auto px = toRegion(demPx);
     if (d.input.waterDepthM.size() == 0) d.input.waterDepthM = gis::Grid<float>(w, h, 0.0f);
     bool any = false;
     for (int y = 0; y < h; ++y) {

@@ -295,7 +295,8 @@ Result<RunSummary> runScenario(const terrain::Scenario& s, const RunOptions& opt
     STRATA_TRY_STATUS(writeMap("inundation_duration", flood.wetDurationS, false));
     STRATA_TRY_STATUS(writeMap("final_depth", depth, false));
     if (s.erosion.enabled) STRATA_TRY_STATUS(writeMap("terrain_change", change, false));
-    STRATA_TRY_STATUS(writeFileAtomic(checkpointPath, encodeCheckpoint(hash, interval, summary.series, sim.snapshot())));
+    STRATA_TRY_STATUS(
+        writeFileAtomic(checkpointPath, encodeCheckpoint(hash, interval, summary.series, sim.snapshot())));
     if (opt.stopAfterIntervals >= 0 && interval >= opt.stopAfterIntervals && interval < intervals) break;
   }
   const auto st = sim.stats();
@@ -316,7 +317,8 @@ Result<RunSummary> runScenario(const terrain::Scenario& s, const RunOptions& opt
     STRATA_TRY(auto plots, writePlots(opt.outDir, domain.bed, summary.completed));
     summary.files.insert(summary.files.end(), plots.begin(), plots.end());
   }
-  STRATA_TRY_STATUS(writeReport(opt.outDir, ReportInput{s, domain, summary, sim.readFloodStats(), ctx.info().renderer}));
+  STRATA_TRY_STATUS(
+      writeReport(opt.outDir, ReportInput{s, domain, summary, sim.readFloodStats(), ctx.info().renderer}));
   summary.files.push_back("report.md");
   return summary;
 }

@@ -98,8 +98,8 @@ Status writeReport(const fs::path& runDir, const ReportInput& in) {
     char date[64];
     const std::time_t now = std::time(nullptr);
     std::strftime(date, sizeof date, "%Y-%m-%d %H:%M UTC", std::gmtime(&now));
-    md += "Run " + std::string(date) + " on " + in.device + ": " + formatDuration(sum.simulatedS) +
-          " simulated in " + formatDuration(sum.wallS) + " of wall time, " + std::to_string(sum.steps) + " steps";
+    md += "Run " + std::string(date) + " on " + in.device + ": " + formatDuration(sum.simulatedS) + " simulated in " +
+          formatDuration(sum.wallS) + " of wall time, " + std::to_string(sum.steps) + " steps";
     if (sum.steps > 0) md += fmt(" (mean step %.2f s)", sum.simulatedS / double(sum.steps));
     md += ".";
     if (!sum.completed) md += " **The run was stopped before the end; the numbers are those of the last interval.**";
@@ -115,14 +115,14 @@ Status writeReport(const fs::path& runDir, const ReportInput& in) {
     hi = std::max(hi, d.bed.values.data[i]);
   }
   md += "| | |\n|---|---|\n";
-  md += "| terrain | `" + s.terrain.dems.front() + "` (" + g.crsName + (g.epsg ? ", EPSG:" + std::to_string(*g.epsg) : "") +
-        ", " + g.body.name + ") |\n";
+  md += "| terrain | `" + s.terrain.dems.front() + "` (" + g.crsName +
+        (g.epsg ? ", EPSG:" + std::to_string(*g.epsg) : "") + ", " + g.body.name + ") |\n";
   md += "| region | " + std::to_string(g.width) + " x " + std::to_string(g.height) + " cells of about " +
         fmt("%.0f", d.input.rowDxM[d.input.rowDxM.size() / 2]) + " x " + fmt("%.0f", d.input.dyM) + " m, " +
         fmt("%.0f", d.totalAreaM2 / 1e6) + " km², elevations " + fmt("%.0f", lo) + " to " + fmt("%.0f", hi) + " m |\n";
   md += std::string("| model | ") +
         (s.model.kind == terrain::WaterModel::Flood ? "flood mode (finite-volume shallow water, Manning friction)"
-                                                     : "virtual pipes") +
+                                                    : "virtual pipes") +
         ", Manning n = " + fmt("%.3f", s.model.manningN) + " s/m^(1/3), CFL " + fmt("%.2f", s.model.cfl) + " |\n";
   const char* edges[4] = {"west", "east", "south", "north"};
   std::string bounds;
@@ -152,8 +152,9 @@ Status writeReport(const fs::path& runDir, const ReportInput& in) {
     const auto& last = sum.series.back();
     const auto peakW = *std::max_element(sum.series.begin(), sum.series.end(),
                                          [](const auto& a, const auto& b) { return a.waterM3 < b.waterM3; });
-    const auto peakA = *std::max_element(sum.series.begin(), sum.series.end(),
-                                         [](const auto& a, const auto& b) { return a.floodedAreaKm2 < b.floodedAreaKm2; });
+    const auto peakA = *std::max_element(sum.series.begin(), sum.series.end(), [](const auto& a, const auto& b) {
+      return a.floodedAreaKm2 < b.floodedAreaKm2;
+    });
     const auto deep = maxOf(in.flood.maxDepthM, d.inside);
     const auto fast = maxOf(in.flood.maxSpeedMS, d.inside);
     double everWet = 0;
@@ -163,8 +164,8 @@ Status writeReport(const fs::path& runDir, const ReportInput& in) {
     const double supplied = last.inflowM3 + last.rainM3 + d.damBreakVolumeM3;
     md += "| quantity | value |\n|---|---|\n";
     md += "| water that entered | " + millions(last.inflowM3 + last.rainM3) + " (inflow " + millions(last.inflowM3) +
-          ", rain " + millions(last.rainM3) + ")" + (d.damBreakVolumeM3 > 0 ? " + dam " + millions(d.damBreakVolumeM3) : "") +
-          " |\n";
+          ", rain " + millions(last.rainM3) + ")" +
+          (d.damBreakVolumeM3 > 0 ? " + dam " + millions(d.damBreakVolumeM3) : "") + " |\n";
     md += "| most water in the region | " + millions(peakW.waterM3) + " at " + hours(peakW.timeS) + " |\n";
     md += "| largest flooded area | " + fmt("%.1f", peakA.floodedAreaKm2) + " km² at " + hours(peakA.timeS) + " (" +
           fmt("%.1f", 100 * peakA.floodedAreaKm2 * 1e6 / d.totalAreaM2) + "% of the region) |\n";
@@ -191,7 +192,8 @@ Status writeReport(const fs::path& runDir, const ReportInput& in) {
   }
   md += "\n## Time series\n\n`series.csv`, one row per output interval:\n\n";
   for (const char* p : {"water", "area", "balance", "sediment"}) {
-    if (fs::exists(runDir / "plots" / (std::string(p) + ".png"))) md += "![" + std::string(p) + "](plots/" + p + ".png)\n";
+    if (fs::exists(runDir / "plots" / (std::string(p) + ".png")))
+      md += "![" + std::string(p) + "](plots/" + p + ".png)\n";
   }
   if (!in.pictures.empty()) {
     md += "\n## Pictures\n\n";

@@ -40,6 +40,7 @@ enum Slot : GLuint {
   kThermal = 15,
   kSources = 16,
   kMaxSpeed = 17,
+  kFloodStats = 18,
 };
 constexpr size_t kParamsDtOffset = offsetof(ts::SimParams, dtS);
 
@@ -56,10 +57,11 @@ struct Simulation::Impl {
   size_t n = 0;
 
   gl::Buffer params, materials, rowDx, base, bed, layers, stateA, stateB, stage, flux, faceX, faceY, tilt, accum, rain,
-      thermal, sourceEntries, maxSpeed;
+      thermal, sourceEntries, maxSpeed, floodStats;
+  float wetThresholdM = -1;  // < 0: flood statistics off
   bool aIsCurrent = true;
   gl::Program pSources, pPointSources, pWaveSpeed, pPipeFlux, pPipeUpdate, pFvFace, pFvUpdate, pErode, pThermalFlux,
-      pThermalApply;
+      pThermalApply, pFloodStats;
 
   const gl::Buffer& cur() const { return aIsCurrent ? stateA : stateB; }
   const gl::Buffer& next() const { return aIsCurrent ? stateB : stateA; }
@@ -158,6 +160,14 @@ struct Simulation::Impl {
     timeS += double(p.dtS);
     lastDt = double(p.dtS);
     ++steps;
+    if (wetThresholdM >= 0) {
+      cur().bindBase(GL_SHADER_STORAGE_BUFFER, kStateIn);
+      floodStats.bindBase(GL_SHADER_STORAGE_BUFFER, kFloodStats);
+      pFloodStats.set("timeS", float(timeS));
+      pFloodStats.set("wetThresholdM", wetThresholdM);
+      pFloodStats.dispatchCovering(int(n));
+      barrier();
+    }
   }
 
   std::vector<float> readState() const {
@@ -190,7 +200,8 @@ Result<Simulation> Simulation::create(const SimInput& input, const SimParams& pa
         Kernel{&s.pWaveSpeed, "sim/wave_speed.comp"}, Kernel{&s.pPipeFlux, "sim/pipe_flux.comp"},
         Kernel{&s.pPipeUpdate, "sim/pipe_update.comp"}, Kernel{&s.pFvFace, "sim/fv_face.comp"},
         Kernel{&s.pFvUpdate, "sim/fv_update.comp"}, Kernel{&s.pErode, "sim/erode.comp"},
-        Kernel{&s.pThermalFlux, "sim/thermal_flux.comp"}, Kernel{&s.pThermalApply, "sim/thermal_apply.comp"}}) {
+        Kernel{&s.pThermalFlux, "sim/thermal_flux.comp"}, Kernel{&s.pThermalApply, "sim/thermal_apply.comp"},
+        Kernel{&s.pFloodStats, "sim/flood_stats.comp"}}) {
     auto prog = gl::Program::compute(name);
     if (!prog) return fail("sim: " + prog.message());
     *program = std::move(prog).value();
@@ -246,6 +257,7 @@ Result<Simulation> Simulation::create(const SimInput& input, const SimParams& pa
   s.thermal.fill(0u);
   s.sourceEntries = gl::Buffer(sizeof(ts::SourceEntry) * 16);
   s.maxSpeed = gl::Buffer(4);
+  s.floodStats = gl::Buffer(16 * n);
 
   Simulation sim(std::move(impl));
   const auto st = sim.stats();
@@ -342,7 +354,7 @@ size_t Simulation::gpuBytes() const {
   size_t total = 0;
   for (const gl::Buffer* b :
        {&s.params, &s.materials, &s.rowDx, &s.base, &s.bed, &s.layers, &s.stateA, &s.stateB, &s.stage, &s.flux,
-        &s.faceX, &s.faceY, &s.tilt, &s.accum, &s.rain, &s.thermal, &s.sourceEntries, &s.maxSpeed}) {
+        &s.faceX, &s.faceY, &s.tilt, &s.accum, &s.rain, &s.thermal, &s.sourceEntries, &s.maxSpeed, &s.floodStats}) {
     total += b->size();
   }
   return total;
@@ -371,6 +383,87 @@ void Simulation::writeRaw(const RawState& raw) {
     bed[i] = b;
   }
   s.bed.upload(0, bed.size() * 4, bed.data());
+}
+
+namespace {
+// Flood statistics start as: no depth, no speed, never arrived, never wet.
+std::vector<float> initialFloodStats(size_t n) {
+  std::vector<float> v(4 * n, 0.0f);
+  for (size_t i = 0; i < n; ++i) v[4 * i + 2] = -1.0f;
+  return v;
+}
+}  // namespace
+
+void Simulation::enableFloodStats(float wetThresholdM) {
+  STRATA_CHECK(wetThresholdM >= 0) << "wet threshold " << wetThresholdM;
+  impl_->wetThresholdM = wetThresholdM;
+  const auto init = initialFloodStats(impl_->n);
+  impl_->floodStats.upload(0, init.size() * 4, init.data());
+}
+
+FloodStats Simulation::readFloodStats() const {
+  const Impl& s = *impl_;
+  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+  const auto v = s.wetThresholdM >= 0 ? s.floodStats.read<float>() : initialFloodStats(s.n);
+  FloodStats f;
+  gis::Grid<float>* grids[4] = {&f.maxDepthM, &f.maxSpeedMS, &f.arrivalS, &f.wetDurationS};
+  for (int k = 0; k < 4; ++k) {
+    *grids[k] = gis::Grid<float>(s.p.width, s.p.height);
+    for (size_t i = 0; i < s.n; ++i) grids[k]->data[i] = v[4 * i + size_t(k)];
+  }
+  return f;
+}
+
+void Simulation::setRainMmPerHour(float mmPerHour) {
+  Impl& s = *impl_;
+  if (s.p.rainMmPerHour == mmPerHour) return;
+  s.p.rainMmPerHour = mmPerHour;
+  s.params.upload(offsetof(ts::SimParams, rainMmPerHour), sizeof(float), &s.p.rainMmPerHour);
+  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+  s.rainRateM3S = ts::rainVolumeRate(s.p, s.rain.read<float>(), s.rowDxD, s.p.width);
+}
+
+Simulation::Snapshot Simulation::snapshot() const {
+  const Impl& s = *impl_;
+  Snapshot snap;
+  snap.counters = {s.timeS,           s.lastDt, s.rainM3,          s.inflowM3, s.initialWater,
+                   s.initialMaterial, s.steps,  s.p.rainMmPerHour, s.p.dtS};
+  snap.raw = readRaw();
+  snap.flood = readFloodStats();
+  return snap;
+}
+
+Status Simulation::restore(const Snapshot& snap) {
+  Impl& s = *impl_;
+  const size_t n = s.n;
+  if (snap.raw.state.size() != 4 * n || snap.raw.flux.size() != 4 * n ||
+      snap.raw.layers.size() != size_t(s.p.layerCount) * n || snap.raw.accum.size() != 8 * n ||
+      snap.flood.maxDepthM.size() != n) {
+    return fail("sim: the snapshot is of a different grid (" + std::to_string(snap.raw.state.size() / 4) +
+                " cells, this simulation has " + std::to_string(n) + ")");
+  }
+  writeRaw(snap.raw);
+  s.accum.upload(0, snap.raw.accum.size() * 4, snap.raw.accum.data());
+  std::vector<float> f(4 * n);
+  for (size_t i = 0; i < n; ++i) {
+    f[4 * i] = snap.flood.maxDepthM.data[i];
+    f[4 * i + 1] = snap.flood.maxSpeedMS.data[i];
+    f[4 * i + 2] = snap.flood.arrivalS.data[i];
+    f[4 * i + 3] = snap.flood.wetDurationS.data[i];
+  }
+  s.floodStats.upload(0, f.size() * 4, f.data());
+  const auto& c = snap.counters;
+  s.timeS = c.timeS;
+  s.lastDt = c.lastDtS;
+  s.rainM3 = c.rainM3;
+  s.inflowM3 = c.inflowM3;
+  s.initialWater = c.initialWaterM3;
+  s.initialMaterial = c.initialMaterialM3;
+  s.steps = c.steps;
+  setRainMmPerHour(c.rainMmPerHour);
+  s.p.dtS = c.dtS;
+  s.params.upload(kParamsDtOffset, sizeof(float), &s.p.dtS);
+  return {};
 }
 
 double Simulation::maxWaveSpeedMS() {

@@ -82,7 +82,7 @@ struct Scenario {
   struct {
     WaterModel kind = WaterModel::Flood;
     double manningN = 0.035;  ///< s/m^(1/3)
-    double cfl = 0.45;  ///< flood mode needs <= 0.5 (positivity of the finite-volume scheme)
+    double cfl = 0.45;        ///< flood mode needs <= 0.5 (positivity of the finite-volume scheme)
     std::array<Boundary, 4> boundaries{Boundary::Open, Boundary::Open, Boundary::Open, Boundary::Open};  ///< W E S N
   } model;
 

@@ -16,17 +16,17 @@
 namespace strata::terrain {
 
 struct ScenarioDomain {
-  gis::Raster bed;                    ///< the region's bedrock elevation (m); georef of the region
-  gis::Grid<uint8_t> inside;          ///< 1 for cells of the region, 0 outside a polygon region (walls)
-  gis::Grid<double> cellAreaM2;       ///< geodesic area of each cell (m^2)
-  sim::SimInput input;                ///< ready for Simulation::create
-  sim::SimParams params;              ///< from [model], [erosion], [water]
-  std::vector<sim::Source> sources;   ///< inflows, on cells
+  gis::Raster bed;                   ///< the region's bedrock elevation (m); georef of the region
+  gis::Grid<uint8_t> inside;         ///< 1 for cells of the region, 0 outside a polygon region (walls)
+  gis::Grid<double> cellAreaM2;      ///< geodesic area of each cell (m^2)
+  sim::SimInput input;               ///< ready for Simulation::create
+  sim::SimParams params;             ///< from [model], [erosion], [water]
+  std::vector<sim::Source> sources;  ///< inflows, on cells
   std::vector<std::string> sourceNames;
-  double rainMmPerHour = 0;           ///< uniform rain rate while it falls
+  double rainMmPerHour = 0;             ///< uniform rain rate while it falls
   double rainStartS = 0, rainEndS = 0;  ///< rain falls in [start, end)
-  double damBreakVolumeM3 = 0;        ///< initial water from dam breaks
-  double totalAreaM2 = 0;             ///< area of the region's cells
+  double damBreakVolumeM3 = 0;          ///< initial water from dam breaks
+  double totalAreaM2 = 0;               ///< area of the region's cells
 };
 
 /// Elevation given to cells outside a polygon region: a wall no flood in a DEM tops.

@@ -17,14 +17,15 @@ struct ReportInput {
   const terrain::Scenario& scenario;
   const terrain::ScenarioDomain& domain;
   const RunSummary& summary;
-  sim::FloodStats flood;  ///< per-cell maxima, arrival and duration at the end of the run
-  std::string device;     ///< the GL renderer the run used
+  sim::FloodStats flood;                   ///< per-cell maxima, arrival and duration at the end of the run
+  std::string device;                      ///< the GL renderer the run used
   std::vector<std::string> pictures = {};  ///< rendered pictures (relative paths), if any
 };
 
 /// plots/*.png: the time series (tools/plot_series.py) and the maps over a hillshade
 /// (tools/plot_maps.py), with Debian's matplotlib. Returns the files written (relative).
-Result<std::vector<std::string>> writePlots(const std::filesystem::path& runDir, const gis::Raster& bed, bool completed);
+Result<std::vector<std::string>> writePlots(const std::filesystem::path& runDir, const gis::Raster& bed,
+                                            bool completed);
 
 /// report.md.
 Status writeReport(const std::filesystem::path& runDir, const ReportInput& input);

@@ -21,6 +21,14 @@ using terrain::sim::SimStats;
 using terrain::sim::Source;
 using terrain::sim::VelocityField;
 
+/// Per-cell flood statistics since the start (enableFloodStats), updated after every step.
+struct FloodStats {
+  gis::Grid<float> maxDepthM;     ///< deepest water (m)
+  gis::Grid<float> maxSpeedMS;    ///< fastest flow (m/s)
+  gis::Grid<float> arrivalS;      ///< first time the depth exceeded the wet threshold (s); -1 = never
+  gis::Grid<float> wetDurationS;  ///< total time above the wet threshold (s)
+};
+
 class Simulation {
  public:
   /// Validates the input, compiles the kernels and uploads the state.
@@ -45,6 +53,24 @@ class Simulation {
   /// Volumes since the start (reads the state back; summed in double on the CPU).
   SimStats stats() const;
   const SimParams& params() const;
+  /// Starts per-step flood statistics with `wetThresholdM` as the wet/dry depth (m).
+  void enableFloodStats(float wetThresholdM);
+  /// The statistics so far (all -1/0 grids if never enabled).
+  FloodStats readFloodStats() const;
+  /// Changes the uniform rain rate (mm/h) from the next step on (rain starting or stopping).
+  void setRainMmPerHour(float mmPerHour);
+
+  /// Everything a run needs to continue exactly where it was (a checkpoint).
+  struct Counters {
+    double timeS = 0, lastDtS = 0, rainM3 = 0, inflowM3 = 0, initialWaterM3 = 0, initialMaterialM3 = 0;
+    long long steps = 0;
+    float rainMmPerHour = 0, dtS = 0;
+  };
+  struct Snapshot;
+  Snapshot snapshot() const;
+  /// Restores a snapshot of a simulation of the same grid and parameters.
+  Status restore(const Snapshot& snapshot);
+
   /// Bytes of GPU buffers this simulation holds.
   size_t gpuBytes() const;
 
@@ -57,6 +83,7 @@ class Simulation {
   };
   RawState readRaw() const;
   /// Replaces state, flux and layers (accum is kept) and recomputes the bed from them.
+  /// (restore() replaces accum too.)
   void writeRaw(const RawState& raw);
   /// max over cells of |u| + sqrt(g h) (m/s), as the adaptive step uses it (W10).
   double maxWaveSpeedMS();
@@ -67,6 +94,12 @@ class Simulation {
   struct Impl;
   explicit Simulation(std::unique_ptr<Impl> impl);
   std::unique_ptr<Impl> impl_;
+};
+
+struct Simulation::Snapshot {
+  Counters counters;
+  RawState raw;
+  FloodStats flood;
 };
 
 }  // namespace strata::render::sim
