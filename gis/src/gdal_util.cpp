@@ -115,9 +115,6 @@ void fillCrs(const OGRSpatialReference& srsIn, Georef& georef) {
   const double invF = srs.GetInvFlattening(&err);
   const char* ellName = srs.GetAttrValue("SPHEROID");
   georef.body = Body::fromEllipsoid(a, invF == 0 ? 0.0 : 1.0 / invF, ellName ? ellName : "");
-  if (srs.IsProjected() || srs.IsGeographic()) {
-    // Linear unit for projected CRSs; vertical unit is the band's, set by the reader.
-  }
 }
 
 Result<OGRSpatialReference> srsOf(const Georef& georef) {

@@ -139,6 +139,22 @@ TEST(Geodesy, LocalEnuFrame) {
   EXPECT_NEAR(std::hypot(q.e, q.n, q.u), std::hypot(a.x - b.x, a.y - b.y, a.z - b.z), 1e-8);
   const Enu viaEcef = frame.toEnu(b);
   EXPECT_NEAR(viaEcef.e, q.e, 1e-8);
+  // Against PROJ's topocentric conversion (ECEF in, ENU out) through gdaltransform -ct: 1 mm.
+  std::vector<LonLat> ecefPts;
+  std::vector<Enu> ours;
+  for (const LonLat& k : kPoints) {
+    const Ecef x = toEcef(k, Body::wgs84());
+    ecefPts.push_back({x.x, x.y, x.z});
+    ours.push_back(frame.toEnu(k));
+  }
+  const auto proj = gdaltransform("EPSG:4978 -ct '+proj=topocentric +ellps=WGS84 +lat_0=36.1 +lon_0=-112.1 +h_0=2100'",
+                                  "EPSG:4978", ecefPts);
+  ASSERT_EQ(proj.size(), kPoints.size());
+  for (size_t i = 0; i < proj.size(); ++i) {
+    EXPECT_NEAR(ours[i].e, proj[i][0], 1e-3) << i;
+    EXPECT_NEAR(ours[i].n, proj[i][1], 1e-3) << i;
+    EXPECT_NEAR(ours[i].u, proj[i][2], 1e-3) << i;
+  }
   const LonLat back = frame.fromEnu(q);
   EXPECT_NEAR(back.lonDeg, p.lonDeg, 1e-12);
   EXPECT_NEAR(back.heightM, p.heightM, 1e-8);

@@ -241,6 +241,38 @@ TEST(Mosaic, InMemoryRasterEqualsItsFile) {
   }
 }
 
+TEST(Mosaic, ZeroTo360SourceOntoMinus180Grid) {
+  // Mars' MEGDR runs 0..360 E; a -180..180 target must still be covered everywhere, with the
+  // western hemisphere taken from 180..360 of the file.
+  const std::string path = test::dataFile("mars/mola_megdr_4ppd.vrt");
+  auto info = probeDem(path);
+  ASSERT_TRUE(info.ok()) << info.message();
+  Georef t = info->georef;
+  t.width = 360;
+  t.height = 180;
+  // Cell centres at x.4 / x.6 degrees: never on a 0.25 degree source pixel edge.
+  t.transform = GeoTransform{{-180.1, 1, 0, 90.1, 0, -1}};
+  MosaicInput in;
+  in.path = path;
+  in.resampling = Resampling::Nearest;
+  auto w = warpToGrid(in, t);
+  ASSERT_TRUE(w.ok()) << w.message();
+  auto src = readDem(path);
+  ASSERT_TRUE(src.ok()) << src.message();
+  int nan = 0;
+  for (float v : w->values.data) nan += std::isnan(v);
+  EXPECT_EQ(nan, 0);
+  for (int r : {0, 79, 100, 179}) {
+    for (int c : {0, 89, 180, 270, 359}) {
+      double lon = t.transform.x(c + 0.5, r + 0.5);
+      const double lat = t.transform.y(c + 0.5, r + 0.5);
+      if (lon < 0) lon += 360;
+      const int sx = int(lon / 0.25), sy = int((90 - lat) / 0.25);
+      EXPECT_EQ(w->values.at(c, r), src->values.at(sx, sy)) << "lon " << lon << " lat " << lat;
+    }
+  }
+}
+
 TEST(Mosaic, Errors) {
   const Georef t = targetGrid();
   MosaicInput moon[1];

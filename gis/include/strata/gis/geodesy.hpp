@@ -46,12 +46,16 @@ LonLat fromEcef(const Ecef& p, const Body& body);
 /// A local tangent frame (east, north, up) at an origin on a body.
 class LocalFrame {
  public:
+  /// East-north-up axes at `origin` (its height included) on `body`'s ellipsoid.
   LocalFrame(const LonLat& origin, const Body& body);
   ~LocalFrame();
   LocalFrame(LocalFrame&&) noexcept;
   LocalFrame& operator=(LocalFrame&&) noexcept;
+  /// Geodetic point -> local east, north, up (m).
   Enu toEnu(const LonLat& p) const;
+  /// Local east, north, up (m) -> geodetic point.
   LonLat fromEnu(const Enu& p) const;
+  /// Body-fixed Cartesian point -> local east, north, up (m).
   Enu toEnu(const Ecef& p) const;
 
  private:
