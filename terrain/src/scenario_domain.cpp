@@ -125,7 +125,8 @@ Result<ScenarioDomain> buildDomain(const Scenario& s) {
       y0 = std::min(y0, p[1]);
       y1 = std::max(y1, p[1]);
     }
-    if (x0 < -1e-3 || y0 < -1e-3 || x1 > full.width + 1e-3 || y1 > full.height + 1e-3) {  // 1e-3 pixel: rounding of the corners
+    if (x0 < -1e-3 || y0 < -1e-3 || x1 > full.width + 1e-3 ||
+        y1 > full.height + 1e-3) {  // 1e-3 pixel: rounding of the corners
       return placeError(
           s, s.region.place,
           "the region is not inside the DEM " + demPath + " (extent " + describeExtent(full) + " in its CRS)");

@@ -1,0 +1,201 @@
+// The flood scenario end to end on whatever GL the machine has (llvmpipe in CI): a small region of
+// the real Grand Canyon DEM, a river inflow, maps, series, report; and interrupt-and-resume.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+#include <strata/core/files.hpp>
+#include <strata/gis/dem_io.hpp>
+#include <strata/gis/geodesy.hpp>
+#include <strata/render/scenario/flood_run.hpp>
+#include <strata/terrain/scenario_domain.hpp>
+
+#include "gl_fixture.hpp"
+#include "strata_test.hpp"
+
+namespace strata::render::scenario {
+namespace {
+
+using test::GlTest;
+
+// 20 minutes of a 20,000 m3/s river entering a ~24 x 18 km piece of the canyon at ~600 m cells.
+std::string scenarioText() {
+  return "name = \"test flood\"\n"
+         "[terrain]\ndem = \"" +
+         test::dataPath("grand_canyon/grand_canyon_512.tif") +
+         "\"\n"
+         "[region]\nbbox_lonlat = [-112.25, 36.02, -112.001, 36.18]\ncell_size = \"600 m\"\n"
+         "[model]\nkind = \"flood\"\nmanning_n = 0.04\n"
+         "boundary = { west = \"open\", east = \"closed\", south = \"open\", north = \"open\" }\n"
+         "[[water.inflow]]\nname = \"Colorado\"\nline_lonlat = [[-112.0225, 36.063], [-112.0225, 36.08]]\n"
+         "hydrograph = [[0, 0], [5, 20000], [20, 20000]]\nhydrograph_units = [\"min\", \"m3/s\"]\n"
+         "[time]\nduration = \"20 min\"\noutput_interval = \"5 min\"\n"
+         "[outputs]\nwet_threshold = \"0.1 m\"\n";
+}
+
+terrain::Scenario writeScenario(const std::filesystem::path& dir) {
+  const auto file = dir / "flood.toml";
+  std::ofstream(file) << scenarioText();
+  auto s = terrain::loadScenario(file);
+  EXPECT_TRUE(s) << s.message();
+  return *s;
+}
+
+std::string run(const std::string& cmd) {
+  std::string out;
+  FILE* p = popen((cmd + " 2>&1").c_str(), "r");
+  std::array<char, 4096> buf{};
+  size_t n = 0;
+  while ((n = fread(buf.data(), 1, buf.size(), p)) > 0) out.append(buf.data(), n);
+  pclose(p);
+  return out;
+}
+
+gis::ReadOptions allowEmpty() {
+  gis::ReadOptions o;
+  o.allowAllNoData = true;
+  return o;
+}
+
+std::vector<std::vector<double>> readCsv(const std::filesystem::path& path) {
+  std::ifstream f(path);
+  std::string line;
+  std::getline(f, line);  // header
+  std::vector<std::vector<double>> rows;
+  while (std::getline(f, line)) {
+    std::vector<double> row;
+    std::stringstream ss(line);
+    std::string cell;
+    while (std::getline(ss, cell, ',')) row.push_back(std::stod(cell));
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+TEST_F(GlTest, FloodScenarioWritesMapsSeriesAndReport) {
+  const auto dir = test::tempDir("flood");
+  const auto scenario = writeScenario(dir);
+  RunOptions opt;
+  opt.outDir = dir / "run";
+  auto summary = runScenario(scenario, opt);
+  ASSERT_TRUE(summary) << summary.message();
+  EXPECT_TRUE(summary->completed);
+  ASSERT_EQ(summary->series.size(), 4u);
+
+  // GeoTIFFs open in gdalinfo with the DEM's CRS (EPSG:4326) and the region's geotransform.
+  auto domain = terrain::buildDomain(scenario);
+  ASSERT_TRUE(domain) << domain.message();
+  const auto& gt = domain->bed.georef.transform.c;
+  for (const char* map : {"max_depth", "max_speed", "arrival_time", "inundation_duration", "final_depth"}) {
+    const auto path = opt.outDir / "maps" / (std::string(map) + ".tif");
+    ASSERT_TRUE(std::filesystem::exists(path)) << path;
+    const std::string info = run("gdalinfo -json '" + path.string() + "'");
+    EXPECT_NE(info.find("ID[\\\"EPSG\\\",4326]"), std::string::npos) << map << ": " << info.substr(0, 400);
+    EXPECT_NE(info.find("\"noDataValue\":-32768"), std::string::npos) << map;
+    const auto at = info.find("\"geoTransform\":[");
+    ASSERT_NE(at, std::string::npos) << map;
+    const char* p = info.c_str() + at + 16;
+    for (int k = 0; k < 6; ++k) {
+      char* end = nullptr;
+      const double v = std::strtod(p, &end);
+      EXPECT_NEAR(v, gt[k], 1e-12 * std::max(1.0, std::abs(gt[k]))) << map << " geotransform term " << k;
+      p = end;
+      while (*p == ',' || *p == ' ' || *p == '\n') ++p;
+    }
+  }
+
+  // The series: volume balance (in - out - stored) within 1e-4 of what came in.
+  const auto rows = readCsv(opt.outDir / "series.csv");
+  ASSERT_EQ(rows.size(), 4u);
+  for (const auto& r : rows) {
+    const double in = r[5] + r[6], out = r[7] + r[8], stored = r[3];
+    EXPECT_LT(std::abs(in - out - stored), 1e-4 * in) << "t = " << r[0];
+  }
+  EXPECT_GT(rows.back()[5], 0.9 * 20000 * 17.5 * 60);  // inflow: 17.5 min at full rate, plus the ramp
+
+  // The flooded area equals the sum of geodesic areas of the cells wetter than the threshold.
+  auto depth = gis::readDem((opt.outDir / "maps" / "final_depth.tif").string(), allowEmpty());
+  ASSERT_TRUE(depth) << depth.message();
+  auto areas = gis::cellAreasM2(depth->georef);
+  ASSERT_TRUE(areas);
+  double wet = 0;
+  for (size_t i = 0; i < depth->values.size(); ++i) {
+    if (depth->values.data[i] > 0.1f) wet += areas->data[i];
+  }
+  EXPECT_GT(wet, 0);
+  // 1e-6: the CSV keeps 9 significant digits and the depths pass through float32 GeoTIFF.
+  EXPECT_NEAR(rows.back()[4], wet / 1e6, 1e-6 * wet / 1e6);
+
+  // Plots and the report.
+  for (const char* f : {"plots/water.png", "plots/area.png", "plots/max_depth.png", "report.md"}) {
+    EXPECT_TRUE(std::filesystem::exists(opt.outDir / f)) << f;
+  }
+  std::ifstream report(opt.outDir / "report.md");
+  std::stringstream text;
+  text << report.rdbuf();
+  EXPECT_NE(text.str().find("| largest flooded area |"), std::string::npos);
+  EXPECT_NE(text.str().find("| volume balance error at the end |"), std::string::npos);
+}
+
+TEST_F(GlTest, InterruptedAndResumedRunEqualsAnUninterruptedOne) {
+  const auto dir = test::tempDir("resume");
+  const auto scenario = writeScenario(dir);
+  RunOptions whole;
+  whole.outDir = dir / "whole";
+  whole.plots = false;
+  ASSERT_TRUE(runScenario(scenario, whole));
+
+  RunOptions part = whole;
+  part.outDir = dir / "part";
+  part.stopAfterIntervals = 2;
+  auto first = runScenario(scenario, part);
+  ASSERT_TRUE(first) << first.message();
+  EXPECT_FALSE(first->completed);
+  EXPECT_EQ(readCsv(part.outDir / "series.csv").size(), 2u);  // outputs up to the last interval
+  part.stopAfterIntervals = -1;
+  part.resume = true;
+  auto second = runScenario(scenario, part);
+  ASSERT_TRUE(second) << second.message();
+  EXPECT_TRUE(second->completed);
+
+  const auto a = readCsv(whole.outDir / "series.csv"), b = readCsv(part.outDir / "series.csv");
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t r = 0; r < a.size(); ++r) {
+    for (size_t c = 0; c < a[r].size(); ++c) {
+      // The same steps on the same state: equal to the digits the CSV keeps.
+      EXPECT_NEAR(a[r][c], b[r][c], 1e-7 * std::max(1.0, std::abs(a[r][c]))) << "row " << r << " column " << c;
+    }
+  }
+  for (const char* map : {"max_depth", "final_depth", "arrival_time"}) {
+    auto x = gis::readDem((whole.outDir / "maps" / (std::string(map) + ".tif")).string(), allowEmpty());
+    auto y = gis::readDem((part.outDir / "maps" / (std::string(map) + ".tif")).string(), allowEmpty());
+    ASSERT_TRUE(x && y);
+    for (size_t i = 0; i < x->values.size(); ++i) {
+      const float u = x->values.data[i], v = y->values.data[i];
+      ASSERT_TRUE((std::isnan(u) && std::isnan(v)) || std::abs(u - v) <= 1e-5f * std::max(1.0f, std::abs(u)))
+          << map << " cell " << i << ": " << u << " vs " << v;
+    }
+  }
+}
+
+TEST_F(GlTest, ResumeRefusesACheckpointOfAnotherScenario) {
+  const auto dir = test::tempDir("resume-other");
+  auto scenario = writeScenario(dir);
+  RunOptions opt;
+  opt.outDir = dir / "run";
+  opt.plots = false;
+  opt.stopAfterIntervals = 1;
+  ASSERT_TRUE(runScenario(scenario, opt));
+  std::ofstream(scenario.file, std::ios::app) << "# edited\n";
+  opt.resume = true;
+  auto again = runScenario(scenario, opt);
+  ASSERT_FALSE(again);
+  EXPECT_EQ(again.message(),
+            (opt.outDir / "checkpoint.bin").string() + ": written by a different scenario (the file changed)");
+}
+
+}  // namespace
+}  // namespace strata::render::scenario
