@@ -202,7 +202,7 @@ TEST(SimWaterCpu, FloodRitterDryDamBreak) {
 // Thacker's planar-surface solution in a frictionless paraboloid z = -h0 (1 - r^2/a^2): the
 // water moves as a tilted plane with angular frequency w = sqrt(2 g h0) / a.
 TEST(SimWaterCpu, FloodThackerBowlPeriod) {
-  const int n = 100;
+  const int n = 80;
   const double L = 4.0, a = 1.0, h0 = 0.1, eta = 0.5, g = 9.81, dx = L / n;
   SimInput in;
   in.baseM = gis::Grid<float>(n, n);
