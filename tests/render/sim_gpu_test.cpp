@@ -103,14 +103,26 @@ TEST_F(GlTest, SimRainAndSourcesBalance) {
   spring.hydrographM3S = {{0.0, 1.0}, {50.0, 4.0}};
   ASSERT_TRUE(sim->addSource(spring));
   EXPECT_FALSE(sim->addSource(terrain::sim::Source{{{-1, 0}}, {}}));
-  sim->advance(200.0);
+  sim->advance(100.0);
+  // The rain stops and evaporation doubles half-way (what a scenario's rain end time does).
+  auto later = sim->params();
+  later.rainMmPerHour = 0.0f;
+  later.evaporationMmPerHour = 40.0f;
+  ASSERT_TRUE(sim->setParams(later));
+  const double rainBefore = sim->stats().rainM3;
+  later.thermalRate = 2.0f;
+  EXPECT_FALSE(sim->setParams(later));  // bad values are refused and change nothing
+  sim->advance(100.0);
   const auto st = sim->stats();
+  // Raster rain (30 mm/h) keeps falling; the uniform 100 mm/h stopped at 100 s.
+  EXPECT_NEAR(st.rainM3 - rainBefore, 30.0 / 3.6e6 * 100.0 * 160.0 * 160.0, 1e-6 * st.rainM3);
   const double moved = st.initialWaterM3 + st.rainM3 + st.inflowM3 + st.outflowM3 + st.evaporatedM3;
   std::printf(
       "GPU balance: rain %.3f inflow %.3f outflow %.3f evaporated %.3f stored %.3f -> %.3f, imbalance %.3g m3\n",
       st.rainM3, st.inflowM3, st.outflowM3, st.evaporatedM3, st.initialWaterM3, st.storedWaterM3, st.waterBalanceM3());
   EXPECT_NEAR(st.timeS, 200.0, 1e-9);
-  EXPECT_NEAR(st.inflowM3, 0.5 * 5.0 * 50.0 + 4.0 * 150.0, 1e-6);  // the hydrograph's integral
+  // The hydrograph's integral (zero after 50 s), with float32 per-cell rates (1e-7 relative).
+  EXPECT_NEAR(st.inflowM3, 0.5 * 5.0 * 50.0, 1e-6 * 125.0);
   EXPECT_GT(st.outflowM3, 1.0);
   EXPECT_GT(st.evaporatedM3, 0.1);
   // Float32 depth updates of ~2e4 m3 over 2000 steps; same bound as the CPU reference (1e-5).

@@ -129,16 +129,16 @@ TEST(SimWaterCpu, SourcesOutflowAndEvaporationBalance) {
     EXPECT_NE(r.message().find("outside"), std::string::npos) << r.message();
     sim->advance(400.0);
     const auto st = sim->stats();
-    // Hydrograph: 0 -> 6 m3/s over 100 s, 6 -> 1 over 200 s, then 1 m3/s for 100 s.
-    const double expectedInflow = 0.5 * 6.0 * 100.0 + 0.5 * 7.0 * 200.0 + 100.0;
+    // Hydrograph: 0 -> 6 m3/s over 100 s, 6 -> 1 over 200 s, then nothing (zero outside its span).
+    const double expectedInflow = 0.5 * 6.0 * 100.0 + 0.5 * 7.0 * 200.0;
     std::printf(
         "balance (model %d): inflow %.3f (expected %.3f) outflow %.3f evaporated %.3f stored %.3f -> %.3f, "
         "imbalance %.3g m3\n",
         params.waterModel, st.inflowM3, expectedInflow, st.outflowM3, st.evaporatedM3, st.initialWaterM3,
         st.storedWaterM3, st.waterBalanceM3());
-    // Midpoint sampling of a piecewise-linear hydrograph is exact except in the step that
-    // straddles a kink: at most dt * |slope change| / 4 per kink.
-    EXPECT_NEAR(st.inflowM3, expectedInflow, 0.05);
+    // Each step takes the hydrograph's exact integral over the step; the per-cell rates are
+    // float32 (1e-7 relative).
+    EXPECT_NEAR(st.inflowM3, expectedInflow, 1e-6 * expectedInflow);
     EXPECT_GT(st.outflowM3, 100.0);
     EXPECT_GT(st.evaporatedM3, 10.0);
     // The per-cell outflow and evaporation sums are compensated (W20), so what is left is the

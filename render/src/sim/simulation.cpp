@@ -53,6 +53,7 @@ struct Simulation::Impl {
   long long steps = 0;
   std::vector<double> rowDxD;
   std::vector<ts::Source> sources;
+  std::vector<float> rainRaster;  // host copy, for the rain volume rate after setParams
   size_t n = 0;
 
   gl::Buffer params, materials, rowDx, base, bed, layers, stateA, stateB, stage, flux, faceX, faceY, tilt, accum, rain,
@@ -104,7 +105,7 @@ struct Simulation::Impl {
       p.dtS = float(dtS);
       params.upload(kParamsDtOffset, sizeof(float), &p.dtS);
     }
-    const auto entries = ts::mergeSources(sources, w, timeS + 0.5 * dtS);
+    const auto entries = ts::mergeSources(sources, w, timeS, timeS + double(float(dtS)));
     for (const auto& e : entries) inflowM3 += double(e.rateM3S) * double(p.dtS);
     rainM3 += rainRateM3S * double(p.dtS);
     bindAll();
@@ -218,6 +219,7 @@ Result<Simulation> Simulation::create(const SimInput& input, const SimParams& pa
   const std::vector<float> rain =
       input.rainMmPerHour.size() > 0 ? input.rainMmPerHour.data : std::vector<float>(n, 0.0f);
   s.rainRateM3S = ts::rainVolumeRate(s.p, rain, s.rowDxD, w);
+  s.rainRaster = rain;
   s.minCell = ts::minCellSize(s.rowDxD, input.dyM);
 
   const GLbitfield dyn = GL_DYNAMIC_STORAGE_BIT;
@@ -273,6 +275,16 @@ Status Simulation::addSource(const Source& source) {
     }
   }
   impl_->sources.push_back(source);
+  return {};
+}
+
+Status Simulation::setParams(const SimParams& params) {
+  Impl& s = *impl_;
+  const SimParams next = ts::runtimeParams(s.p, params);
+  STRATA_TRY_STATUS(ts::validateParams(next));
+  s.p = next;
+  s.params.upload(0, sizeof(ts::SimParams), &s.p);
+  s.rainRateM3S = ts::rainVolumeRate(s.p, s.rainRaster, s.rowDxD, s.p.width);
   return {};
 }
 

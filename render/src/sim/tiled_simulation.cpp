@@ -143,7 +143,7 @@ void TiledSimulation::step(int n) {
       for (auto& tile : tiles_) speed = std::max(speed, tile.sim.maxWaveSpeedMS());
     }
     const double dt = ts::stepDt(p_, speed, minCell_);
-    for (const auto& e : ts::mergeSources(sources_, width_, timeS_ + 0.5 * dt)) {
+    for (const auto& e : ts::mergeSources(sources_, width_, timeS_, timeS_ + double(float(dt)))) {
       inflowM3_ += double(e.rateM3S) * double(float(dt));
     }
     rainM3_ += rainRateM3S_ * double(float(dt));

@@ -151,6 +151,14 @@ float CpuSimulation::sinTilt(int x, int y) const {
   return std::sqrt(g2 / (1.0f + g2));
 }
 
+Status CpuSimulation::setParams(const SimParams& params) {
+  const SimParams next = runtimeParams(p_, params);
+  STRATA_TRY_STATUS(validateParams(next));
+  p_ = next;
+  rainRateM3S_ = rainVolumeRate(p_, rain_, rowDxD_, p_.width);
+  return {};
+}
+
 float CpuSimulation::faceWidthY(int yFace) const {
   if (yFace <= 0) return dx(0);
   if (yFace >= p_.height) return dx(p_.height - 1);
@@ -197,7 +205,7 @@ void CpuSimulation::advance(double seconds) {
 
 void CpuSimulation::takeStep(double dtS) {
   p_.dtS = float(dtS);
-  entries_ = mergeSources(sources_, p_.width, timeS_ + 0.5 * dtS);
+  entries_ = mergeSources(sources_, p_.width, timeS_, timeS_ + double(float(dtS)));
   for (const auto& e : entries_) inflowM3_ += double(e.rateM3S) * double(p_.dtS);
   rainM3_ += rainRateM3S_ * double(p_.dtS);
   sourcesPass();

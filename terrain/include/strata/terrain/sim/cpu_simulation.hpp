@@ -25,6 +25,9 @@ class CpuSimulation {
 
   /// Adds an inflow source (spring, inflow line with a hydrograph); cells must be inside.
   Status addSource(const Source& source);
+  /// Changes the run-time parameters (rain, evaporation, friction, erosion constants, edges, time
+  /// step rule) from the next step on; grid size, layers and water model stay as created.
+  Status setParams(const SimParams& params);
   /// Takes `n` steps (each of stepDt(), W10).
   void step(int n = 1);
   /// Steps until `seconds` more have been simulated (the last step is shortened to land on it).

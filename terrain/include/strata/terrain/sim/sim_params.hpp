@@ -93,13 +93,16 @@ struct SimInput {
   double datumM = 0.0;         ///< elevations are stored relative to this (m)
 };
 
-/// A point or line of inflow: `rateM3S` over time, linearly interpolated between samples
-/// (constant outside them), split equally over `cells` (W12).
+/// A point or line of inflow: discharge over time, linearly interpolated between samples and
+/// zero outside their span (as terrain::Hydrograph in scenario files), split equally over
+/// `cells` (W12).
 struct Source {
   std::vector<std::pair<int, int>> cells;                ///< (x, y) cells it feeds
   std::vector<std::pair<double, double>> hydrographM3S;  ///< (time s, discharge m^3/s), time increasing
   /// Discharge at time `tS` (m^3/s).
   double rateAt(double tS) const;
+  /// Volume delivered between t0S and t1S (m^3): the exact integral of the piecewise-linear curve.
+  double volume(double t0S, double t1S) const;
 };
 
 /// Water and material bookkeeping since the start (volumes in m^3, summed in double).
@@ -127,6 +130,13 @@ struct SimStats {
 /// Checks `input` against `params` (sizes, per-row dx, materials, non-negative thicknesses);
 /// the message names the field and the problem.
 Status validate(const SimInput& input, const SimParams& params);
+
+/// Checks the parameters alone (ranges, model); validate() calls it.
+Status validateParams(const SimParams& params);
+
+/// `next` with the fields fixed at creation (grid size, layer count, water model, dyM) and the
+/// current step taken from `current`: what setParams() applies mid-run.
+SimParams runtimeParams(const SimParams& current, const SimParams& next);
 
 /// Cell-size helpers shared by both solvers: dx of `row`, and the minimum over rows.
 double rowDx(const SimInput& input, int row);
