@@ -172,6 +172,8 @@ TEST_F(GlTest, SimPipesAgreeWithCpuReference) {
   p.rainMmPerHour = 40.0f;
   terrain::sim::Source spring{{{5, 5}}, {{0.0, 2.0}, {30.0, 0.5}}};
   expectAgreement(in, p, 300, 1e-4, 1e-6, &spring);
+  p.diagonalPipes = 1;
+  expectAgreement(in, p, 300, 1e-4, 1e-6, &spring);
 }
 
 TEST_F(GlTest, SimFloodAgreesWithCpuReference) {
@@ -293,6 +295,8 @@ TEST_F(GlTest, SimTiledErosionEqualsUntiled) {
   auto p = test::erosionParams();
   p.openEdges = terrain::sim::kEdgeSouth;
   auto spring = test::valleySpring(n);
+  expectTiledEqualsUntiled(in, p, 40, &spring);
+  p.diagonalPipes = 1;
   expectTiledEqualsUntiled(in, p, 40, &spring);
 }
 

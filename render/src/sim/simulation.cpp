@@ -40,6 +40,7 @@ enum Slot : GLuint {
   kThermal = 15,
   kSources = 16,
   kMaxSpeed = 17,
+  kFluxDiag = 18,
 };
 constexpr size_t kParamsDtOffset = offsetof(ts::SimParams, dtS);
 
@@ -56,8 +57,8 @@ struct Simulation::Impl {
   std::vector<float> rainRaster;  // host copy, for the rain volume rate after setParams
   size_t n = 0;
 
-  gl::Buffer params, materials, rowDx, base, bed, layers, stateA, stateB, stage, flux, faceX, faceY, tilt, accum, rain,
-      thermal, sourceEntries, maxSpeed;
+  gl::Buffer params, materials, rowDx, base, bed, layers, stateA, stateB, stage, flux, fluxDiag, faceX, faceY, tilt,
+      accum, rain, thermal, sourceEntries, maxSpeed;
   bool aIsCurrent = true;
   gl::Program pSources, pPointSources, pWaveSpeed, pPipeFlux, pPipeUpdate, pFvFace, pFvUpdate, pErode, pThermalFlux,
       pThermalApply;
@@ -76,6 +77,7 @@ struct Simulation::Impl {
     next().bindBase(GL_SHADER_STORAGE_BUFFER, kStateOut);
     stage.bindBase(GL_SHADER_STORAGE_BUFFER, kStage);
     flux.bindBase(GL_SHADER_STORAGE_BUFFER, kFlux);
+    fluxDiag.bindBase(GL_SHADER_STORAGE_BUFFER, kFluxDiag);
     faceX.bindBase(GL_SHADER_STORAGE_BUFFER, kFaceX);
     faceY.bindBase(GL_SHADER_STORAGE_BUFFER, kFaceY);
     tilt.bindBase(GL_SHADER_STORAGE_BUFFER, kTilt);
@@ -234,6 +236,8 @@ Result<Simulation> Simulation::create(const SimInput& input, const SimParams& pa
   s.stage = gl::Buffer::from(std::span<const float>(state));
   s.flux = gl::Buffer(16 * n);
   s.flux.fill(0u);
+  s.fluxDiag = gl::Buffer(s.p.diagonalPipes ? 16 * n : 16);
+  s.fluxDiag.fill(0u);
   const bool flood = s.p.waterModel == int32_t(ts::WaterModel::kFiniteVolume);
   s.faceX = gl::Buffer(flood ? 16 * size_t(w + 1) * size_t(h) : 16);
   s.faceX.fill(0u);
@@ -354,7 +358,7 @@ size_t Simulation::gpuBytes() const {
   size_t total = 0;
   for (const gl::Buffer* b :
        {&s.params, &s.materials, &s.rowDx, &s.base, &s.bed, &s.layers, &s.stateA, &s.stateB, &s.stage, &s.flux,
-        &s.faceX, &s.faceY, &s.tilt, &s.accum, &s.rain, &s.thermal, &s.sourceEntries, &s.maxSpeed}) {
+        &s.fluxDiag, &s.faceX, &s.faceY, &s.tilt, &s.accum, &s.rain, &s.thermal, &s.sourceEntries, &s.maxSpeed}) {
     total += b->size();
   }
   return total;
@@ -363,7 +367,8 @@ size_t Simulation::gpuBytes() const {
 Simulation::RawState Simulation::readRaw() const {
   const Impl& s = *impl_;
   glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-  return {s.cur().read<float>(), s.flux.read<float>(), s.layers.read<float>(), s.accum.read<float>()};
+  return {s.cur().read<float>(), s.flux.read<float>(), s.fluxDiag.read<float>(), s.layers.read<float>(),
+          s.accum.read<float>()};
 }
 
 void Simulation::writeRaw(const RawState& raw) {
@@ -374,6 +379,7 @@ void Simulation::writeRaw(const RawState& raw) {
   glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
   (s.aIsCurrent ? s.stateA : s.stateB).upload(0, raw.state.size() * 4, raw.state.data());
   s.flux.upload(0, raw.flux.size() * 4, raw.flux.data());
+  s.fluxDiag.upload(0, raw.fluxDiag.size() * 4, raw.fluxDiag.data());
   s.layers.upload(0, raw.layers.size() * 4, raw.layers.data());
   const auto base = s.base.read<float>();
   std::vector<float> bed(s.n);

@@ -128,6 +128,7 @@ void TiledSimulation::exchangeHalos() {
         for (int c = 0; c < 4; ++c) {
           updated[k].state[4 * i + size_t(c)] = raw[o].state[4 * j + size_t(c)];
           updated[k].flux[4 * i + size_t(c)] = raw[o].flux[4 * j + size_t(c)];
+          if (p_.diagonalPipes) updated[k].fluxDiag[4 * i + size_t(c)] = raw[o].fluxDiag[4 * j + size_t(c)];
         }
         for (int l = 0; l < L; ++l) updated[k].layers[size_t(l) * cells + i] = raw[o].layers[size_t(l) * srcCells + j];
       }

@@ -53,10 +53,11 @@ class Simulation {
 
   /// For tiled runs (TiledSimulation): the persistent per-cell state as stored on the GPU.
   struct RawState {
-    std::vector<float> state;   ///< 4 per cell: h, s, hu, hv
-    std::vector<float> flux;    ///< 4 per cell: pipe outflows W, E, N, S
-    std::vector<float> layers;  ///< layer-major: layers[l * cells + cell]
-    std::vector<float> accum;   ///< 8 per cell: (sum, error) of outflow, evaporation, sediment outflow
+    std::vector<float> state;     ///< 4 per cell: h, s, hu, hv
+    std::vector<float> flux;      ///< 4 per cell: pipe outflows W, E, N, S
+    std::vector<float> fluxDiag;  ///< diagonal pipes NW, NE, SW, SE: 4 per cell (4 floats in all without them)
+    std::vector<float> layers;    ///< layer-major: layers[l * cells + cell]
+    std::vector<float> accum;     ///< 8 per cell: (sum, error) of outflow, evaporation, sediment outflow
   };
   RawState readRaw() const;
   /// Replaces state, flux and layers (accum is kept) and recomputes the bed from them.

@@ -77,6 +77,7 @@ class CpuSimulation {
   std::vector<float> state_, stateNext_;    // vec4 per cell: h, s, hu, hv
   std::vector<float> stage_;                // flood mode: the Heun predictor U1
   std::vector<float> flux_;                 // vec4 per cell: pipe outflows W, E, N, S (m^3/s)
+  std::vector<float> fluxDiag_;             // vec4 per cell: diagonal outflows NW, NE, SW, SE (m^3/s)
   std::vector<float> faceX_, faceY_;        // vec4 per face (flood mode)
   std::vector<float> tilt_;                 // sin(bed tilt)
   std::vector<float> accum_;                // 8 per cell: (sum, error) of water out, evaporated, sediment out (m^3)

@@ -35,10 +35,10 @@ struct SimParams {
   int32_t height = 0;      ///< cells in y (rows, row 0 north)
   int32_t layerCount = 0;  ///< material layers (set by create)
   int32_t waterModel = int32_t(WaterModel::kVirtualPipes);
-  uint32_t openEdges = 0;       ///< EdgeBits; 0 = closed box
-  uint32_t erosionEnabled = 0;  ///< 1: erosion, deposition, dissolution and transport (E1-E6)
-  uint32_t thermalEnabled = 0;  ///< 1: thermal weathering and bank slippage (E7-E8)
-  uint32_t pad0 = 0;
+  uint32_t openEdges = 0;             ///< EdgeBits; 0 = closed box
+  uint32_t erosionEnabled = 0;        ///< 1: erosion, deposition, dissolution and transport (E1-E6)
+  uint32_t thermalEnabled = 0;        ///< 1: thermal weathering and bank slippage (E7-E8)
+  uint32_t diagonalPipes = 0;         ///< 1: pipes model with 8 pipes (diagonals too), no axis-aligned gullies (W1b)
   float dyM = 1.0f;                   ///< cell size north-south (m); per-row dx is in SimInput::rowDxM
   float gravityMS2 = 9.81f;           ///< g (m/s^2)
   float dtS = 0.0f;                   ///< the current step (s); written by the solver each step
