@@ -67,7 +67,7 @@ void run(benchmark::State& state, ts::SimParams p, double bytesPerCell) {
     return;
   }
   sim->step(2);  // warm up: first dispatches compile and page in
-  const int stepsPerIteration = 4;
+  const int stepsPerIteration = n >= 1024 ? 1 : 4;
   for (auto _ : state) {
     render::gl::GpuTimer t;
     t.begin();

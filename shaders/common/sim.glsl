@@ -12,7 +12,7 @@ struct SimParams {
   uint openEdges;
   uint erosionEnabled;
   uint thermalEnabled;
-  uint pad0;
+  uint diagonalPipes;
   float dyM;
   float gravityMS2;
   float dtS;
@@ -51,6 +51,8 @@ layout(std430, binding = 0) readonly buffer SimParamsBlock { SimParams P; };
 layout(std430, binding = 2) readonly buffer RowDxBlock { float rowDx[]; };
 
 const ivec2 kDir[4] = ivec2[4](ivec2(-1, 0), ivec2(1, 0), ivec2(0, -1), ivec2(0, 1));  // W, E, N, S
+// Diagonal pipes (W1b): NW, NE, SW, SE; the opposite of k is 3 - k.
+const ivec2 kDiag[4] = ivec2[4](ivec2(-1, -1), ivec2(1, -1), ivec2(-1, 1), ivec2(1, 1));
 const float kMmPerHourToMS = 1.0 / 3.6e6;
 const float kHeadNoise = 4.0 * 1.1920929e-7;   // W1a
 const float kForceNoise = 16.0 * 1.1920929e-7; // W24

@@ -5,7 +5,7 @@
 #include "../common/sim.glsl"
 layout(local_size_x = 256) in;
 layout(std430, binding = 6) readonly buffer StateIn { vec4 state[]; };
-layout(std430, binding = 18) buffer FloodStats { vec4 floodStats[]; };  // maxDepth, maxSpeed, arrival, wetTime
+layout(std430, binding = 19) buffer FloodStats { vec4 floodStats[]; };  // maxDepth, maxSpeed, arrival, wetTime
 
 uniform float timeS;          // simulated time at the end of this step
 uniform float wetThresholdM;

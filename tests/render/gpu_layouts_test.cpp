@@ -103,7 +103,7 @@ TEST(GpuLayouts, SimParamsMatchesGlsl) {
                                            STRATA_FIELD(SimParams, openEdges),
                                            STRATA_FIELD(SimParams, erosionEnabled),
                                            STRATA_FIELD(SimParams, thermalEnabled),
-                                           STRATA_FIELD(SimParams, pad0),
+                                           STRATA_FIELD(SimParams, diagonalPipes),
                                            STRATA_FIELD(SimParams, dyM),
                                            STRATA_FIELD(SimParams, gravityMS2),
                                            STRATA_FIELD(SimParams, dtS),

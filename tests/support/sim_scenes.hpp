@@ -120,7 +120,7 @@ inline terrain::sim::SimParams erosionParams() {
 inline terrain::sim::Source valleySpring(int n) {
   terrain::sim::Source s;
   for (int x = n / 2 - 2; x <= n / 2 + 2; ++x) s.cells.push_back({x, 1});
-  s.hydrographM3S = {{0.0, 2.0}, {200.0, 5.0}};
+  s.hydrographM3S = {{0.0, 2.0}, {200.0, 5.0}, {1000.0, 5.0}};
   return s;
 }
 

@@ -6,6 +6,7 @@
 #include <numbers>
 
 #include <strata/terrain/sim/cpu_simulation.hpp>
+#include <strata/terrain/sim/region.hpp>
 
 #include "sim_scenes.hpp"
 
@@ -89,6 +90,49 @@ TEST(SimErosionCpu, ThermalWeatheringReachesTalusAndConserves) {
   EXPECT_LT(worst, 1e-3);
   // Pure transfers between float thicknesses of a few metres: rounding only.
   EXPECT_LT(rel, 1e-6);
+}
+
+}  // namespace
+}  // namespace strata::terrain::sim
+
+namespace strata::terrain::sim {
+namespace {
+
+TEST(SimRegionCpu, CutSimulateAndWriteBack) {
+  // A 24x22 region of the eroding valley, run on its own and written back: inside the region the
+  // terrain is the region's result exactly, outside it is untouched.
+  const int n = 40;
+  const auto full = test::erodingValley(n);
+  const CellRect rect{10, 18, 24, 22};  // includes the wet lower valley (rows 32+)
+  auto region = cutRegion(full, rect);
+  ASSERT_TRUE(region) << region.message();
+  EXPECT_EQ(region->baseM.width, 24);
+  EXPECT_EQ(region->layersM[2].at(3, 4), full.layersM[2].at(13, 22));
+  auto sim = CpuSimulation::create(*region, test::erosionParams());
+  ASSERT_TRUE(sim) << sim.message();
+  sim->step(1000);
+  const auto after = sim->readLayers();
+  auto layers = full.layersM;
+  ASSERT_TRUE(writeBackLayers(layers, after, rect));
+  int changedInside = 0;
+  for (size_t l = 0; l < layers.size(); ++l) {
+    for (int y = 0; y < n; ++y) {
+      for (int x = 0; x < n; ++x) {
+        const bool inside = x >= rect.x0 && x < rect.x0 + rect.width && y >= rect.y0 && y < rect.y0 + rect.height;
+        if (inside) {
+          ASSERT_EQ(layers[l].at(x, y), after[l].at(x - rect.x0, y - rect.y0));
+          changedInside += layers[l].at(x, y) != full.layersM[l].at(x, y);
+        } else {
+          ASSERT_EQ(layers[l].at(x, y), full.layersM[l].at(x, y));
+        }
+      }
+    }
+  }
+  EXPECT_GT(changedInside, 50);  // the run did change the region
+  const auto bad = cutRegion(full, CellRect{30, 30, 20, 20});
+  ASSERT_FALSE(bad);
+  EXPECT_NE(bad.message().find("not inside"), std::string::npos) << bad.message();
+  EXPECT_FALSE(writeBackLayers(layers, after, CellRect{0, 0, 10, 10}));
 }
 
 }  // namespace

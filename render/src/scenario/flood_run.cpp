@@ -109,6 +109,7 @@ std::string encodeCheckpoint(uint64_t hash, int interval, const std::vector<Seri
   w.pod(snap.counters);
   w.vec(snap.raw.state);
   w.vec(snap.raw.flux);
+  w.vec(snap.raw.fluxDiag);
   w.vec(snap.raw.layers);
   w.vec(snap.raw.accum);
   writeGrid(w, snap.flood.maxDepthM);
@@ -134,6 +135,7 @@ Status decodeCheckpoint(const fs::path& path, uint64_t hash, int& interval, std:
   r.pod(snap.counters);
   r.vec(snap.raw.state);
   r.vec(snap.raw.flux);
+  r.vec(snap.raw.fluxDiag);
   r.vec(snap.raw.layers);
   r.vec(snap.raw.accum);
   readGrid(r, snap.flood.maxDepthM);
@@ -193,6 +195,7 @@ Result<RunSummary> runScenario(const terrain::Scenario& s, const RunOptions& opt
   const auto initialLayers = sim.readLayers();
   const gis::Grid<float> initialMaterial = materialThickness(initialLayers);
 
+  auto rainAt = [&](double t) { return t >= domain.rainStartS && t < domain.rainEndS ? domain.rainMmPerHour : 0.0; };
   RunSummary summary;
   int interval = 0;
   if (opt.resume) {
@@ -200,6 +203,9 @@ Result<RunSummary> runScenario(const terrain::Scenario& s, const RunOptions& opt
     sim::Simulation::Snapshot snap;
     STRATA_TRY_STATUS(decodeCheckpoint(checkpointPath, hash, interval, summary.series, snap));
     STRATA_TRY_STATUS(sim.restore(snap));
+    auto p = sim.params();
+    p.rainMmPerHour = float(rainAt(snap.counters.timeS));
+    STRATA_TRY_STATUS(sim.setParams(p));
     log::info("flood") << "resuming at " << formatDuration(sim.stats().timeS) << " (interval " << interval << ")";
   } else {
     STRATA_TRY_STATUS(writeFileAtomic(opt.outDir / "scenario.toml", scenarioText));
@@ -210,7 +216,6 @@ Result<RunSummary> runScenario(const terrain::Scenario& s, const RunOptions& opt
   constexpr int kChunks = 20;
   Progress progress("flood " + s.name, s.durationS);
   installInterruptHandler();
-  auto rainAt = [&](double t) { return t >= domain.rainStartS && t < domain.rainEndS ? domain.rainMmPerHour : 0.0; };
 
   std::vector<std::string> mapFiles;
   while (interval < intervals) {
@@ -225,7 +230,11 @@ Result<RunSummary> runScenario(const terrain::Scenario& s, const RunOptions& opt
         for (double edge : {domain.rainStartS, domain.rainEndS}) {
           if (edge > t + 1e-9 && edge < next) next = edge;
         }
-        sim.setRainMmPerHour(float(rainAt(t)));
+        if (float(rainAt(t)) != sim.params().rainMmPerHour) {
+          auto p = sim.params();
+          p.rainMmPerHour = float(rainAt(t));
+          STRATA_TRY_STATUS(sim.setParams(p));
+        }
         sim.advance(next - sim.stats().timeS);
         t = next;
       }

@@ -40,7 +40,8 @@ enum Slot : GLuint {
   kThermal = 15,
   kSources = 16,
   kMaxSpeed = 17,
-  kFloodStats = 18,
+  kFluxDiag = 18,
+  kFloodStats = 19,
 };
 constexpr size_t kParamsDtOffset = offsetof(ts::SimParams, dtS);
 
@@ -54,10 +55,11 @@ struct Simulation::Impl {
   long long steps = 0;
   std::vector<double> rowDxD;
   std::vector<ts::Source> sources;
+  std::vector<float> rainRaster;  // host copy, for the rain volume rate after setParams
   size_t n = 0;
 
-  gl::Buffer params, materials, rowDx, base, bed, layers, stateA, stateB, stage, flux, faceX, faceY, tilt, accum, rain,
-      thermal, sourceEntries, maxSpeed, floodStats;
+  gl::Buffer params, materials, rowDx, base, bed, layers, stateA, stateB, stage, flux, fluxDiag, faceX, faceY, tilt,
+      accum, rain, thermal, sourceEntries, maxSpeed, floodStats;
   float wetThresholdM = -1;  // < 0: flood statistics off
   bool aIsCurrent = true;
   gl::Program pSources, pPointSources, pWaveSpeed, pPipeFlux, pPipeUpdate, pFvFace, pFvUpdate, pErode, pThermalFlux,
@@ -77,6 +79,7 @@ struct Simulation::Impl {
     next().bindBase(GL_SHADER_STORAGE_BUFFER, kStateOut);
     stage.bindBase(GL_SHADER_STORAGE_BUFFER, kStage);
     flux.bindBase(GL_SHADER_STORAGE_BUFFER, kFlux);
+    fluxDiag.bindBase(GL_SHADER_STORAGE_BUFFER, kFluxDiag);
     faceX.bindBase(GL_SHADER_STORAGE_BUFFER, kFaceX);
     faceY.bindBase(GL_SHADER_STORAGE_BUFFER, kFaceY);
     tilt.bindBase(GL_SHADER_STORAGE_BUFFER, kTilt);
@@ -106,7 +109,7 @@ struct Simulation::Impl {
       p.dtS = float(dtS);
       params.upload(kParamsDtOffset, sizeof(float), &p.dtS);
     }
-    const auto entries = ts::mergeSources(sources, w, timeS + 0.5 * dtS);
+    const auto entries = ts::mergeSources(sources, w, timeS, timeS + double(float(dtS)));
     for (const auto& e : entries) inflowM3 += double(e.rateM3S) * double(p.dtS);
     rainM3 += rainRateM3S * double(p.dtS);
     bindAll();
@@ -229,6 +232,7 @@ Result<Simulation> Simulation::create(const SimInput& input, const SimParams& pa
   const std::vector<float> rain =
       input.rainMmPerHour.size() > 0 ? input.rainMmPerHour.data : std::vector<float>(n, 0.0f);
   s.rainRateM3S = ts::rainVolumeRate(s.p, rain, s.rowDxD, w);
+  s.rainRaster = rain;
   s.minCell = ts::minCellSize(s.rowDxD, input.dyM);
 
   const GLbitfield dyn = GL_DYNAMIC_STORAGE_BIT;
@@ -243,6 +247,8 @@ Result<Simulation> Simulation::create(const SimInput& input, const SimParams& pa
   s.stage = gl::Buffer::from(std::span<const float>(state));
   s.flux = gl::Buffer(16 * n);
   s.flux.fill(0u);
+  s.fluxDiag = gl::Buffer(s.p.diagonalPipes ? 16 * n : 16);
+  s.fluxDiag.fill(0u);
   const bool flood = s.p.waterModel == int32_t(ts::WaterModel::kFiniteVolume);
   s.faceX = gl::Buffer(flood ? 16 * size_t(w + 1) * size_t(h) : 16);
   s.faceX.fill(0u);
@@ -285,6 +291,16 @@ Status Simulation::addSource(const Source& source) {
     }
   }
   impl_->sources.push_back(source);
+  return {};
+}
+
+Status Simulation::setParams(const SimParams& params) {
+  Impl& s = *impl_;
+  const SimParams next = ts::runtimeParams(s.p, params);
+  STRATA_TRY_STATUS(ts::validateParams(next));
+  s.p = next;
+  s.params.upload(0, sizeof(ts::SimParams), &s.p);
+  s.rainRateM3S = ts::rainVolumeRate(s.p, s.rainRaster, s.rowDxD, s.p.width);
   return {};
 }
 
@@ -354,7 +370,8 @@ size_t Simulation::gpuBytes() const {
   size_t total = 0;
   for (const gl::Buffer* b :
        {&s.params, &s.materials, &s.rowDx, &s.base, &s.bed, &s.layers, &s.stateA, &s.stateB, &s.stage, &s.flux,
-        &s.faceX, &s.faceY, &s.tilt, &s.accum, &s.rain, &s.thermal, &s.sourceEntries, &s.maxSpeed, &s.floodStats}) {
+        &s.fluxDiag, &s.faceX, &s.faceY, &s.tilt, &s.accum, &s.rain, &s.thermal, &s.sourceEntries, &s.maxSpeed,
+        &s.floodStats}) {
     total += b->size();
   }
   return total;
@@ -363,7 +380,8 @@ size_t Simulation::gpuBytes() const {
 Simulation::RawState Simulation::readRaw() const {
   const Impl& s = *impl_;
   glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-  return {s.cur().read<float>(), s.flux.read<float>(), s.layers.read<float>(), s.accum.read<float>()};
+  return {s.cur().read<float>(), s.flux.read<float>(), s.fluxDiag.read<float>(), s.layers.read<float>(),
+          s.accum.read<float>()};
 }
 
 void Simulation::writeRaw(const RawState& raw) {
@@ -374,6 +392,7 @@ void Simulation::writeRaw(const RawState& raw) {
   glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
   (s.aIsCurrent ? s.stateA : s.stateB).upload(0, raw.state.size() * 4, raw.state.data());
   s.flux.upload(0, raw.flux.size() * 4, raw.flux.data());
+  s.fluxDiag.upload(0, raw.fluxDiag.size() * 4, raw.fluxDiag.data());
   s.layers.upload(0, raw.layers.size() * 4, raw.layers.data());
   const auto base = s.base.read<float>();
   std::vector<float> bed(s.n);
@@ -414,15 +433,6 @@ FloodStats Simulation::readFloodStats() const {
   return f;
 }
 
-void Simulation::setRainMmPerHour(float mmPerHour) {
-  Impl& s = *impl_;
-  if (s.p.rainMmPerHour == mmPerHour) return;
-  s.p.rainMmPerHour = mmPerHour;
-  s.params.upload(offsetof(ts::SimParams, rainMmPerHour), sizeof(float), &s.p.rainMmPerHour);
-  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-  s.rainRateM3S = ts::rainVolumeRate(s.p, s.rain.read<float>(), s.rowDxD, s.p.width);
-}
-
 Simulation::Snapshot Simulation::snapshot() const {
   const Impl& s = *impl_;
   Snapshot snap;
@@ -460,7 +470,6 @@ Status Simulation::restore(const Snapshot& snap) {
   s.initialWater = c.initialWaterM3;
   s.initialMaterial = c.initialMaterialM3;
   s.steps = c.steps;
-  setRainMmPerHour(c.rainMmPerHour);
   s.p.dtS = c.dtS;
   s.params.upload(kParamsDtOffset, sizeof(float), &s.p.dtS);
   return {};

@@ -128,6 +128,7 @@ void TiledSimulation::exchangeHalos() {
         for (int c = 0; c < 4; ++c) {
           updated[k].state[4 * i + size_t(c)] = raw[o].state[4 * j + size_t(c)];
           updated[k].flux[4 * i + size_t(c)] = raw[o].flux[4 * j + size_t(c)];
+          if (p_.diagonalPipes) updated[k].fluxDiag[4 * i + size_t(c)] = raw[o].fluxDiag[4 * j + size_t(c)];
         }
         for (int l = 0; l < L; ++l) updated[k].layers[size_t(l) * cells + i] = raw[o].layers[size_t(l) * srcCells + j];
       }
@@ -143,7 +144,7 @@ void TiledSimulation::step(int n) {
       for (auto& tile : tiles_) speed = std::max(speed, tile.sim.maxWaveSpeedMS());
     }
     const double dt = ts::stepDt(p_, speed, minCell_);
-    for (const auto& e : ts::mergeSources(sources_, width_, timeS_ + 0.5 * dt)) {
+    for (const auto& e : ts::mergeSources(sources_, width_, timeS_, timeS_ + double(float(dt)))) {
       inflowM3_ += double(e.rateM3S) * double(float(dt));
     }
     rainM3_ += rainRateM3S_ * double(float(dt));

@@ -13,6 +13,8 @@ namespace {
 
 constexpr int kDx[4] = {-1, 1, 0, 0};  // W, E, N, S
 constexpr int kDy[4] = {0, 0, -1, 1};
+constexpr int kDiagDx[4] = {-1, 1, -1, 1};  // NW, NE, SW, SE; the opposite of k is 3 - k
+constexpr int kDiagDy[4] = {-1, -1, 1, 1};
 constexpr float kMmPerHourToMS = 1.0f / 3.6e6f;
 // W1a: a head difference below 4 float32 ulps of the operands is rounding, not a gradient.
 constexpr float kHeadNoise = 4.0f * 1.1920929e-7f;
@@ -110,6 +112,7 @@ Result<CpuSimulation> CpuSimulation::create(const SimInput& input, const SimPara
   s.stateNext_ = s.state_;
   s.stage_ = s.state_;
   s.flux_.assign(4 * n, 0.0f);
+  s.fluxDiag_.assign(4 * n, 0.0f);
   s.faceX_.assign(4 * size_t(w + 1) * size_t(h), 0.0f);
   s.faceY_.assign(4 * size_t(w) * size_t(h + 1), 0.0f);
   s.tilt_.assign(n, 0.0f);
@@ -149,6 +152,14 @@ float CpuSimulation::sinTilt(int x, int y) const {
   const float gy = (bed_[idx(x, yd)] - bed_[idx(x, yu)]) / (float(yd - yu) * p_.dyM);
   const float g2 = gx * gx + gy * gy;
   return std::sqrt(g2 / (1.0f + g2));
+}
+
+Status CpuSimulation::setParams(const SimParams& params) {
+  const SimParams next = runtimeParams(p_, params);
+  STRATA_TRY_STATUS(validateParams(next));
+  p_ = next;
+  rainRateM3S_ = rainVolumeRate(p_, rain_, rowDxD_, p_.width);
+  return {};
 }
 
 float CpuSimulation::faceWidthY(int yFace) const {
@@ -197,7 +208,7 @@ void CpuSimulation::advance(double seconds) {
 
 void CpuSimulation::takeStep(double dtS) {
   p_.dtS = float(dtS);
-  entries_ = mergeSources(sources_, p_.width, timeS_ + 0.5 * dtS);
+  entries_ = mergeSources(sources_, p_.width, timeS_, timeS_ + double(float(dtS)));
   for (const auto& e : entries_) inflowM3_ += double(e.rateM3S) * double(p_.dtS);
   rainM3_ += rainRateM3S_ * double(p_.dtS);
   sourcesPass();
@@ -243,7 +254,11 @@ void CpuSimulation::sourcesPass() {
 
 // shaders/sim/pipe_flux.comp: W1 (flux from head difference), W2 (scaling K).
 void CpuSimulation::pipeFluxPass() {
-  const float dt = p_.dtS, g = p_.gravityMS2, A = p_.pipeAreaM2;
+  const float dt = p_.dtS, g = p_.gravityMS2;
+  // W1b: with diagonal pipes the areas follow the isotropic 9-point Laplacian (axis 2/3,
+  // diagonal sqrt(2)/6 of pipeAreaM2), which keeps the total conductance of the 4 pipes.
+  const float A = p_.diagonalPipes ? p_.pipeAreaM2 * (2.0f / 3.0f) : p_.pipeAreaM2;
+  const float Ad = p_.pipeAreaM2 * (1.41421356f / 6.0f);
   for (int y = 0; y < p_.height; ++y) {
     for (int x = 0; x < p_.width; ++x) {
       const size_t i = idx(x, y);
@@ -270,8 +285,25 @@ void CpuSimulation::pipeFluxPass() {
         f[d] = std::max(0.0f, flux_[4 * i + size_t(d)] + dt * A * g * dH / len);
         sum += f[d];
       }
+      // W1b: optional diagonal pipes to the four corner neighbours (closed at the edges).
+      float fd[4] = {0, 0, 0, 0};
+      if (p_.diagonalPipes) {
+        const float len = std::sqrt(dx(y) * dx(y) + p_.dyM * p_.dyM);
+        for (int k = 0; k < 4; ++k) {
+          const int nx = x + kDiagDx[k], ny = y + kDiagDy[k];
+          if (nx < 0 || ny < 0 || nx >= p_.width || ny >= p_.height) continue;
+          const size_t j = idx(nx, ny);
+          const float hj = state_[4 * j], bj = bed_[j];
+          float dH = (bi - bj) + (hi - hj);
+          const float noise = kHeadNoise * std::max(std::max(std::abs(bi), std::abs(bj)), std::max(hi, hj));
+          if (std::abs(dH) <= noise) dH = 0.0f;
+          fd[k] = std::max(0.0f, fluxDiag_[4 * i + size_t(k)] + dt * Ad * g * dH / len);
+          sum += fd[k];
+        }
+      }
       const float K = sum > 0.0f ? std::min(1.0f, hi * area(y) / (sum * dt)) : 0.0f;
       for (int d = 0; d < 4; ++d) flux_[4 * i + size_t(d)] = f[d] * K;
+      for (int k = 0; k < 4; ++k) fluxDiag_[4 * i + size_t(k)] = fd[k] * K;
     }
   }
 }
@@ -281,12 +313,20 @@ void CpuSimulation::pipeUpdatePass() {
   const float dt = p_.dtS, dry = p_.dryDepthM;
   const int w = p_.width, hgt = p_.height;
   auto fluxAt = [&](int x, int y, int d) { return flux_[4 * idx(x, y) + size_t(d)]; };
+  const bool diag = p_.diagonalPipes != 0;
+  auto outTotal = [&](size_t j) {
+    float out = flux_[4 * j] + flux_[4 * j + 1] + flux_[4 * j + 2] + flux_[4 * j + 3];
+    if (diag) out += fluxDiag_[4 * j] + fluxDiag_[4 * j + 1] + fluxDiag_[4 * j + 2] + fluxDiag_[4 * j + 3];
+    return out;
+  };
+  // Share of cell (x, y)'s water (and so of its suspended sediment) leaving through pipe d this
+  // step: d < 4 axis pipes, d >= 4 diagonal pipes (W1b).
   auto fraction = [&](int x, int y, int d) {
-    // Share of the cell's water (and so of its suspended sediment) leaving through d this step.
     const size_t j = idx(x, y);
-    const float out = (flux_[4 * j] + flux_[4 * j + 1] + flux_[4 * j + 2] + flux_[4 * j + 3]) * dt;
+    const float out = outTotal(j) * dt;
     const float den = std::max(state_[4 * j] * area(y), out);
-    return den > 0.0f ? flux_[4 * j + size_t(d)] * dt / den : 0.0f;
+    const float f = d < 4 ? flux_[4 * j + size_t(d)] : fluxDiag_[4 * j + size_t(d - 4)];
+    return den > 0.0f ? f * dt / den : 0.0f;
   };
   for (int y = 0; y < hgt; ++y) {
     for (int x = 0; x < w; ++x) {
@@ -308,13 +348,29 @@ void CpuSimulation::pipeUpdatePass() {
         sOut += fr;
       }
       const float* f = &flux_[4 * i];
-      const float out = f[0] + f[1] + f[2] + f[3];
+      float qxDiag = 0.0f, qyDiag = 0.0f;
+      if (diag) {
+        const float len = std::sqrt(dx(y) * dx(y) + p_.dyM * p_.dyM);
+        for (int k = 0; k < 4; ++k) {
+          const int nx = x + kDiagDx[k], ny = y + kDiagDy[k];
+          if (nx < 0 || ny < 0 || nx >= w || ny >= hgt) continue;
+          const float inK = fluxDiag_[4 * idx(nx, ny) + size_t(3 - k)];
+          in += inK;
+          sIn += state_[4 * idx(nx, ny) + 1] * area(ny) * fraction(nx, ny, 4 + (3 - k));
+          sOut += fraction(x, y, 4 + k);
+          // Net flow along the pipe's direction, projected on x and y.
+          const float net = fluxDiag_[4 * i + size_t(k)] - inK;
+          qxDiag += 0.5f * net * float(kDiagDx[k]) * dx(y) / len;
+          qyDiag += 0.5f * net * float(kDiagDy[k]) * p_.dyM / len;
+        }
+      }
+      const float out = outTotal(i);
       const float hNew = std::max(0.0f, h + dt * (in - out) / A);
       const float sNew = s - s * sOut + sIn / A;
       // W4: mean discharge through the cell over its cross-section.
       const float hMean = 0.5f * (h + hNew);
-      const float qx = 0.5f * (inD[0] - f[0] + f[1] - inD[1]);
-      const float qy = 0.5f * (inD[2] - f[2] + f[3] - inD[3]);
+      const float qx = 0.5f * (inD[0] - f[0] + f[1] - inD[1]) + qxDiag;
+      const float qy = 0.5f * (inD[2] - f[2] + f[3] - inD[3]) + qyDiag;
       float u = 0.0f, v = 0.0f;
       if (hMean > dry) {
         u = qx / (p_.dyM * hMean);

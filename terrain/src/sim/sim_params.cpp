@@ -18,14 +18,26 @@ SimMaterial toSimMaterial(const Material& m) {
 }
 
 double Source::rateAt(double tS) const {
-  if (hydrographM3S.empty()) return 0.0;
-  if (tS <= hydrographM3S.front().first) return hydrographM3S.front().second;
-  if (tS >= hydrographM3S.back().first) return hydrographM3S.back().second;
+  if (hydrographM3S.empty() || tS < hydrographM3S.front().first || tS > hydrographM3S.back().first) return 0.0;
+  if (hydrographM3S.size() == 1 || tS == hydrographM3S.back().first) return hydrographM3S.back().second;
   auto it = std::upper_bound(hydrographM3S.begin(), hydrographM3S.end(), tS,
                              [](double t, const std::pair<double, double>& p) { return t < p.first; });
   const auto& [t1, q1] = *it;
   const auto& [t0, q0] = *(it - 1);
   return q0 + (q1 - q0) * (tS - t0) / (t1 - t0);
+}
+
+double Source::volume(double t0S, double t1S) const {
+  double v = 0;
+  for (size_t i = 1; i < hydrographM3S.size(); ++i) {
+    const auto [ta, qa] = hydrographM3S[i - 1];
+    const auto [tb, qb] = hydrographM3S[i];
+    const double a = std::max(t0S, ta), b = std::min(t1S, tb);
+    if (b <= a) continue;
+    auto q = [&](double t) { return qa + (qb - qa) * (t - ta) / (tb - ta); };
+    v += 0.5 * (q(a) + q(b)) * (b - a);  // trapezoid: exact for a linear piece
+  }
+  return v;
 }
 
 namespace {
@@ -69,6 +81,10 @@ Status validate(const SimInput& input, const SimParams& params) {
     if (!(dx > 0)) return fail("sim input: rowDxM has a non-positive cell size " + std::to_string(dx));
   }
   if (!(input.dyM > 0)) return fail("sim input: dyM must be positive, got " + std::to_string(input.dyM));
+  return validateParams(params);
+}
+
+Status validateParams(const SimParams& params) {
   if (!(params.maxDtS > 0)) return fail("sim params: maxDtS must be positive");
   if (!(params.gravityMS2 > 0)) return fail("sim params: gravityMS2 must be positive");
   if (params.waterModel != int32_t(WaterModel::kVirtualPipes) &&
@@ -85,15 +101,26 @@ Status validate(const SimInput& input, const SimParams& params) {
   return {};
 }
 
+SimParams runtimeParams(const SimParams& current, const SimParams& next) {
+  SimParams p = next;
+  p.width = current.width;
+  p.height = current.height;
+  p.layerCount = current.layerCount;
+  p.waterModel = current.waterModel;
+  p.dyM = current.dyM;
+  p.dtS = current.dtS;
+  return p;
+}
+
 double rowDx(const SimInput& input, int row) {
   return input.rowDxM.size() == 1 ? input.rowDxM[0] : input.rowDxM[size_t(row)];
 }
 
-std::vector<SourceEntry> mergeSources(const std::vector<Source>& sources, int width, double tS) {
+std::vector<SourceEntry> mergeSources(const std::vector<Source>& sources, int width, double t0S, double t1S) {
   std::map<uint32_t, double> perCell;
   for (const auto& s : sources) {
-    if (s.cells.empty()) continue;
-    const double q = s.rateAt(tS) / double(s.cells.size());
+    if (s.cells.empty() || !(t1S > t0S)) continue;
+    const double q = s.volume(t0S, t1S) / (t1S - t0S) / double(s.cells.size());
     for (auto [x, y] : s.cells) perCell[uint32_t(y) * uint32_t(width) + uint32_t(x)] += q;
   }
   std::vector<SourceEntry> out;

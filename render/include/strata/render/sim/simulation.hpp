@@ -39,6 +39,9 @@ class Simulation {
 
   /// Adds an inflow source (spring, inflow line with a hydrograph); cells must be inside.
   Status addSource(const Source& source);
+  /// Changes the run-time parameters (rain, evaporation, friction, erosion constants, edges, time
+  /// step rule) from the next step on; grid size, layers and water model stay as created.
+  Status setParams(const SimParams& params);
   /// Takes `n` steps (each of terrain::sim::stepDt, W10).
   void step(int n = 1);
   /// Steps until `seconds` more have been simulated (the last step is shortened to land on it).
@@ -57,18 +60,17 @@ class Simulation {
   void enableFloodStats(float wetThresholdM);
   /// The statistics so far (all -1/0 grids if never enabled).
   FloodStats readFloodStats() const;
-  /// Changes the uniform rain rate (mm/h) from the next step on (rain starting or stopping).
-  void setRainMmPerHour(float mmPerHour);
 
   /// Everything a run needs to continue exactly where it was (a checkpoint).
   struct Counters {
     double timeS = 0, lastDtS = 0, rainM3 = 0, inflowM3 = 0, initialWaterM3 = 0, initialMaterialM3 = 0;
     long long steps = 0;
-    float rainMmPerHour = 0, dtS = 0;
+    float dtS = 0;
   };
   struct Snapshot;
   Snapshot snapshot() const;
-  /// Restores a snapshot of a simulation of the same grid and parameters.
+  /// Restores a snapshot of a simulation of the same grid and parameters (set the parameters in
+  /// force at that time, e.g. rain, with setParams).
   Status restore(const Snapshot& snapshot);
 
   /// Bytes of GPU buffers this simulation holds.
@@ -76,10 +78,11 @@ class Simulation {
 
   /// For tiled runs (TiledSimulation): the persistent per-cell state as stored on the GPU.
   struct RawState {
-    std::vector<float> state;   ///< 4 per cell: h, s, hu, hv
-    std::vector<float> flux;    ///< 4 per cell: pipe outflows W, E, N, S
-    std::vector<float> layers;  ///< layer-major: layers[l * cells + cell]
-    std::vector<float> accum;   ///< 8 per cell: (sum, error) of outflow, evaporation, sediment outflow
+    std::vector<float> state;     ///< 4 per cell: h, s, hu, hv
+    std::vector<float> flux;      ///< 4 per cell: pipe outflows W, E, N, S
+    std::vector<float> fluxDiag;  ///< diagonal pipes NW, NE, SW, SE: 4 per cell (4 floats in all without them)
+    std::vector<float> layers;    ///< layer-major: layers[l * cells + cell]
+    std::vector<float> accum;     ///< 8 per cell: (sum, error) of outflow, evaporation, sediment outflow
   };
   RawState readRaw() const;
   /// Replaces state, flux and layers (accum is kept) and recomputes the bed from them.

@@ -25,6 +25,9 @@ class CpuSimulation {
 
   /// Adds an inflow source (spring, inflow line with a hydrograph); cells must be inside.
   Status addSource(const Source& source);
+  /// Changes the run-time parameters (rain, evaporation, friction, erosion constants, edges, time
+  /// step rule) from the next step on; grid size, layers and water model stay as created.
+  Status setParams(const SimParams& params);
   /// Takes `n` steps (each of stepDt(), W10).
   void step(int n = 1);
   /// Steps until `seconds` more have been simulated (the last step is shortened to land on it).
@@ -74,6 +77,7 @@ class CpuSimulation {
   std::vector<float> state_, stateNext_;    // vec4 per cell: h, s, hu, hv
   std::vector<float> stage_;                // flood mode: the Heun predictor U1
   std::vector<float> flux_;                 // vec4 per cell: pipe outflows W, E, N, S (m^3/s)
+  std::vector<float> fluxDiag_;             // vec4 per cell: diagonal outflows NW, NE, SW, SE (m^3/s)
   std::vector<float> faceX_, faceY_;        // vec4 per face (flood mode)
   std::vector<float> tilt_;                 // sin(bed tilt)
   std::vector<float> accum_;                // 8 per cell: (sum, error) of water out, evaporated, sediment out (m^3)

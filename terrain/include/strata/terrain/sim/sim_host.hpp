@@ -16,8 +16,9 @@ struct SourceEntry {
 };
 static_assert(sizeof(SourceEntry) == 8);
 
-/// The sources' discharges at `tS`, merged per cell (each cell once, sorted by cell index).
-std::vector<SourceEntry> mergeSources(const std::vector<Source>& sources, int width, double tS);
+/// The sources' mean discharges over [t0S, t1S] (exact integrals of the hydrographs), merged
+/// per cell (each cell once, sorted by cell index).
+std::vector<SourceEntry> mergeSources(const std::vector<Source>& sources, int width, double t0S, double t1S);
 
 /// Step length (W10): maxDtS when cflAlpha <= 0 or the domain is still; otherwise
 /// alpha * minCellM / maxWaveSpeedMS, capped by maxDtS. `maxWaveSpeedMS` is max(|u| + sqrt(g h)).

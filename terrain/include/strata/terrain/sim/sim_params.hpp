@@ -35,10 +35,10 @@ struct SimParams {
   int32_t height = 0;      ///< cells in y (rows, row 0 north)
   int32_t layerCount = 0;  ///< material layers (set by create)
   int32_t waterModel = int32_t(WaterModel::kVirtualPipes);
-  uint32_t openEdges = 0;       ///< EdgeBits; 0 = closed box
-  uint32_t erosionEnabled = 0;  ///< 1: erosion, deposition, dissolution and transport (E1-E6)
-  uint32_t thermalEnabled = 0;  ///< 1: thermal weathering and bank slippage (E7-E8)
-  uint32_t pad0 = 0;
+  uint32_t openEdges = 0;             ///< EdgeBits; 0 = closed box
+  uint32_t erosionEnabled = 0;        ///< 1: erosion, deposition, dissolution and transport (E1-E6)
+  uint32_t thermalEnabled = 0;        ///< 1: thermal weathering and bank slippage (E7-E8)
+  uint32_t diagonalPipes = 0;         ///< 1: pipes model with 8 pipes (diagonals too), no axis-aligned gullies (W1b)
   float dyM = 1.0f;                   ///< cell size north-south (m); per-row dx is in SimInput::rowDxM
   float gravityMS2 = 9.81f;           ///< g (m/s^2)
   float dtS = 0.0f;                   ///< the current step (s); written by the solver each step
@@ -93,13 +93,16 @@ struct SimInput {
   double datumM = 0.0;         ///< elevations are stored relative to this (m)
 };
 
-/// A point or line of inflow: `rateM3S` over time, linearly interpolated between samples
-/// (constant outside them), split equally over `cells` (W12).
+/// A point or line of inflow: discharge over time, linearly interpolated between samples and
+/// zero outside their span (as terrain::Hydrograph in scenario files), split equally over
+/// `cells` (W12).
 struct Source {
   std::vector<std::pair<int, int>> cells;                ///< (x, y) cells it feeds
   std::vector<std::pair<double, double>> hydrographM3S;  ///< (time s, discharge m^3/s), time increasing
   /// Discharge at time `tS` (m^3/s).
   double rateAt(double tS) const;
+  /// Volume delivered between t0S and t1S (m^3): the exact integral of the piecewise-linear curve.
+  double volume(double t0S, double t1S) const;
 };
 
 /// Water and material bookkeeping since the start (volumes in m^3, summed in double).
@@ -127,6 +130,13 @@ struct SimStats {
 /// Checks `input` against `params` (sizes, per-row dx, materials, non-negative thicknesses);
 /// the message names the field and the problem.
 Status validate(const SimInput& input, const SimParams& params);
+
+/// Checks the parameters alone (ranges, model); validate() calls it.
+Status validateParams(const SimParams& params);
+
+/// `next` with the fields fixed at creation (grid size, layer count, water model, dyM) and the
+/// current step taken from `current`: what setParams() applies mid-run.
+SimParams runtimeParams(const SimParams& current, const SimParams& next);
 
 /// Cell-size helpers shared by both solvers: dx of `row`, and the minimum over rows.
 double rowDx(const SimInput& input, int row);
