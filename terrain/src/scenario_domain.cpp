@@ -292,8 +292,9 @@ Result<ScenarioDomain> buildDomain(const Scenario& s) {
     d.rainEndS = s.water.rain->endS < 0 ? s.durationS : s.water.rain->endS;
     if (!s.water.rain->raster.empty()) {
       if (s.water.rain->startS > 0 || s.water.rain->endS >= 0) {
-        return fail(s.file.string() + ": key 'water.rain.raster': a rain raster falls for the whole run; "
-                                      "start and end apply to a uniform rate only");
+        return fail(s.file.string() +
+                    ": key 'water.rain.raster': a rain raster falls for the whole run; "
+                    "start and end apply to a uniform rate only");
       }
       STRATA_TRY(auto r, gis::warpToGrid({s.water.rain->raster, std::nullopt}, g));
       d.input.rainMmPerHour = gis::Grid<float>(w, h, 0.0f);

@@ -369,9 +369,9 @@ size_t Simulation::gpuBytes() const {
   const Impl& s = *impl_;
   size_t total = 0;
   for (const gl::Buffer* b :
-       {&s.params, &s.materials, &s.rowDx, &s.base, &s.bed, &s.layers, &s.stateA, &s.stateB, &s.stage, &s.flux,
-        &s.fluxDiag, &s.faceX, &s.faceY, &s.tilt, &s.accum, &s.rain, &s.thermal, &s.sourceEntries, &s.maxSpeed,
-        &s.floodStats}) {
+       {&s.params, &s.materials, &s.rowDx,   &s.base,          &s.bed,      &s.layers,    &s.stateA,
+        &s.stateB, &s.stage,     &s.flux,    &s.fluxDiag,      &s.faceX,    &s.faceY,     &s.tilt,
+        &s.accum,  &s.rain,      &s.thermal, &s.sourceEntries, &s.maxSpeed, &s.floodStats}) {
     total += b->size();
   }
   return total;
@@ -436,8 +436,7 @@ FloodStats Simulation::readFloodStats() const {
 Simulation::Snapshot Simulation::snapshot() const {
   const Impl& s = *impl_;
   Snapshot snap;
-  snap.counters = {s.timeS,           s.lastDt, s.rainM3,          s.inflowM3, s.initialWater,
-                   s.initialMaterial, s.steps,  s.p.rainMmPerHour, s.p.dtS};
+  snap.counters = {s.timeS, s.lastDt, s.rainM3, s.inflowM3, s.initialWater, s.initialMaterial, s.steps, s.p.dtS};
   snap.raw = readRaw();
   snap.flood = readFloodStats();
   return snap;
