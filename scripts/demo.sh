@@ -1,7 +1,11 @@
 #!/usr/bin/env bash
-# Strata's main job. Sets itself up (packages, build) and runs the most complete real thing
-# the project can do today (see README "Quick start").
+# Strata's main job: the Grand Canyon flood what-if (scenarios/grand_canyon_flood.toml) on the
+# shipped data. Sets itself up (packages, build), runs the scenario on the GPU (llvmpipe where
+# there is none) and writes runs/grand_canyon_flood/ (report.md, maps/*.tif, plots/*.png,
+# series.csv). Extra arguments go to `strata flood` (e.g. --resume after a Ctrl-C).
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 "$root/scripts/setup.sh" >&2
-"$root/build/apps/strata" gpu-info
+cd "$root"
+build/apps/strata gpu-info | sed -n '1p;5p' >&2
+build/apps/strata flood scenarios/grand_canyon_flood.toml -o runs/grand_canyon_flood "$@"
