@@ -279,7 +279,7 @@ Status readRegion(const Reader& r, const toml::table& root, Scenario& s) {
 Status readModel(const Reader& r, const toml::table& root, Scenario& s) {
   const auto* t = root["model"].as_table();
   if (!t) return {};
-  STRATA_TRY_STATUS(r.onlyKeys(*t, "model", {"kind", "manning_n", "cfl", "boundary"}));
+  STRATA_TRY_STATUS(r.onlyKeys(*t, "model", {"kind", "manning_n", "cfl", "max_step", "boundary"}));
   if (const auto* k = t->get("kind")) {
     STRATA_TRY(auto v, r.string(*k, "model.kind"));
     if (v == "flood") {
@@ -302,6 +302,10 @@ Status readModel(const Reader& r, const toml::table& root, Scenario& s) {
     if (s.model.kind == WaterModel::Flood && s.model.cfl > 0.5) {
       return r.error(*c, "model.cfl", "flood mode needs cfl <= 0.5 (positivity of the finite-volume scheme)");
     }
+  }
+  if (const auto* m = t->get("max_step")) {
+    STRATA_TRY(s.model.maxStepS, r.quantity(*m, "model.max_step", "time"));
+    if (s.model.maxStepS <= 0) return r.error(*m, "model.max_step", "must be positive");
   }
   if (const auto* b = t->get("boundary")) {
     auto parse = [&](const toml::node& n, const std::string& key) -> Result<Boundary> {

@@ -243,9 +243,10 @@ Result<ScenarioDomain> buildDomain(const Scenario& s) {
   p.waterModel =
       int32_t(s.model.kind == WaterModel::Flood ? sim::WaterModel::kFiniteVolume : sim::WaterModel::kVirtualPipes);
   p.cflAlpha = float(s.model.cfl);
-  // The CFL step (W10) is computed before the sources pour in, so on a dry domain it would be
-  // unbounded: cap it. 10 s keeps a source's first steps small against the output interval.
-  p.maxDtS = 2.0f;
+  // The CFL step (W10) is computed before the step's sources pour in, and on steep dry slopes a
+  // long step lets a thin sheet overshoot (volume is then created where depths are clipped):
+  // capped, by default at 2 s (docs/scenario.md).
+  p.maxDtS = float(s.model.maxStepS);
   p.manningN = float(s.model.manningN);
   const uint32_t bits[4] = {sim::kEdgeWest, sim::kEdgeEast, sim::kEdgeSouth, sim::kEdgeNorth};
   p.openEdges = 0;
