@@ -39,7 +39,7 @@ std::string scenarioText() {
 terrain::Scenario writeScenario(const std::filesystem::path& dir) {
   const auto file = dir / "flood.toml";
   std::ofstream(file) << scenarioText();
-  auto s = terrain::loadScenario(file);
+  auto s = strata::terrain::loadScenario(file);
   EXPECT_TRUE(s) << s.message();
   return *s;
 }
@@ -86,7 +86,7 @@ TEST_F(GlTest, FloodScenarioWritesMapsSeriesAndReport) {
   ASSERT_EQ(summary->series.size(), 4u);
 
   // GeoTIFFs open in gdalinfo with the DEM's CRS (EPSG:4326) and the region's geotransform.
-  auto domain = terrain::buildDomain(scenario);
+  auto domain = strata::terrain::buildDomain(scenario);
   ASSERT_TRUE(domain) << domain.message();
   const auto& gt = domain->bed.georef.transform.c;
   for (const char* map : {"max_depth", "max_speed", "arrival_time", "inundation_duration", "final_depth"}) {

@@ -17,8 +17,8 @@
 namespace strata::render::sim {
 namespace {
 
-using terrain::sim::CpuSimulation;
-using terrain::sim::WaterModel;
+using strata::terrain::sim::CpuSimulation;
+using strata::terrain::sim::WaterModel;
 using test::GlTest;
 
 SimParams pipeParams() {
@@ -94,7 +94,7 @@ TEST_F(GlTest, SimRainAndSourcesBalance) {
   in.rainMmPerHour = gis::Grid<float>(32, 32, 30.0f);
   auto params = pipeParams();
   params.rainMmPerHour = 100.0f;
-  params.openEdges = terrain::sim::kEdgeSouth;
+  params.openEdges = strata::terrain::sim::kEdgeSouth;
   params.evaporationMmPerHour = 20.0f;
   auto sim = Simulation::create(in, params);
   ASSERT_TRUE(sim) << sim.message();
@@ -293,7 +293,7 @@ TEST_F(GlTest, SimTiledErosionEqualsUntiled) {
   const int n = 48;
   auto in = test::erodingValley(n);
   auto p = test::erosionParams();
-  p.openEdges = terrain::sim::kEdgeSouth;
+  p.openEdges = strata::terrain::sim::kEdgeSouth;
   auto spring = test::valleySpring(n);
   expectTiledEqualsUntiled(in, p, 40, &spring);
   p.diagonalPipes = 1;

@@ -172,9 +172,9 @@ std::string seriesCsv(const std::vector<SeriesRow>& rows) {
   return out;
 }
 
-Result<RunSummary> runScenario(const terrain::Scenario& s, const RunOptions& opt) {
+Result<RunSummary> runScenario(const strata::terrain::Scenario& s, const RunOptions& opt) {
   const auto wallStart = std::chrono::steady_clock::now();
-  STRATA_TRY(auto domain, terrain::buildDomain(s));
+  STRATA_TRY(auto domain, strata::terrain::buildDomain(s));
   const auto& g = domain.bed.georef;
   const int w = g.width, h = g.height;
   log::info("flood") << s.name << ": " << w << " x " << h << " cells, " << domain.totalAreaM2 / 1e6 << " km^2, "

@@ -120,15 +120,16 @@ Status writeReport(const fs::path& runDir, const ReportInput& in) {
   md += "| region | " + std::to_string(g.width) + " x " + std::to_string(g.height) + " cells of about " +
         fmt("%.0f", d.input.rowDxM[d.input.rowDxM.size() / 2]) + " x " + fmt("%.0f", d.input.dyM) + " m, " +
         fmt("%.0f", d.totalAreaM2 / 1e6) + " km², elevations " + fmt("%.0f", lo) + " to " + fmt("%.0f", hi) + " m |\n";
-  md += std::string("| model | ") +
-        (s.model.kind == terrain::WaterModel::Flood ? "flood mode (finite-volume shallow water, Manning friction)"
-                                                    : "virtual pipes") +
-        ", Manning n = " + fmt("%.3f", s.model.manningN) + " s/m^(1/3), CFL " + fmt("%.2f", s.model.cfl) + " |\n";
+  md +=
+      std::string("| model | ") +
+      (s.model.kind == strata::terrain::WaterModel::Flood ? "flood mode (finite-volume shallow water, Manning friction)"
+                                                          : "virtual pipes") +
+      ", Manning n = " + fmt("%.3f", s.model.manningN) + " s/m^(1/3), CFL " + fmt("%.2f", s.model.cfl) + " |\n";
   const char* edges[4] = {"west", "east", "south", "north"};
   std::string bounds;
   for (int e = 0; e < 4; ++e) {
     bounds += std::string(bounds.empty() ? "" : ", ") + edges[e] + " " +
-              (s.model.boundaries[size_t(e)] == terrain::Boundary::Open ? "open" : "closed");
+              (s.model.boundaries[size_t(e)] == strata::terrain::Boundary::Open ? "open" : "closed");
   }
   md += "| edges | " + bounds + " |\n";
   for (size_t i = 0; i < s.water.inflows.size(); ++i) {

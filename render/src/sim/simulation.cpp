@@ -17,7 +17,7 @@
 
 namespace strata::render::sim {
 
-namespace ts = terrain::sim;
+namespace ts = strata::terrain::sim;
 
 namespace {
 // Binding slots (shaders/common/sim.glsl and the kernels).

@@ -7,7 +7,7 @@
 
 namespace strata::render::sim {
 
-namespace ts = terrain::sim;
+namespace ts = strata::terrain::sim;
 
 namespace {
 gis::Grid<float> crop(const gis::Grid<float>& g, int x0, int y0, int x1, int y1) {

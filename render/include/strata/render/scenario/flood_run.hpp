@@ -43,7 +43,7 @@ struct RunSummary {
   std::vector<std::string> files;  ///< written, relative to the run folder
 };
 
-Result<RunSummary> runScenario(const terrain::Scenario& scenario, const RunOptions& options);
+Result<RunSummary> runScenario(const strata::terrain::Scenario& scenario, const RunOptions& options);
 
 /// The CSV text of a series (header + rows), as series.csv holds it.
 std::string seriesCsv(const std::vector<SeriesRow>& rows);

@@ -14,8 +14,8 @@
 namespace strata::render::scenario {
 
 struct ReportInput {
-  const terrain::Scenario& scenario;
-  const terrain::ScenarioDomain& domain;
+  const strata::terrain::Scenario& scenario;
+  const strata::terrain::ScenarioDomain& domain;
   const RunSummary& summary;
   sim::FloodStats flood;                   ///< per-cell maxima, arrival and duration at the end of the run
   std::string device;                      ///< the GL renderer the run used

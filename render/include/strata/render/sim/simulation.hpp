@@ -15,11 +15,11 @@
 
 namespace strata::render::sim {
 
-using terrain::sim::SimInput;
-using terrain::sim::SimParams;
-using terrain::sim::SimStats;
-using terrain::sim::Source;
-using terrain::sim::VelocityField;
+using strata::terrain::sim::SimInput;
+using strata::terrain::sim::SimParams;
+using strata::terrain::sim::SimStats;
+using strata::terrain::sim::Source;
+using strata::terrain::sim::VelocityField;
 
 /// Per-cell flood statistics since the start (enableFloodStats), updated after every step.
 struct FloodStats {
