@@ -95,7 +95,7 @@ void expectSimLayout(const std::string& name, const std::vector<Field>& cpp) {
   Field { #f, offsetof(T, f) }
 
 TEST(GpuLayouts, SimParamsMatchesGlsl) {
-  using terrain::sim::SimParams;
+  using strata::terrain::sim::SimParams;
   expectSimLayout<SimParams>("SimParams", {STRATA_FIELD(SimParams, width),
                                            STRATA_FIELD(SimParams, height),
                                            STRATA_FIELD(SimParams, layerCount),
@@ -127,8 +127,8 @@ TEST(GpuLayouts, SimParamsMatchesGlsl) {
 }
 
 TEST(GpuLayouts, SimMaterialAndSourceEntryMatchGlsl) {
-  using terrain::sim::SimMaterial;
-  using terrain::sim::SourceEntry;
+  using strata::terrain::sim::SimMaterial;
+  using strata::terrain::sim::SourceEntry;
   expectSimLayout<SimMaterial>("SimMaterial",
                                {STRATA_FIELD(SimMaterial, erodibility), STRATA_FIELD(SimMaterial, dissolutionRate),
                                 STRATA_FIELD(SimMaterial, tanTalus), STRATA_FIELD(SimMaterial, pad)});

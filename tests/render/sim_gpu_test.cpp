@@ -98,11 +98,11 @@ TEST_F(GlTest, SimRainAndSourcesBalance) {
   params.evaporationMmPerHour = 20.0f;
   auto sim = Simulation::create(in, params);
   ASSERT_TRUE(sim) << sim.message();
-  terrain::sim::Source spring;
+  strata::terrain::sim::Source spring;
   spring.cells = {{3, 3}, {4, 3}};
   spring.hydrographM3S = {{0.0, 1.0}, {50.0, 4.0}};
   ASSERT_TRUE(sim->addSource(spring));
-  EXPECT_FALSE(sim->addSource(terrain::sim::Source{{{-1, 0}}, {}}));
+  EXPECT_FALSE(sim->addSource(strata::terrain::sim::Source{{{-1, 0}}, {}}));
   sim->advance(100.0);
   // The rain stops and evaporation doubles half-way (what a scenario's rain end time does).
   auto later = sim->params();
@@ -132,8 +132,8 @@ TEST_F(GlTest, SimRainAndSourcesBalance) {
 // GPU and CPU run the same passes in float32; they differ only where the GPU compiler fuses a
 // multiply-add or orders a sum differently (~1 ulp per operation), which the dynamics then
 // amplify a little each step.
-void expectAgreement(const terrain::sim::SimInput& in, const SimParams& params, int steps, double depthTol,
-                     double layerTol, const terrain::sim::Source* source) {
+void expectAgreement(const strata::terrain::sim::SimInput& in, const SimParams& params, int steps, double depthTol,
+                     double layerTol, const strata::terrain::sim::Source* source) {
   auto gpu = Simulation::create(in, params);
   ASSERT_TRUE(gpu) << gpu.message();
   auto cpu = CpuSimulation::create(in, params);
@@ -168,9 +168,9 @@ TEST_F(GlTest, SimPipesAgreeWithCpuReference) {
   // to 1e-4 m (measured ~1e-6; rounding differences grow slowly in this undamped model).
   auto in = test::sloshingBox(32);
   auto p = pipeParams();
-  p.openEdges = terrain::sim::kEdgeEast;
+  p.openEdges = strata::terrain::sim::kEdgeEast;
   p.rainMmPerHour = 40.0f;
-  terrain::sim::Source spring{{{5, 5}}, {{0.0, 2.0}, {30.0, 0.5}}};
+  strata::terrain::sim::Source spring{{{5, 5}}, {{0.0, 2.0}, {30.0, 0.5}}};
   expectAgreement(in, p, 300, 1e-4, 1e-6, &spring);
   p.diagonalPipes = 1;
   expectAgreement(in, p, 300, 1e-4, 1e-6, &spring);
@@ -284,7 +284,7 @@ TEST_F(GlTest, SimTiledFloodEqualsUntiled) {
     }
   }
   auto p = floodParams();
-  p.openEdges = terrain::sim::kEdgeWest;
+  p.openEdges = strata::terrain::sim::kEdgeWest;
   p.manningN = 0.03f;
   expectTiledEqualsUntiled(in, p, 80, nullptr);
 }
