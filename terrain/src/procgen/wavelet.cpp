@@ -1,0 +1,227 @@
+// CPU reference of the CDF 5/3 lifting transform (docs/procgen.md, "Transform").
+#include <strata/terrain/procgen/wavelet.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+namespace strata::terrain::procgen {
+
+int PyramidShape::regionWidth(int l) const {
+  int w = width;
+  for (int i = 0; i < l; ++i) w = (w + 1) / 2;
+  return w;
+}
+
+int PyramidShape::regionHeight(int l) const {
+  int h = height;
+  for (int i = 0; i < l; ++i) h = (h + 1) / 2;
+  return h;
+}
+
+BandRect PyramidShape::band(int l, Band b) const {
+  STRATA_CHECK(l >= 0 && l <= levels) << "level " << l << " of " << levels;
+  const int w = regionWidth(l), h = regionHeight(l);
+  const int ws = (w + 1) / 2, hs = (h + 1) / 2;
+  switch (b) {
+    case Band::LL: STRATA_CHECK(l == levels) << "LL exists only at the coarsest level"; return {0, 0, w, h};
+    case Band::HL: return {ws, 0, w - ws, hs};
+    case Band::LH: return {0, hs, ws, h - hs};
+    case Band::HH: return {ws, hs, w - ws, h - hs};
+  }
+  return {};
+}
+
+int maxLevels(int width, int height) {
+  int levels = 0;
+  while (width >= 2 && height >= 2) {
+    ++levels;
+    width = (width + 1) / 2;
+    height = (height + 1) / 2;
+  }
+  return levels;
+}
+
+Status validateLevels(int width, int height, int levels) {
+  const int most = maxLevels(width, height);
+  if (levels < 1 || levels > most) {
+    return fail("wavelet: " + std::to_string(levels) + " levels asked for a " + std::to_string(width) + "x" +
+                std::to_string(height) + " grid (1.." + std::to_string(most) + " possible)");
+  }
+  return {};
+}
+
+void forward53(std::span<const float> x, std::span<float> out) {
+  const int n = int(x.size());
+  STRATA_CHECK(n >= 2 && out.size() == x.size()) << "forward53 of " << n << " samples";
+  const int ns = (n + 1) / 2, nd = n / 2;
+  auto xm = [&](int j) { return x[size_t(j >= n ? 2 * n - 2 - j : j)]; };
+  auto d = [&](int i) {
+    i = std::clamp(i, 0, nd - 1);
+    return xm(2 * i + 1) - 0.5f * (xm(2 * i) + xm(2 * i + 2));
+  };
+  for (int i = 0; i < nd; ++i) out[size_t(ns + i)] = d(i);
+  for (int i = 0; i < ns; ++i) out[size_t(i)] = xm(2 * i) + 0.25f * (d(i - 1) + d(i));
+}
+
+void inverse53(std::span<const float> c, std::span<float> x) {
+  const int n = int(c.size());
+  STRATA_CHECK(n >= 2 && x.size() == c.size()) << "inverse53 of " << n << " samples";
+  const int ns = (n + 1) / 2, nd = n / 2;
+  auto d = [&](int i) { return c[size_t(ns + std::clamp(i, 0, nd - 1))]; };
+  // Even samples first (they only need s and d), then odd ones from their even neighbours.
+  auto even = [&](int i) { return c[size_t(i)] - 0.25f * (d(i - 1) + d(i)); };
+  for (int i = 0; i < ns; ++i) x[size_t(2 * i)] = even(i);
+  for (int i = 0; i < nd; ++i) {
+    const int right = 2 * i + 2 < n ? i + 1 : i;  // x[n] mirrors to x[n-2]
+    x[size_t(2 * i + 1)] = d(i) + 0.5f * (even(i) + even(right));
+  }
+}
+
+namespace {
+
+// Applies a 1D transform to the rows (axis 0) or columns (axis 1) of the w x h top-left region.
+template <class F>
+void apply(Grid<float>& g, int w, int h, int axis, F&& f) {
+  const int n = axis == 0 ? w : h, count = axis == 0 ? h : w;
+  std::vector<float> in(static_cast<size_t>(n)), out(static_cast<size_t>(n));
+  for (int k = 0; k < count; ++k) {
+    for (int i = 0; i < n; ++i) in[size_t(i)] = axis == 0 ? g.at(i, k) : g.at(k, i);
+    f(std::span<const float>(in), std::span<float>(out));
+    for (int i = 0; i < n; ++i) (axis == 0 ? g.at(i, k) : g.at(k, i)) = out[size_t(i)];
+  }
+}
+
+}  // namespace
+
+Grid<float> forwardTransform(const Grid<float>& heights, int levels) {
+  STRATA_CHECK(validateLevels(heights.width, heights.height, levels).ok()) << "bad level count " << levels;
+  Grid<float> g = heights;
+  const PyramidShape shape{heights.width, heights.height, levels};
+  for (int l = 0; l < levels; ++l) {
+    const int w = shape.regionWidth(l), h = shape.regionHeight(l);
+    apply(g, w, h, 0, forward53);
+    apply(g, w, h, 1, forward53);
+  }
+  return g;
+}
+
+Grid<float> inverseTransform(const Grid<float>& coeffs, int levels) {
+  STRATA_CHECK(validateLevels(coeffs.width, coeffs.height, levels).ok()) << "bad level count " << levels;
+  Grid<float> g = coeffs;
+  const PyramidShape shape{coeffs.width, coeffs.height, levels};
+  for (int l = levels - 1; l >= 0; --l) {
+    const int w = shape.regionWidth(l), h = shape.regionHeight(l);
+    apply(g, w, h, 1, inverse53);
+    apply(g, w, h, 0, inverse53);
+  }
+  return g;
+}
+
+void matchHistogram(std::span<float> values, std::span<const float> reference) {
+  const size_t n = values.size(), m = reference.size();
+  STRATA_CHECK(m > 0 || n == 0) << "histogram matching against an empty reference";
+  if (n == 0) return;
+  std::vector<size_t> order(n);
+  std::iota(order.begin(), order.end(), size_t(0));
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return values[a] < values[b]; });
+  std::vector<float> ref(reference.begin(), reference.end());
+  std::sort(ref.begin(), ref.end());
+  for (size_t r = 0; r < n; ++r) {
+    float v;
+    if (n == m) {
+      v = ref[r];
+    } else {
+      const double q = n == 1 ? 0.5 * double(m - 1) : double(r) * double(m - 1) / double(n - 1);
+      const size_t i = std::min(size_t(q), m - 1), j = std::min(i + 1, m - 1);
+      v = float(double(ref[i]) + (q - double(i)) * (double(ref[j]) - double(ref[i])));
+    }
+    values[order[r]] = v;
+  }
+}
+
+std::vector<float> bandValues(const Grid<float>& coeffs, const BandRect& rect) {
+  std::vector<float> out;
+  out.reserve(size_t(std::max(0, rect.width * rect.height)));
+  for (int y = rect.y0; y < rect.y0 + rect.height; ++y) {
+    for (int x = rect.x0; x < rect.x0 + rect.width; ++x) out.push_back(coeffs.at(x, y));
+  }
+  return out;
+}
+
+void matchLevels(Grid<float>& coeffs, const Grid<float>& reference, int levels, bool includeCoarse) {
+  STRATA_CHECK(coeffs.width == reference.width && coeffs.height == reference.height)
+      << "pyramids of different sizes: " << coeffs.width << "x" << coeffs.height << " and " << reference.width << "x"
+      << reference.height;
+  const PyramidShape shape{coeffs.width, coeffs.height, levels};
+  auto matchRect = [&](const BandRect& rect) {
+    if (rect.empty()) return;
+    auto values = bandValues(coeffs, rect);
+    matchHistogram(values, bandValues(reference, rect));
+    size_t k = 0;
+    for (int y = rect.y0; y < rect.y0 + rect.height; ++y) {
+      for (int x = rect.x0; x < rect.x0 + rect.width; ++x) coeffs.at(x, y) = values[k++];
+    }
+  };
+  for (int l = 0; l < levels; ++l) {
+    for (Band b : {Band::HL, Band::LH, Band::HH}) matchRect(shape.band(l, b));
+  }
+  if (includeCoarse) matchRect(shape.band(levels, Band::LL));
+}
+
+double ksDistance(std::span<const float> a, std::span<const float> b) {
+  if (a.empty() || b.empty()) return a.empty() && b.empty() ? 0.0 : 1.0;
+  std::vector<float> x(a.begin(), a.end()), y(b.begin(), b.end());
+  std::sort(x.begin(), x.end());
+  std::sort(y.begin(), y.end());
+  size_t i = 0, j = 0;
+  double worst = 0;
+  while (i < x.size() && j < y.size()) {
+    const float v = std::min(x[i], y[j]);
+    while (i < x.size() && x[i] == v) ++i;
+    while (j < y.size() && y[j] == v) ++j;
+    worst = std::max(worst, std::abs(double(i) / double(x.size()) - double(j) / double(y.size())));
+  }
+  return worst;
+}
+
+Grid<float> resampleBilinear(const Grid<float>& src, int width, int height) {
+  STRATA_CHECK(src.width >= 1 && src.height >= 1 && width >= 1 && height >= 1)
+      << "resample to " << width << "x" << height;
+  Grid<float> out(width, height);
+  const double sx = width > 1 ? double(src.width - 1) / double(width - 1) : 0.0;
+  const double sy = height > 1 ? double(src.height - 1) / double(height - 1) : 0.0;
+  for (int y = 0; y < height; ++y) {
+    const double fy = y * sy;
+    const int y0 = std::min(int(fy), src.height - 1), y1 = std::min(y0 + 1, src.height - 1);
+    const double ty = fy - y0;
+    for (int x = 0; x < width; ++x) {
+      const double fx = x * sx;
+      const int x0 = std::min(int(fx), src.width - 1), x1 = std::min(x0 + 1, src.width - 1);
+      const double tx = fx - x0;
+      const double top = src.at(x0, y0) * (1 - tx) + src.at(x1, y0) * tx;
+      const double bottom = src.at(x0, y1) * (1 - tx) + src.at(x1, y1) * tx;
+      out.at(x, y) = float(top * (1 - ty) + bottom * ty);
+    }
+  }
+  return out;
+}
+
+Result<Grid<float>> fillNoData(Grid<float> grid, const std::string& what) {
+  double sum = 0;
+  size_t count = 0;
+  for (float v : grid.data) {
+    if (!gis::isNoData(v)) {
+      sum += v;
+      ++count;
+    }
+  }
+  if (count == 0) return fail(what + ": every cell is no data");
+  const float mean = float(sum / double(count));
+  for (float& v : grid.data) {
+    if (gis::isNoData(v)) v = mean;
+  }
+  return grid;
+}
+
+}  // namespace strata::terrain::procgen
