@@ -102,9 +102,10 @@ constexpr const char* kHeight =
     "  float dunes = wave(p, normalize(vec2(1.0, 0.3)), 24.0, 4.0, 0.0);\n"
     "  return hills + dunes + peak(p, 0.5 * SIZE, 0.12 * SIZE.x, 600.0);\n"
     "}\n";
-constexpr const char* kLike = "float level(vec2 p, int lvl) {\n"
-                              "  return lvl == LEVELS ? dem0Level(p, lvl) : whiteCoeff(p, lvl);\n"
-                              "}\n";
+constexpr const char* kLike =
+    "float level(vec2 p, int lvl) {\n"
+    "  return lvl == LEVELS ? dem0Level(p, lvl) : whiteCoeff(p, lvl);\n"
+    "}\n";
 void BM_GenerateFbmWavesMountain(benchmark::State& s) { BM_Generate(s, kHeight, false); }
 void BM_GenerateLikeDem(benchmark::State& s) { BM_Generate(s, kLike, true); }
 BENCHMARK(BM_GenerateFbmWavesMountain)->Arg(512)->Arg(1024)->Arg(2048)->Unit(benchmark::kMillisecond)->UseRealTime();
