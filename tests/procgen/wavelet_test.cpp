@@ -121,11 +121,13 @@ TEST(Resample, BilinearKeepsCornersAndPlanes) {
   EXPECT_FLOAT_EQ(r.at(0, 0), 0.0f);
   EXPECT_FLOAT_EQ(r.at(8, 6), 17.0f);
   EXPECT_FLOAT_EQ(r.at(4, 3), 8.5f);  // plane at (2, 1.5)
-  Grid<float> holes(2, 1);
-  holes.data = {gis::kNoData, 4.0f};
+  // A void takes the heights around it: a 3-cell hole in a row between 10 and 40 fills from
+  // both ends inwards (10, then the mean of its neighbours in the middle, 40).
+  Grid<float> holes(5, 1);
+  holes.data = {10.0f, gis::kNoData, gis::kNoData, gis::kNoData, 40.0f};
   auto filled = fillNoData(holes, "x");
   ASSERT_TRUE(filled);
-  EXPECT_EQ(filled->data[0], 4.0f);
+  EXPECT_EQ(filled->data, (std::vector<float>{10, 10, 25, 40, 40}));
   EXPECT_FALSE(fillNoData(Grid<float>(2, 2, gis::kNoData), "x").ok());
 }
 

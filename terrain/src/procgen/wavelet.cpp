@@ -208,18 +208,38 @@ Grid<float> resampleBilinear(const Grid<float>& src, int width, int height) {
 }
 
 Result<Grid<float>> fillNoData(Grid<float> grid, const std::string& what) {
-  double sum = 0;
-  size_t count = 0;
-  for (float v : grid.data) {
-    if (!gis::isNoData(v)) {
-      sum += v;
-      ++count;
-    }
+  // Grow inwards from the edges of each hole: every pass gives the no-data cells that touch
+  // valid ones (4-neighbours) the mean of those neighbours, so a void takes the heights around
+  // it (a summit void stays high) instead of a global value.
+  std::vector<size_t> holes;
+  for (size_t i = 0; i < grid.size(); ++i) {
+    if (gis::isNoData(grid.data[i])) holes.push_back(i);
   }
-  if (count == 0) return fail(what + ": every cell is no data");
-  const float mean = float(sum / double(count));
-  for (float& v : grid.data) {
-    if (gis::isNoData(v)) v = mean;
+  if (holes.size() == grid.size()) return fail(what + ": every cell is no data");
+  std::vector<std::pair<size_t, float>> filled;
+  while (!holes.empty()) {
+    filled.clear();
+    std::vector<size_t> still;
+    for (size_t i : holes) {
+      const int x = int(i % size_t(grid.width)), y = int(i / size_t(grid.width));
+      double sum = 0;
+      int count = 0;
+      for (auto [dx, dy] : {std::pair{1, 0}, std::pair{-1, 0}, std::pair{0, 1}, std::pair{0, -1}}) {
+        if (!grid.contains(x + dx, y + dy)) continue;
+        const float v = grid.at(x + dx, y + dy);
+        if (!gis::isNoData(v)) {
+          sum += v;
+          ++count;
+        }
+      }
+      if (count > 0) {
+        filled.emplace_back(i, float(sum / count));
+      } else {
+        still.push_back(i);
+      }
+    }
+    for (auto [i, v] : filled) grid.data[i] = v;
+    holes = std::move(still);
   }
   return grid;
 }

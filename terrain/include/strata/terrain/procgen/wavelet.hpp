@@ -72,7 +72,8 @@ double ksDistance(std::span<const float> a, std::span<const float> b);
 /// Bilinear resampling to w x h, corner-aligned (the corner cells map onto the corner cells).
 Grid<float> resampleBilinear(const Grid<float>& src, int width, int height);
 
-/// Replaces NaN (no data) by the mean of the valid cells; fails when no cell is valid.
+/// Fills NaN (no data) from the edges of each void inwards, each cell taking the mean of its
+/// valid 4-neighbours; fails when no cell is valid.
 Result<Grid<float>> fillNoData(Grid<float> grid, const std::string& what);
 
 }  // namespace strata::terrain::procgen
