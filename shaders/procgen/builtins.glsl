@@ -109,6 +109,17 @@ float fbm(vec2 p, int octaves, float gain, float lacunarity) {
   return sum;
 }
 
+// fBm with any per-octave amplitudes: sum over i < octaves (at most 16) of
+// amps[i] * noise(p * lacunarity^i), same octave salts as fbm() above.
+float fbmAmps(vec2 p, int octaves, float amps[16], float lacunarity) {
+  precise float sum = 0.0, freq = 1.0;
+  for (int i = 0; i < min(octaves, 16); ++i) {
+    sum += amps[i] * gradientNoise(p * freq, uint(i) * 0x9e3779b9u + 1u);
+    freq *= lacunarity;
+  }
+  return sum;
+}
+
 // A plane wave: amplitude * sin(2 pi (p . dir) / wavelength + phase), dir normalised by caller.
 float wave(vec2 p, vec2 dir, float wavelength, float amplitude, float phase) {
   return amplitude * dsin(2.0 * PI * dot(p, dir) / wavelength + phase);

@@ -240,6 +240,31 @@ TEST_F(GlTest, FbmPowerSpectrumFollowsItsAmplitudes) {
   }
 }
 
+TEST_F(GlTest, FbmWithExplicitAmplitudesEqualsTheGainForm) {
+  // B_i = 0.5^i written out is the gain form term by term (powers of two: exact products),
+  // so the two fields must agree to the bit; a third octave set to 0 must change the field.
+  const char* gain = "float height(vec2 p) { return 100.0 * fbm(p / 16.0, 5, 0.5, 2.0); }\n";
+  const char* amps =
+      "float height(vec2 p) {\n"
+      "  float b[16] = float[16](1.0, 0.5, 0.25, 0.125, 0.0625, 0., 0., 0., 0., 0., 0., 0., 0., 0., 0., 0.);\n"
+      "  return 100.0 * fbmAmps(p / 16.0, 5, b, 2.0);\n"
+      "}\n";
+  const char* holed =
+      "float height(vec2 p) {\n"
+      "  float b[16] = float[16](1.0, 0.5, 0.0, 0.125, 0.0625, 0., 0., 0., 0., 0., 0., 0., 0., 0., 0., 0.);\n"
+      "  return 100.0 * fbmAmps(p / 16.0, 5, b, 2.0);\n"
+      "}\n";
+  GenerateOptions o;
+  o.width = 64;
+  o.height = 48;
+  auto a = generate({"gain.glsl", gain, 1}, o);
+  auto b = generate({"amps.glsl", amps, 1}, o);
+  auto c = generate({"holed.glsl", holed, 1}, o);
+  ASSERT_TRUE(a && b && c) << (a ? b ? c.message() : b.message() : a.message());
+  EXPECT_EQ(std::memcmp(a->data.data(), b->data.data(), a->size() * sizeof(float)), 0);
+  EXPECT_GT(maxAbsDiff(*a, *c), 1.0f);
+}
+
 TEST_F(GlTest, SynthesisLikeDemMatchesEachLevelsHistogram) {
   const int n = 256, levels = 5;
   auto synth = runExample("dem_like.toml", n, n, 5);
