@@ -1,4 +1,4 @@
-// Procedural terrain: the CDF 5/3 transform on the GPU (timer queries) next to the CPU
+// Procedural terrain: the CDF 5/3 and 9/7 transforms on the GPU (timer queries) next to the CPU
 // reference, and whole generation runs (wall time: compile + fill + inverse + read back).
 //   build/bench/strata_bench_procgen [--benchmark_filter=...]
 // Figures: docs/benchmarks.md, "Procedural".
@@ -40,7 +40,7 @@ strata::gis::Grid<float> field(int n) {
   return g;
 }
 
-void BM_WaveletGpu(benchmark::State& state, bool inverse) {
+void BM_WaveletGpu(benchmark::State& state, bool inverse, strata::terrain::procgen::Wavelet kind) {
   ctx();
   const int n = int(state.range(0));
   auto wavelet = procgen::WaveletGpu::create();
@@ -49,30 +49,38 @@ void BM_WaveletGpu(benchmark::State& state, bool inverse) {
     return;
   }
   auto tex = procgen::uploadGrid(field(n));
-  wavelet->forward(tex, kLevels);  // warm-up (allocates the scratch texture)
+  wavelet->forward(tex, kLevels, kind);  // warm-up (allocates the scratch texture)
   for (auto _ : state) {
     gl::GpuTimer t;
     t.begin();
     if (inverse) {
-      wavelet->inverse(tex, kLevels);
+      wavelet->inverse(tex, kLevels, kind);
     } else {
-      wavelet->forward(tex, kLevels);
+      wavelet->forward(tex, kLevels, kind);
     }
     t.end();
     state.SetIterationTime(t.milliseconds() * 1e-3);
   }
 }
-void BM_WaveletForwardGpu(benchmark::State& s) { BM_WaveletGpu(s, false); }
-void BM_WaveletInverseGpu(benchmark::State& s) { BM_WaveletGpu(s, true); }
-BENCHMARK(BM_WaveletForwardGpu)->Arg(512)->Arg(1024)->Arg(2048)->UseManualTime()->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_WaveletInverseGpu)->Arg(512)->Arg(1024)->Arg(2048)->UseManualTime()->Unit(benchmark::kMillisecond);
+using strata::terrain::procgen::Wavelet;
+void BM_Cdf53ForwardGpu(benchmark::State& s) { BM_WaveletGpu(s, false, Wavelet::Cdf53); }
+void BM_Cdf53InverseGpu(benchmark::State& s) { BM_WaveletGpu(s, true, Wavelet::Cdf53); }
+void BM_Cdf97ForwardGpu(benchmark::State& s) { BM_WaveletGpu(s, false, Wavelet::Cdf97); }
+void BM_Cdf97InverseGpu(benchmark::State& s) { BM_WaveletGpu(s, true, Wavelet::Cdf97); }
+BENCHMARK(BM_Cdf53ForwardGpu)->Arg(512)->Arg(1024)->Arg(2048)->UseManualTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Cdf53InverseGpu)->Arg(512)->Arg(1024)->Arg(2048)->UseManualTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Cdf97ForwardGpu)->Arg(512)->Arg(1024)->Arg(2048)->UseManualTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Cdf97InverseGpu)->Arg(512)->Arg(1024)->Arg(2048)->UseManualTime()->Unit(benchmark::kMillisecond);
 
 // The CPU reference, single-threaded: the baseline of the GPU figures above.
-void BM_WaveletForwardCpu(benchmark::State& state) {
+void BM_WaveletForwardCpu(benchmark::State& state, Wavelet kind) {
   const auto g = field(int(state.range(0)));
-  for (auto _ : state) benchmark::DoNotOptimize(strata::terrain::procgen::forwardTransform(g, kLevels));
+  for (auto _ : state) benchmark::DoNotOptimize(strata::terrain::procgen::forwardTransform(g, kLevels, kind));
 }
-BENCHMARK(BM_WaveletForwardCpu)->Arg(512)->Arg(1024)->Arg(2048)->Unit(benchmark::kMillisecond);
+void BM_Cdf53ForwardCpu(benchmark::State& s) { BM_WaveletForwardCpu(s, Wavelet::Cdf53); }
+void BM_Cdf97ForwardCpu(benchmark::State& s) { BM_WaveletForwardCpu(s, Wavelet::Cdf97); }
+BENCHMARK(BM_Cdf53ForwardCpu)->Arg(512)->Arg(1024)->Arg(2048)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Cdf97ForwardCpu)->Arg(512)->Arg(1024)->Arg(2048)->Unit(benchmark::kMillisecond);
 
 // A whole run of seed example 1 (height form) and of a level-form script with histogram
 // matching against a DEM (the CPU sort per band included), wall time.

@@ -84,6 +84,7 @@ Status run(const std::string& scriptPath, const std::string& outDir, uint32_t se
   options.height = h;
   options.seed = seed;
   options.levels = levels > 0 ? levels : file.levels;
+  options.wavelet = file.wavelet;
   for (const auto& dem : file.demPaths) {
     STRATA_TRY(auto grid, readDemBand(dem));
     options.dems.push_back(std::move(grid));

@@ -124,6 +124,7 @@ TEST(ProcgenScript, ExamplesParseWithTheGlslLineNumbersOfTheFile) {
   ASSERT_TRUE(like);
   EXPECT_EQ(like->layers[0].matchDem, 0);
   EXPECT_EQ(like->levels, 5);
+  EXPECT_EQ(like->wavelet, terrain::procgen::Wavelet::Cdf53);  // the default
 }
 
 TEST(ProcgenScript, BadFilesNameTheFileAndTheField) {
@@ -142,6 +143,7 @@ TEST(ProcgenScript, BadFilesNameTheFileAndTheField) {
   check("[georef]\nepsg = 4326\norigin = [1.0]\ncell_size = 1.0\n[[layer]]\nname = \"a\"\nglsl = \"\"\n",
         "georef.origin");
   check("[[layer]]\nname = \"a\"\nglsl = \"\"\nmatch_dem = 0\n", "match_dem");
+  check("wavelet = \"haar\"\n[[layer]]\nname = \"a\"\nglsl = \"\"\n", "'wavelet'");
   check("levels = [\n", "bad.toml:");
   EXPECT_FALSE(loadScriptFile((dir / "missing.toml").string()));
 }

@@ -103,7 +103,7 @@ Result<gis::Grid<float>> generate(const UserScript& script, const GenerateOption
   for (int i = 0; i < needDems; ++i) {
     STRATA_TRY(auto filled, terrain::procgen::fillNoData(options.dems[size_t(i)], "dem" + std::to_string(i)));
     auto tex = uploadGrid(terrain::procgen::resampleBilinear(filled, w, h));
-    wavelet.forward(tex, levels);
+    wavelet.forward(tex, levels, options.wavelet);
     if (i == options.matchDem) demCoeffs.push_back(downloadGrid(tex));
     dems.push_back(std::move(tex));
   }
@@ -128,7 +128,7 @@ Result<gis::Grid<float>> generate(const UserScript& script, const GenerateOption
       terrain::procgen::matchLevels(coeffs, demCoeffs.front(), levels, options.matchCoarse);
       field.upload(coeffs.data.data());
     }
-    wavelet.inverse(field, levels);
+    wavelet.inverse(field, levels, options.wavelet);
   }
   return downloadGrid(field);
 }

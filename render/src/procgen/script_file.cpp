@@ -50,6 +50,16 @@ Result<ScriptFile> loadScriptFile(const std::string& path) {
     if (!v || *v < 1 || *v > 14) return fail(path + ": 'levels' must be an integer in 1..14");
     out.levels = int(*v);
   }
+  if (auto* node = root.get("wavelet")) {
+    const auto v = node->value<std::string>();
+    if (v == "cdf53") {
+      out.wavelet = terrain::procgen::Wavelet::Cdf53;
+    } else if (v == "cdf97") {
+      out.wavelet = terrain::procgen::Wavelet::Cdf97;
+    } else {
+      return fail(path + ": 'wavelet' must be \"cdf53\" or \"cdf97\"");
+    }
+  }
   if (auto* node = root.get("dems")) {
     auto* arr = node->as_array();
     if (!arr || arr->size() > 2) return fail(path + ": 'dems' must be an array of at most 2 file paths");

@@ -7,10 +7,16 @@
 namespace strata::render::procgen {
 
 Result<WaveletGpu> WaveletGpu::create() {
-  STRATA_TRY(auto program, gl::Program::compute("procgen/dwt53.comp"));
+  STRATA_TRY(auto cdf53, gl::Program::compute("procgen/dwt53.comp"));
+  STRATA_TRY(auto cdf97, gl::Program::compute("procgen/dwt97.comp"));
   WaveletGpu w;
-  w.program_ = std::move(program);
+  w.cdf53_ = std::move(cdf53);
+  w.cdf97_ = std::move(cdf97);
   return w;
+}
+
+const gl::Program& WaveletGpu::programFor(terrain::procgen::Wavelet wavelet) const {
+  return wavelet == terrain::procgen::Wavelet::Cdf97 ? cdf97_ : cdf53_;
 }
 
 gl::Texture& WaveletGpu::scratchFor(const gl::Texture& field) {
@@ -20,39 +26,40 @@ gl::Texture& WaveletGpu::scratchFor(const gl::Texture& field) {
   return scratch_;
 }
 
-void WaveletGpu::pass(gl::Texture& from, gl::Texture& to, glm::ivec2 region, int axis, bool inverse) {
+void WaveletGpu::pass(const gl::Program& program, gl::Texture& from, gl::Texture& to, glm::ivec2 region, int axis,
+                      bool inverse) {
   from.bindImage(0, GL_READ_ONLY);
   to.bindImage(1, GL_WRITE_ONLY);
-  program_.set("uRegion", region);
-  program_.set("uAxis", axis);
-  program_.set("uInverse", inverse ? 1 : 0);
-  program_.dispatchCovering(region.x, region.y);
+  program.set("uRegion", region);
+  program.set("uAxis", axis);
+  program.set("uInverse", inverse ? 1 : 0);
+  program.dispatchCovering(region.x, region.y);
   glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
 }
 
-void WaveletGpu::forward(gl::Texture& field, int levels) {
+void WaveletGpu::forward(gl::Texture& field, int levels, terrain::procgen::Wavelet wavelet) {
   STRATA_CHECK(terrain::procgen::validateLevels(field.width(), field.height(), levels).ok())
       << levels << " levels for " << field.width() << "x" << field.height();
   auto& scratch = scratchFor(field);
   const terrain::procgen::PyramidShape shape{field.width(), field.height(), levels};
-  program_.use();
+  const auto& program = programFor(wavelet);
   for (int l = 0; l < levels; ++l) {
     const glm::ivec2 region{shape.regionWidth(l), shape.regionHeight(l)};
-    pass(field, scratch, region, 0, false);
-    pass(scratch, field, region, 1, false);
+    pass(program, field, scratch, region, 0, false);
+    pass(program, scratch, field, region, 1, false);
   }
 }
 
-void WaveletGpu::inverse(gl::Texture& field, int levels) {
+void WaveletGpu::inverse(gl::Texture& field, int levels, terrain::procgen::Wavelet wavelet) {
   STRATA_CHECK(terrain::procgen::validateLevels(field.width(), field.height(), levels).ok())
       << levels << " levels for " << field.width() << "x" << field.height();
   auto& scratch = scratchFor(field);
   const terrain::procgen::PyramidShape shape{field.width(), field.height(), levels};
-  program_.use();
+  const auto& program = programFor(wavelet);
   for (int l = levels - 1; l >= 0; --l) {
     const glm::ivec2 region{shape.regionWidth(l), shape.regionHeight(l)};
-    pass(field, scratch, region, 1, true);
-    pass(scratch, field, region, 0, true);
+    pass(program, field, scratch, region, 1, true);
+    pass(program, scratch, field, region, 0, true);
   }
 }
 

@@ -80,6 +80,51 @@ void inverse53(std::span<const float> c, std::span<float> x) {
 
 namespace {
 
+// CDF 9/7 lifting constants (Daubechies & Sweldens 1998); the same decimal literals as
+// shaders/procgen/dwt97.comp, so both round them to the same floats.
+constexpr float kAlpha = -1.586134342059924f;
+constexpr float kBeta = -0.052980118572961f;
+constexpr float kGamma = 0.882911075530934f;
+constexpr float kDelta = 0.443506852043971f;
+constexpr float kK = 1.230174104914001f;
+constexpr float kInvK = 0.8128930661159609f;
+
+}  // namespace
+
+void forward97(std::span<const float> x, std::span<float> out) {
+  const int n = int(x.size());
+  STRATA_CHECK(n >= 2 && out.size() == x.size()) << "forward97 of " << n << " samples";
+  const int ns = (n + 1) / 2, nd = n / 2;
+  auto cs = [&](int k) { return size_t(std::clamp(k, 0, ns - 1)); };
+  auto cd = [&](int i) { return size_t(std::clamp(i, 0, nd - 1)); };
+  std::vector<float> s(static_cast<size_t>(ns)), d(static_cast<size_t>(nd));
+  for (int i = 0; i < nd; ++i) d[size_t(i)] = x[size_t(2 * i + 1)] + kAlpha * (x[2 * cs(i)] + x[2 * cs(i + 1)]);
+  for (int k = 0; k < ns; ++k) s[size_t(k)] = x[2 * size_t(k)] + kBeta * (d[cd(k - 1)] + d[cd(k)]);
+  for (int i = 0; i < nd; ++i) d[size_t(i)] = d[size_t(i)] + kGamma * (s[size_t(i)] + s[cs(i + 1)]);
+  for (int k = 0; k < ns; ++k) s[size_t(k)] = s[size_t(k)] + kDelta * (d[cd(k - 1)] + d[cd(k)]);
+  for (int k = 0; k < ns; ++k) out[size_t(k)] = s[size_t(k)] * kInvK;
+  for (int i = 0; i < nd; ++i) out[size_t(ns + i)] = d[size_t(i)] * kK;
+}
+
+void inverse97(std::span<const float> c, std::span<float> x) {
+  const int n = int(c.size());
+  STRATA_CHECK(n >= 2 && x.size() == c.size()) << "inverse97 of " << n << " samples";
+  const int ns = (n + 1) / 2, nd = n / 2;
+  auto cs = [&](int k) { return size_t(std::clamp(k, 0, ns - 1)); };
+  auto cd = [&](int i) { return size_t(std::clamp(i, 0, nd - 1)); };
+  std::vector<float> s(static_cast<size_t>(ns)), d(static_cast<size_t>(nd));
+  for (int k = 0; k < ns; ++k) s[size_t(k)] = c[size_t(k)] * kK;
+  for (int i = 0; i < nd; ++i) d[size_t(i)] = c[size_t(ns + i)] * kInvK;
+  for (int k = 0; k < ns; ++k) s[size_t(k)] = s[size_t(k)] - kDelta * (d[cd(k - 1)] + d[cd(k)]);
+  for (int i = 0; i < nd; ++i) d[size_t(i)] = d[size_t(i)] - kGamma * (s[size_t(i)] + s[cs(i + 1)]);
+  for (int k = 0; k < ns; ++k) x[2 * size_t(k)] = s[size_t(k)] - kBeta * (d[cd(k - 1)] + d[cd(k)]);
+  for (int i = 0; i < nd; ++i) {
+    x[size_t(2 * i + 1)] = d[size_t(i)] - kAlpha * (x[2 * cs(i)] + x[2 * cs(i + 1)]);
+  }
+}
+
+namespace {
+
 // Applies a 1D transform to the rows (axis 0) or columns (axis 1) of the w x h top-left region.
 template <class F>
 void apply(Grid<float>& g, int w, int h, int axis, F&& f) {
@@ -94,26 +139,28 @@ void apply(Grid<float>& g, int w, int h, int axis, F&& f) {
 
 }  // namespace
 
-Grid<float> forwardTransform(const Grid<float>& heights, int levels) {
+Grid<float> forwardTransform(const Grid<float>& heights, int levels, Wavelet wavelet) {
+  const auto f = wavelet == Wavelet::Cdf97 ? forward97 : forward53;
   STRATA_CHECK(validateLevels(heights.width, heights.height, levels).ok()) << "bad level count " << levels;
   Grid<float> g = heights;
   const PyramidShape shape{heights.width, heights.height, levels};
   for (int l = 0; l < levels; ++l) {
     const int w = shape.regionWidth(l), h = shape.regionHeight(l);
-    apply(g, w, h, 0, forward53);
-    apply(g, w, h, 1, forward53);
+    apply(g, w, h, 0, f);
+    apply(g, w, h, 1, f);
   }
   return g;
 }
 
-Grid<float> inverseTransform(const Grid<float>& coeffs, int levels) {
+Grid<float> inverseTransform(const Grid<float>& coeffs, int levels, Wavelet wavelet) {
+  const auto f = wavelet == Wavelet::Cdf97 ? inverse97 : inverse53;
   STRATA_CHECK(validateLevels(coeffs.width, coeffs.height, levels).ok()) << "bad level count " << levels;
   Grid<float> g = coeffs;
   const PyramidShape shape{coeffs.width, coeffs.height, levels};
   for (int l = levels - 1; l >= 0; --l) {
     const int w = shape.regionWidth(l), h = shape.regionHeight(l);
-    apply(g, w, h, 1, inverse53);
-    apply(g, w, h, 0, inverse53);
+    apply(g, w, h, 1, f);
+    apply(g, w, h, 0, f);
   }
   return g;
 }

@@ -10,6 +10,7 @@
 #include <strata/core/result.hpp>
 #include <strata/gis/raster.hpp>
 #include <strata/render/gl/shader_source.hpp>
+#include <strata/terrain/procgen/wavelet.hpp>
 
 namespace strata::render::procgen {
 
@@ -36,6 +37,8 @@ struct GenerateOptions {
   int width = 256, height = 256;  ///< output grid, cells
   uint32_t seed = 1;              ///< seeds every hash of the built-ins
   int levels = 6;                 ///< wavelet levels (clamped to what the size supports)
+  /// The pyramid's wavelet (level form; also the transform of the input DEMs).
+  terrain::procgen::Wavelet wavelet = terrain::procgen::Wavelet::Cdf53;
   /// Input DEMs (metres, NaN = no data) read by dem0Level/dem1Level; each is resampled
   /// (bilinear) to width x height and its no data filled with its mean before the transform.
   std::vector<gis::Grid<float>> dems;

@@ -32,6 +32,7 @@ struct ScriptFile {
   std::vector<LayerScript> layers;
   std::vector<std::string> demPaths;  ///< resolved against the script's folder
   int levels = 6;
+  terrain::procgen::Wavelet wavelet = terrain::procgen::Wavelet::Cdf53;  ///< `wavelet = "cdf53" | "cdf97"`
   std::optional<OutputGeoref> georef;
 };
 

@@ -1,5 +1,6 @@
 #pragma once
-// CPU reference of the CDF 5/3 (LeGall) biorthogonal wavelet transform by lifting, multi-level,
+// CPU reference of the CDF 5/3 (LeGall) and CDF 9/7 biorthogonal wavelet transforms by lifting,
+// multi-level,
 // separable (rows then columns), with whole-sample symmetric extension so any size >= 2 works,
 // and the coefficients in Mallat layout. The GPU transform (render/procgen) computes the same
 // formulas; docs/procgen.md has the maths. No GL here.
@@ -25,6 +26,10 @@ struct BandRect {
   bool empty() const { return width <= 0 || height <= 0; }
 };
 
+/// Which biorthogonal wavelet: CDF 5/3 (weights 1/2, 1/4: exact products, piecewise-linear
+/// synthesis) or CDF 9/7 (four lifting steps and a scaling: smoother synthesis).
+enum class Wavelet : int { Cdf53 = 0, Cdf97 = 1 };
+
 /// Sizes of the low-pass region at each level: sizes[0] = (w, h), sizes[l+1] = ceil(sizes[l] / 2).
 struct PyramidShape {
   int width = 0, height = 0, levels = 0;
@@ -48,11 +53,19 @@ void forward53(std::span<const float> x, std::span<float> out);
 /// Inverse of forward53 (same layout), exact up to float rounding.
 void inverse53(std::span<const float> coeffs, std::span<float> x);
 
+/// 1D forward CDF 9/7 lifting (same layout and extension as forward53), with
+///   d1 = x_odd + a (x_even + x_even'), s1 = x_even + b (d1' + d1), d2 = d1 + c (s1 + s1'),
+///   s2 = s1 + e (d2' + d2), s = s2 / K, d = d2 K   (a..e, K: Daubechies-Sweldens 1998),
+/// so that s has DC gain 1.
+void forward97(std::span<const float> x, std::span<float> out);
+/// Inverse of forward97, exact up to float rounding.
+void inverse97(std::span<const float> coeffs, std::span<float> x);
+
 /// Multi-level 2D forward transform (Mallat layout, same size as the input). levels must pass
 /// validateLevels.
-Grid<float> forwardTransform(const Grid<float>& heights, int levels);
+Grid<float> forwardTransform(const Grid<float>& heights, int levels, Wavelet wavelet = Wavelet::Cdf53);
 /// Inverse of forwardTransform.
-Grid<float> inverseTransform(const Grid<float>& coeffs, int levels);
+Grid<float> inverseTransform(const Grid<float>& coeffs, int levels, Wavelet wavelet = Wavelet::Cdf53);
 
 /// Replaces `values` by the values of `reference` at the same ranks (quantile mapping; the
 /// reference's empirical quantile function is interpolated linearly when the sizes differ), so
