@@ -103,7 +103,7 @@ TEST(ProcgenScript, ExamplesParseWithTheGlslLineNumbersOfTheFile) {
     ASSERT_FALSE(file->layers.empty());
     const auto lines = fileLines(path);
     for (const auto& layer : file->layers) {
-      EXPECT_EQ(layer.script.fileName, name);
+      EXPECT_EQ(layer.script.fileName, path);
       // The first GLSL line must be the file line firstLine.
       const std::string first = layer.script.glsl.substr(0, layer.script.glsl.find('\n'));
       ASSERT_GE(layer.script.firstLine, 1);

@@ -41,7 +41,6 @@ Result<ScriptFile> loadScriptFile(const std::string& path) {
   } catch (const toml::parse_error& e) {
     return fail(path + ":" + std::to_string(e.source().begin.line) + ": " + std::string(e.description()));
   }
-  const std::string name = std::filesystem::path(path).filename().string();
   const std::filesystem::path dir = std::filesystem::path(path).parent_path();
   ScriptFile out;
 
@@ -104,7 +103,7 @@ Result<ScriptFile> loadScriptFile(const std::string& path) {
     layer.name = *layerName;
     auto* glsl = (*t).get("glsl");
     if (!glsl || !glsl->is_string()) return fail(where + " ('" + layer.name + "'): 'glsl' must be a string");
-    layer.script.fileName = name;
+    layer.script.fileName = path;  // as the user gave it: compile errors say "path:line"
     layer.script.glsl = *glsl->value<std::string>();
     layer.script.firstLine = firstContentLine(lines, int(glsl->source().begin.line), int(glsl->source().begin.column));
     if (auto m = (*t)["match_dem"].value<int64_t>()) {
