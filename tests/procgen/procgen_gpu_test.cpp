@@ -174,6 +174,22 @@ TEST_F(GlTest, SyntaxErrorInUserScriptNamesTheUsersFileAndLine) {
   EXPECT_NE(r2.message().find("broken.toml:6"), std::string::npos) << r2.message();
 }
 
+TEST_F(GlTest, LevelFormRefusesMoreLevelsThanTheSizeAllows) {
+  // 20 x 12: regions 20x12, 10x6, 5x3, 3x2 -> 4 levels at most.
+  GenerateOptions o;
+  o.width = 20;
+  o.height = 12;
+  o.levels = 5;
+  const UserScript script{"deep.toml", "float level(vec2 p, int lvl) { return whiteCoeff(p, lvl); }\n", 3};
+  auto r = generate(script, o);
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.message().find("deep.toml"), std::string::npos) << r.message();
+  EXPECT_NE(r.message().find("1..4"), std::string::npos) << r.message();
+  o.levels = 4;
+  auto ok = generate(script, o);
+  EXPECT_TRUE(ok) << ok.message();
+}
+
 TEST_F(GlTest, SameSeedGivesTheSameBytes) {
   for (const char* name : {"fbm_waves_mountain.toml", "dem_coarse_fbm_detail.toml"}) {
     SCOPED_TRACE(name);

@@ -95,6 +95,12 @@ Result<gis::Grid<float>> generate(const UserScript& script, const GenerateOption
   STRATA_TRY(auto source, spliceScript(script, form));
   STRATA_TRY(auto program, gl::Program::link({{GL_COMPUTE_SHADER, source.text, source.files}}, script.fileName));
   STRATA_TRY(auto wavelet, WaveletGpu::create());
+  // The level form fills the pyramid the user asked for: too many levels is an error, not a
+  // silent clamp. The height form has no pyramid; its DEMs (if any) use what the size allows.
+  if (form == ScriptForm::Level) {
+    auto valid = terrain::procgen::validateLevels(w, h, options.levels);
+    if (!valid) return fail(script.fileName + ": " + valid.message());
+  }
   const int levels = effectiveLevels(w, h, options.levels);
 
   // Input DEMs: resampled to the output grid, then transformed with the same levels.

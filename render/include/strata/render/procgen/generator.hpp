@@ -36,7 +36,7 @@ Result<gl::ShaderSource> spliceScript(const UserScript& script, ScriptForm form)
 struct GenerateOptions {
   int width = 256, height = 256;  ///< output grid, cells
   uint32_t seed = 1;              ///< seeds every hash of the built-ins
-  int levels = 6;                 ///< wavelet levels (clamped to what the size supports)
+  int levels = 6;                 ///< wavelet levels; level form: must fit the size (maxLevels)
   /// The pyramid's wavelet (level form; also the transform of the input DEMs).
   terrain::procgen::Wavelet wavelet = terrain::procgen::Wavelet::Cdf53;
   /// Input DEMs (metres, NaN = no data) read by dem0Level/dem1Level; each is resampled
@@ -51,7 +51,8 @@ struct GenerateOptions {
 /// Runs a script on the current GL context and returns the height field (row 0 at the top).
 Result<gis::Grid<float>> generate(const UserScript& script, const GenerateOptions& options);
 
-/// Levels actually used for a w x h output when `requested` are asked for.
+/// Levels actually used for a w x h output when `requested` are asked for (clamped to
+/// 1..maxLevels; only the height form, which has no pyramid of its own, relies on the clamp).
 int effectiveLevels(int width, int height, int requested);
 
 }  // namespace strata::render::procgen
