@@ -9,6 +9,10 @@ layout(local_size_x = 16, local_size_y = 16) in;
 layout(r32f, binding = 1) uniform writeonly image2D uOut;
 
 //@strata-user-script
+#ifndef STRATA_USER_SCRIPT
+// The template compiled on its own (a check that compiles every embedded shader): a flat field.
+float height(vec2 p) { return 0.0; }
+#endif
 
 void main() {
   const ivec2 c = ivec2(gl_GlobalInvocationID.xy);

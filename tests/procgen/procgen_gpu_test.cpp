@@ -174,6 +174,15 @@ TEST_F(GlTest, SyntaxErrorInUserScriptNamesTheUsersFileAndLine) {
   EXPECT_NE(r2.message().find("broken.toml:6"), std::string::npos) << r2.message();
 }
 
+TEST_F(GlTest, TemplateAndTransformShadersCompileOnTheirOwn) {
+  // Every embedded shader must compile by itself (the generation template falls back to a
+  // flat height() when no script is spliced in).
+  for (const char* name : {"procgen/generate.comp", "procgen/dwt53.comp", "procgen/dwt97.comp"}) {
+    auto p = gl::Program::compute(name);
+    EXPECT_TRUE(p) << p.message();
+  }
+}
+
 TEST_F(GlTest, LevelFormRefusesMoreLevelsThanTheSizeAllows) {
   // 20 x 12: regions 20x12, 10x6, 5x3, 3x2 -> 4 levels at most.
   GenerateOptions o;

@@ -55,6 +55,7 @@ Result<gl::ShaderSource> spliceScript(const UserScript& script, ScriptForm form)
     }
     ++lineNo;
     if (!spliced && line.find(kMarker) != std::string::npos) {
+      out += "#define STRATA_USER_SCRIPT 1\n";
       if (form == ScriptForm::Level) out += "#define STRATA_FORM_LEVEL 1\n";
       out += "#line " + std::to_string(script.firstLine) + " " + std::to_string(userFile) + '\n';
       out += script.glsl;
