@@ -1,9 +1,6 @@
 // strata generate SCRIPT -o OUT: procedural terrain from a generation script (docs/procgen.md),
-// one float EXR per material layer. DEMs are read with GDAL here until gis::readDem is on main;
-// the outputs become GeoTIFFs once gis::writeGeoTiff is (EXR carries the georeference as
-// strata:* attributes meanwhile).
-#include <gdal_priv.h>
-
+// one file per material layer: a GeoTIFF (gis::writeGeoTiff) when the script gives a
+// georeference, else a float EXR (no CRS to write).
 #include <OpenImageIO/imageio.h>
 
 #include <cstdio>
@@ -12,6 +9,7 @@
 
 #include <strata/core/files.hpp>
 #include <strata/core/log.hpp>
+#include <strata/gis/dem_io.hpp>
 #include <strata/render/gl/context.hpp>
 #include <strata/render/procgen/generator.hpp>
 #include <strata/render/procgen/script_file.hpp>
@@ -21,32 +19,26 @@
 namespace strata::app {
 namespace {
 
-// Band 1 of a raster in metres (scale/offset applied), nodata as NaN.
-Result<gis::Grid<float>> readDemBand(const std::string& path) {
-  GDALAllRegister();
-  std::unique_ptr<GDALDataset> ds(static_cast<GDALDataset*>(GDALOpen(path.c_str(), GA_ReadOnly)));
-  if (!ds || ds->GetRasterCount() < 1) return fail(path + ": cannot open as a raster (GDAL)");
-  auto* band = ds->GetRasterBand(1);
-  gis::Grid<float> g(ds->GetRasterXSize(), ds->GetRasterYSize());
-  if (band->RasterIO(GF_Read, 0, 0, g.width, g.height, g.data.data(), g.width, g.height, GDT_Float32, 0, 0, nullptr) !=
-      CE_None) {
-    return fail(path + ": cannot read band 1");
-  }
-  int hasNoData = 0;
-  const double noData = band->GetNoDataValue(&hasNoData);
-  const double scale = band->GetScale(), offset = band->GetOffset();
-  for (float& v : g.data) {
-    if (hasNoData && double(v) == noData) {
-      v = gis::kNoData;
-    } else {
-      v = float(double(v) * scale + offset);
-    }
-  }
-  return g;
+// A georeferenced layer: float32 GeoTIFF, north-up, origin at the top-left corner.
+Status writeLayerGeoTiff(const std::filesystem::path& target, const gis::Grid<float>& heights,
+                         const render::procgen::OutputGeoref& georef) {
+  gis::Raster raster;
+  raster.georef.epsg = georef.epsg;
+  raster.georef.width = heights.width;
+  raster.georef.height = heights.height;
+  raster.georef.transform.c[0] = georef.originX;
+  raster.georef.transform.c[1] = georef.cellSize;
+  raster.georef.transform.c[2] = 0;
+  raster.georef.transform.c[3] = georef.originY;
+  raster.georef.transform.c[4] = 0;
+  raster.georef.transform.c[5] = -georef.cellSize;
+  raster.values = heights;
+  return gis::writeGeoTiff(target.string(), raster);
 }
 
-Status writeExr(const std::filesystem::path& target, const gis::Grid<float>& heights,
-                const std::optional<render::procgen::OutputGeoref>& georef, const std::string& script, uint32_t seed) {
+// A layer without georeference: a float EXR (seed and script as attributes).
+Status writeExr(const std::filesystem::path& target, const gis::Grid<float>& heights, const std::string& script,
+                uint32_t seed) {
   const auto temporary = temporaryPathFor(target);
   auto out = OIIO::ImageOutput::create("openexr");
   if (!out) return fail(target.string() + ": OpenImageIO has no EXR writer");
@@ -56,13 +48,6 @@ Status writeExr(const std::filesystem::path& target, const gis::Grid<float>& hei
   spec.attribute("strata:script", script);
   spec.attribute("strata:seed", int(seed));
   spec.attribute("strata:units", "m");
-  if (georef) {
-    spec.attribute("strata:epsg", georef->epsg);
-    // Doubles: a UTM northing needs more than a float's 24 bits.
-    spec.attribute("strata:originX", OIIO::TypeDesc::DOUBLE, &georef->originX);
-    spec.attribute("strata:originY", OIIO::TypeDesc::DOUBLE, &georef->originY);
-    spec.attribute("strata:cellSize", OIIO::TypeDesc::DOUBLE, &georef->cellSize);
-  }
   if (!out->open(temporary.string(), spec) || !out->write_image(OIIO::TypeDesc::FLOAT, heights.data.data()) ||
       !out->close()) {
     std::error_code ec;
@@ -86,8 +71,8 @@ Status run(const std::string& scriptPath, const std::string& outDir, uint32_t se
   options.levels = levels > 0 ? levels : file.levels;
   options.wavelet = file.wavelet;
   for (const auto& dem : file.demPaths) {
-    STRATA_TRY(auto grid, readDemBand(dem));
-    options.dems.push_back(std::move(grid));
+    STRATA_TRY(auto raster, gis::readDem(dem));
+    options.dems.push_back(std::move(raster.values));
   }
   std::error_code ec;
   std::filesystem::create_directories(outDir, ec);
@@ -97,8 +82,12 @@ Status run(const std::string& scriptPath, const std::string& outDir, uint32_t se
     options.matchDem = layer.matchDem;
     options.matchCoarse = layer.matchCoarse;
     STRATA_TRY(auto heights, render::procgen::generate(layer.script, options));
-    const auto target = std::filesystem::path(outDir) / (layer.name + ".exr");
-    STRATA_TRY_STATUS(writeExr(target, heights, file.georef, scriptPath, seed));
+    const auto target = std::filesystem::path(outDir) / (layer.name + (file.georef ? ".tif" : ".exr"));
+    if (file.georef) {
+      STRATA_TRY_STATUS(writeLayerGeoTiff(target, heights, *file.georef));
+    } else {
+      STRATA_TRY_STATUS(writeExr(target, heights, scriptPath, seed));
+    }
     float lo = heights.data.front(), hi = lo;
     for (float v : heights.data) {
       lo = std::min(lo, v);
@@ -112,7 +101,8 @@ Status run(const std::string& scriptPath, const std::string& outDir, uint32_t se
 }  // namespace
 
 void addGenerateCommand(CLI::App& app) {
-  auto* cmd = app.add_subcommand("generate", "Procedural terrain from a generation script: one EXR per layer");
+  auto* cmd =
+      app.add_subcommand("generate", "Procedural terrain from a generation script: one GeoTIFF (or EXR) per layer");
   struct Args {
     std::string script, out, size = "512x512";
     uint32_t seed = 1;
@@ -120,7 +110,8 @@ void addGenerateCommand(CLI::App& app) {
   };
   auto args = std::make_shared<Args>();
   cmd->add_option("SCRIPT", args->script, "Generation script (TOML, see docs/procgen.md)")->required();
-  cmd->add_option("-o,--out", args->out, "Output folder (one <layer>.exr per layer)")->required();
+  cmd->add_option("-o,--out", args->out, "Output folder: <layer>.tif per layer (<layer>.exr without a [georef])")
+      ->required();
   cmd->add_option("--seed", args->seed, "Seed of every noise built-in (same seed, same bytes)");
   cmd->add_option("--size", args->size, "Output grid WxH in cells");
   cmd->add_option("--levels", args->levels, "Wavelet levels (default: the script's, else 6)");

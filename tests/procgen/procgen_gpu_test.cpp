@@ -52,7 +52,7 @@ Result<Grid<float>> runExample(const std::string& name, int w, int h, uint32_t s
 
 // The DEM as generate() sees it: no data filled, resampled to w x h.
 Grid<float> preparedDem(const std::string& relative, int w, int h) {
-  auto filled = cpu::fillNoData(test::readDemForTest(test::procgenDataPath(relative)), relative);
+  auto filled = cpu::fillNoData(test::readDemForTest(test::dataPath(relative)), relative);
   STRATA_CHECK(filled.ok()) << filled.message();
   return cpu::resampleBilinear(*filled, w, h);
 }
@@ -83,7 +83,7 @@ double correlation(const std::vector<float>& a, const std::vector<float>& b) {
 }
 
 TEST_F(GlTest, GpuTransformEqualsCpuReferenceOnGrandCanyon) {
-  const auto dem = test::readDemForTest(test::procgenDataPath("grand_canyon/grand_canyon_512.tif"));
+  const auto dem = test::readDemForTest(test::dataPath("grand_canyon/grand_canyon_512.tif"));
   const int levels = cpu::maxLevels(dem.width, dem.height);
   auto wavelet = WaveletGpu::create();
   ASSERT_TRUE(wavelet) << wavelet.message();
@@ -104,7 +104,7 @@ TEST_F(GlTest, GpuTransformEqualsCpuReferenceOnGrandCanyon) {
 }
 
 TEST_F(GlTest, GpuCdf97EqualsCpuReferenceOnGrandCanyon) {
-  const auto dem = test::readDemForTest(test::procgenDataPath("grand_canyon/grand_canyon_512.tif"));
+  const auto dem = test::readDemForTest(test::dataPath("grand_canyon/grand_canyon_512.tif"));
   const int levels = cpu::maxLevels(dem.width, dem.height);
   auto wavelet = WaveletGpu::create();
   ASSERT_TRUE(wavelet) << wavelet.message();

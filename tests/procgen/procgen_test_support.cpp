@@ -1,36 +1,19 @@
 #include "procgen_test_support.hpp"
 
-#include <gdal_priv.h>
-
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
 #include <cmath>
 
 #include <strata/core/check.hpp>
+#include <strata/gis/dem_io.hpp>
 
 namespace strata::test {
 
-std::string procgenDataPath(const std::string& relative) { return std::string(STRATA_DATA_DIR) + "/" + relative; }
-
 gis::Grid<float> readDemForTest(const std::string& path) {
-  GDALAllRegister();
-  auto* ds = static_cast<GDALDataset*>(GDALOpen(path.c_str(), GA_ReadOnly));
-  STRATA_CHECK(ds != nullptr) << "cannot open " << path;
-  auto* band = ds->GetRasterBand(1);
-  gis::Grid<float> g(ds->GetRasterXSize(), ds->GetRasterYSize());
-  const CPLErr err =
-      band->RasterIO(GF_Read, 0, 0, g.width, g.height, g.data.data(), g.width, g.height, GDT_Float32, 0, 0, nullptr);
-  STRATA_CHECK(err == CE_None) << "cannot read " << path;
-  int hasNoData = 0;
-  const double noData = band->GetNoDataValue(&hasNoData);
-  if (hasNoData) {
-    for (float& v : g.data) {
-      if (double(v) == noData) v = gis::kNoData;
-    }
-  }
-  GDALClose(ds);
-  return g;
+  auto dem = gis::readDem(path);
+  STRATA_CHECK(dem.ok()) << dem.message();
+  return std::move(dem->values);
 }
 
 bool writeHillshadePng(const gis::Grid<float>& h, double cellSizeM, const std::filesystem::path& png) {

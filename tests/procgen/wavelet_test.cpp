@@ -72,7 +72,7 @@ TEST(Wavelet97, OneDimensionalRoundTripOfEveryLength) {
 }
 
 TEST(Wavelet97, GrandCanyonRoundTrip) {
-  const auto dem = test::readDemForTest(test::procgenDataPath("grand_canyon/grand_canyon_512.tif"));
+  const auto dem = test::readDemForTest(test::dataPath("grand_canyon/grand_canyon_512.tif"));
   const int levels = maxLevels(dem.width, dem.height);
   const auto back = inverseTransform(forwardTransform(dem, levels, Wavelet::Cdf97), levels, Wavelet::Cdf97);
   const float err = maxAbsDiff(back, dem);
@@ -112,7 +112,7 @@ TEST(Wavelet53, RoundTripOfOddSizedRandomGrid) {
 }
 
 TEST(Wavelet53, GrandCanyonRoundTripIsExactToFloatTolerance) {
-  const auto dem = test::readDemForTest(test::procgenDataPath("grand_canyon/grand_canyon_512.tif"));
+  const auto dem = test::readDemForTest(test::dataPath("grand_canyon/grand_canyon_512.tif"));
   ASSERT_EQ(dem.width, 512);
   const int levels = maxLevels(dem.width, dem.height);
   EXPECT_EQ(levels, 9);
