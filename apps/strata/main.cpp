@@ -7,6 +7,7 @@ int main(int argc, char** argv) {
   strata::app::addGpuInfoCommand(app);
   strata::app::addInfoCommand(app);
   strata::app::addFloodCommands(app);
+  strata::app::addGenerateCommand(app);
   CLI11_PARSE(app, argc, argv);
   return 0;
 }
