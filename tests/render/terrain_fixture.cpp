@@ -1,0 +1,132 @@
+#include "terrain_fixture.hpp"
+
+#include <gdal_priv.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+namespace strata::test {
+
+gis::Raster roughTerrain(int size, double cellM, double amplitudeM, uint32_t seed) {
+  gis::Raster r;
+  r.georef.geographic = false;
+  r.georef.crsName = "synthetic (projected metres)";
+  r.georef.width = r.georef.height = size;
+  r.georef.transform.c[0] = 500000.0;
+  r.georef.transform.c[1] = cellM;
+  r.georef.transform.c[3] = 4000000.0;
+  r.georef.transform.c[5] = -cellM;
+  r.values = gis::Grid<float>(size, size);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> uni(-1.0f, 1.0f);
+  double amp = amplitudeM;
+  for (int period = size / 2; period >= 2; period /= 2) {
+    const int lattice = size / period + 2;
+    std::vector<float> v(size_t(lattice * lattice));
+    for (auto& x : v) x = uni(rng);
+    for (int y = 0; y < size; ++y) {
+      for (int x = 0; x < size; ++x) {
+        const double fx = double(x) / period, fy = double(y) / period;
+        const int i = int(fx), j = int(fy);
+        double sx = fx - i, sy = fy - j;
+        sx = sx * sx * (3 - 2 * sx);
+        sy = sy * sy * (3 - 2 * sy);
+        auto at = [&](int a, int b) { return double(v[size_t(b * lattice + a)]); };
+        const double n = (1 - sy) * ((1 - sx) * at(i, j) + sx * at(i + 1, j)) +
+                         sy * ((1 - sx) * at(i, j + 1) + sx * at(i + 1, j + 1));
+        r.values.at(x, y) += float(amp * n);
+      }
+    }
+    amp *= 0.55;
+  }
+  for (auto& z : r.values.data) z += float(amplitudeM);
+  return r;
+}
+
+Result<gis::Raster> readDemForTest(const std::string& path, const gis::Body& body) {
+  GDALAllRegister();
+  std::unique_ptr<GDALDataset> ds(GDALDataset::Open(path.c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY));
+  if (!ds) return fail(path + ": GDAL cannot open it");
+  gis::Raster r;
+  auto& g = r.georef;
+  g.width = ds->GetRasterXSize();
+  g.height = ds->GetRasterYSize();
+  if (ds->GetGeoTransform(g.transform.c) != CE_None) return fail(path + ": no geotransform");
+  const OGRSpatialReference* srs = ds->GetSpatialRef();
+  g.geographic = srs && srs->IsGeographic();
+  g.body = body;
+  GDALRasterBand* band = ds->GetRasterBand(1);
+  r.values = gis::Grid<float>(g.width, g.height);
+  if (band->RasterIO(GF_Read, 0, 0, g.width, g.height, r.values.data.data(), g.width, g.height, GDT_Float32, 0, 0) !=
+      CE_None) {
+    return fail(path + ": band 1 read failed");
+  }
+  int hasNoData = 0, hasScale = 0, hasOffset = 0;
+  const double noData = band->GetNoDataValue(&hasNoData);
+  double scale = band->GetScale(&hasScale), offset = band->GetOffset(&hasOffset);
+  if (!hasScale) scale = 1;
+  if (!hasOffset) offset = 0;
+  for (float& v : r.values.data) {
+    if (hasNoData && double(v) == noData) {
+      v = gis::kNoData;
+    } else {
+      v = float(double(v) * scale + offset);
+    }
+  }
+  return r;
+}
+
+GoldenResult compareWithGolden(const std::string& name, const render::Image8& actual, int maxChannelDiff,
+                               double allowedFraction, const std::filesystem::path& outDir) {
+  GoldenResult res;
+  const std::string goldenPath = std::string(STRATA_SOURCE_DIR) + "/tests/render/golden/" + name + ".png";
+  const std::string actualPath = (outDir / (name + ".actual.png")).string();
+  const std::string diffPath = (outDir / (name + ".diff.png")).string();
+  const auto written = render::writeImage8(actualPath, actual.width, actual.height, actual.channels, actual.pixels);
+  const std::string writeNote = written ? "" : " (could not write the actual image: " + written.message() + ")";
+  auto golden = render::readImage8(goldenPath);
+  if (!golden) {
+    res.message = "no golden image " + goldenPath + " (" + golden.message() + "); actual written to " + actualPath +
+                  ": check it and run scripts/promote-golden.sh" + writeNote;
+    return res;
+  }
+  if (golden->width != actual.width || golden->height != actual.height || golden->channels != actual.channels) {
+    res.message = "golden " + goldenPath + " is " + std::to_string(golden->width) + "x" +
+                  std::to_string(golden->height) + "x" + std::to_string(golden->channels) + ", actual " +
+                  std::to_string(actual.width) + "x" + std::to_string(actual.height) + "x" +
+                  std::to_string(actual.channels);
+    return res;
+  }
+  const size_t pixels = size_t(actual.width) * size_t(actual.height);
+  const int ch = actual.channels;
+  std::vector<uint8_t> diff(pixels * 4, 0);
+  size_t differing = 0;
+  res.maxDiff = 0;
+  for (size_t p = 0; p < pixels; ++p) {
+    int d = 0;
+    for (int c = 0; c < ch; ++c) {
+      d = std::max(d, std::abs(int(actual.pixels[p * size_t(ch) + size_t(c)]) -
+                               int(golden->pixels[p * size_t(ch) + size_t(c)])));
+    }
+    res.maxDiff = std::max(res.maxDiff, d);
+    if (d > maxChannelDiff) ++differing;
+    const uint8_t v = uint8_t(std::min(255, d * 4));
+    diff[p * 4 + 0] = d > maxChannelDiff ? 255 : v;
+    diff[p * 4 + 1] = v;
+    diff[p * 4 + 2] = v;
+    diff[p * 4 + 3] = 255;
+  }
+  res.differingFraction = double(differing) / double(pixels);
+  res.ok = res.differingFraction <= allowedFraction;
+  if (!res.ok) {
+    const auto wroteDiff = render::writeImage8(diffPath, actual.width, actual.height, 4, diff);
+    res.message = name + ": " + std::to_string(res.differingFraction * 100) + "% of pixels differ by more than " +
+                  std::to_string(maxChannelDiff) + " (allowed " + std::to_string(allowedFraction * 100) +
+                  "%); actual " + actualPath + ", diff " + diffPath + writeNote +
+                  (wroteDiff ? "" : " (diff not written: " + wroteDiff.message() + ")");
+  }
+  return res;
+}
+
+}  // namespace strata::test

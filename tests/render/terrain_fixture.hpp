@@ -1,0 +1,36 @@
+#pragma once
+// Helpers for the terrain renderer tests: synthetic DEMs, a minimal GDAL DEM reader (a stand-in
+// until strata::gis::readDem lands on main; delete it then), and golden-image comparison.
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <strata/core/result.hpp>
+#include <strata/gis/raster.hpp>
+#include <strata/render/image_io.hpp>
+
+namespace strata::test {
+
+/// A rough fractal terrain (sum of value-noise octaves) on a projected grid of `size`^2 cells of
+/// `cellM` metres, origin at easting 500 km, northing 4000 km (realistic CRS magnitudes).
+gis::Raster roughTerrain(int size, double cellM, double amplitudeM, uint32_t seed);
+
+/// Reads band 1 of a DEM with GDAL (scale/offset applied, nodata -> NaN), georeferenced with
+/// `body`. Test-only stand-in for strata::gis::readDem.
+Result<gis::Raster> readDemForTest(const std::string& path, const gis::Body& body);
+
+/// Golden comparison: a pixel differs when any channel differs by more than `maxChannelDiff`;
+/// passes when at most `allowedFraction` of the pixels differ. On failure (or when the golden
+/// is missing) writes <name>.actual.png and <name>.diff.png to `outDir` and says so.
+struct GoldenResult {
+  bool ok = false;
+  double differingFraction = 1;
+  int maxDiff = 255;
+  std::string message;
+};
+GoldenResult compareWithGolden(const std::string& name, const render::Image8& actual, int maxChannelDiff,
+                               double allowedFraction, const std::filesystem::path& outDir);
+
+}  // namespace strata::test
