@@ -21,7 +21,8 @@ uniform int uHasSea;
 uniform float uWaterDepthScaleM; // depth at which water looks 1/e of the way to deep
 uniform float uLayerOpaqueM;     // thickness at which a layer hides 1/e of what is below
 uniform vec3 uLayerColour[4];
-uniform vec2 uElevRange;         // min, max elevation of the scene (m) for the tint
+uniform vec2 uElevRange;         // elevations (m) at the two ends of the tint
+uniform int uPalette;            // 0: hypsometric (Earth), 1: grey (airless bodies), 2: rust (Mars)
 uniform vec3 uSunDir;            // unit, towards the sun, in the viewer's ENU frame
 uniform vec3 uPole;              // planetary: unit vector to the north pole, viewer's ENU frame
 uniform vec4 uSky;               // haze colour
@@ -42,7 +43,7 @@ vec3 hypsometric(float t) {
 
 void main() {
   vec2 uv = fs.uv;
-  if (uv.y < 0.0 || uv.y > 1.0 || (uPlanetary == 0 && (uv.x < 0.0 || uv.x > 1.0))) discard;
+  if (uv.y < 0.0 || uv.y > 1.0 || (uWrapU == 0 && (uv.x < 0.0 || uv.x > 1.0))) discard;
 
   // Surface gradient (m/m, exaggerated) from central differences one texel of the vertex's
   // MIP level apart.
@@ -66,7 +67,10 @@ void main() {
   vec3 n = nLocal.x * east + nLocal.y * north + nLocal.z * up;
 
   float elev = fs.elev;
-  vec3 albedo = hypsometric((elev - uElevRange.x) / max(uElevRange.y - uElevRange.x, 1.0));
+  float t = clamp((elev - uElevRange.x) / max(uElevRange.y - uElevRange.x, 1.0), 0.0, 1.0);
+  vec3 albedo = uPalette == 1   ? mix(vec3(0.30), vec3(0.80), t)
+                : uPalette == 2 ? mix(vec3(0.42, 0.20, 0.10), vec3(0.85, 0.62, 0.42), t)
+                                : hypsometric(t);
   if (uHasLayers != 0) {
     vec4 thick = textureLod(uLayers, uv, lod);
     for (int k = 0; k < 4; ++k) albedo = mix(albedo, uLayerColour[k], 1.0 - exp(-max(thick[k], 0.0) / uLayerOpaqueM));

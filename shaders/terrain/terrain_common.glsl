@@ -9,31 +9,37 @@ uniform mat4 uViewProj;       // viewer-relative metres -> clip (reversed-Z)
 uniform int uPlanetary;       // 0: planar (a local tangent plane), 1: on a sphere of radius uRadius
 uniform float uExaggeration;  // vertical exaggeration of elevations
 uniform float uCamZ;          // planar: viewer z (m above the datum); planetary: viewer height above the sphere
-uniform vec2 uUvCam;          // planar: texture coordinates under the viewer
+uniform vec2 uUvCam;          // texture coordinates under the viewer
 uniform vec2 uUvPerMetre;     // planar: d(u, v) / d(east, north) (v grows southwards: y < 0)
 uniform vec2 uTexSize;        // texels of level 0
+uniform int uWrapU;           // 1: the DEM wraps around in longitude (global, planetary)
 uniform float uRadius;        // planetary: sphere radius (m)
-uniform vec2 uCamLonLat;      // planetary: viewer longitude, latitude (radians)
-uniform vec4 uGeoToUv;        // planetary: u = (lon - x) * y, v = (lat - z) * w (radians)
+uniform vec2 uCamLonLat;      // planetary: viewer longitude, latitude (radians; for sines and cosines only)
+uniform vec4 uGeoToUv;        // planetary: u = (lon - x) * y, v = (lat - z) * w (radians); x, z only for shading
 
-// Texture coordinates of a geographic point (radians).
-vec2 lonLatToUv(vec2 lonLat) { return vec2((lonLat.x - uGeoToUv.x) * uGeoToUv.y, (lonLat.y - uGeoToUv.z) * uGeoToUv.w); }
-
-// The point at great-circle angle `gamma` from the viewer's nadir, in direction `dir`
-// (unit east, north), as longitude and latitude (radians).
-vec2 lonLatAt(float gamma, vec2 dir) {
+// Longitude and latitude (radians) of the point at great-circle angle `gamma` from the viewer's
+// nadir in direction `dir` (unit east, north), RELATIVE to the nadir's: written so that no
+// absolute angle is rounded (at 10,000 km from the centre a float radian is 0.6 m), hence no
+// jitter when the viewer moves by less than that (docs/render-rings.md, "Precision").
+vec2 deltaLonLatAt(float gamma, vec2 dir) {
   float sl = sin(uCamLonLat.y), cl = cos(uCamLonLat.y);
-  float sg = sin(gamma), cg = cos(gamma);
-  float slat = clamp(sl * cg + cl * sg * dir.y, -1.0, 1.0);
-  float lon = uCamLonLat.x + atan(dir.x * sg * cl, cg - sl * slat);
-  return vec2(lon, asin(slat));
+  float s = sin(0.5 * gamma);
+  float e = sin(gamma) * dir.x, n = sin(gamma) * dir.y, u = 1.0 - 2.0 * s * s;
+  float x = u * cl - n * sl;                // towards the viewer's meridian in the equator plane
+  float rho = sqrt(x * x + e * e);          // cos(latitude)
+  float z = n * cl + u * sl;                // sin(latitude)
+  float sinD = n - sl * e * e / (rho + x);  // sin(lat - lat0) without cancellation
+  float cosD = rho * cl + z * sl;
+  return vec2(atan(e, x), atan(sinD, cosD));
 }
 
 // Texture coordinates of the terrain point at horizontal distance `dist` (planar: metres on
-// the plane; planetary: metres of arc) in direction `dir` from the viewer's nadir.
+// the plane; planetary: metres of arc) in direction `dir` from the viewer's nadir, relative
+// to the texture coordinates under the viewer (computed in double on the CPU).
 vec2 uvAt(float dist, vec2 dir) {
   if (uPlanetary == 0) return uUvCam + dir * dist * uUvPerMetre;
-  return lonLatToUv(lonLatAt(dist / uRadius, dir));
+  vec2 d = deltaLonLatAt(dist / uRadius, dir);
+  return uUvCam + vec2(d.x * uGeoToUv.y, d.y * uGeoToUv.w);
 }
 
 // The viewer-relative position of the terrain point at distance `dist` in direction `dir`

@@ -44,7 +44,7 @@ gis::Raster roughTerrain(int size, double cellM, double amplitudeM, uint32_t see
   return r;
 }
 
-Result<gis::Raster> readDemForTest(const std::string& path, const gis::Body& body) {
+Result<gis::Raster> readDemForTest(const std::string& path, const gis::Body& body, double subtractM) {
   GDALAllRegister();
   std::unique_ptr<GDALDataset> ds(GDALDataset::Open(path.c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY));
   if (!ds) return fail(path + ": GDAL cannot open it");
@@ -55,6 +55,13 @@ Result<gis::Raster> readDemForTest(const std::string& path, const gis::Body& bod
   if (ds->GetGeoTransform(g.transform.c) != CE_None) return fail(path + ": no geotransform");
   const OGRSpatialReference* srs = ds->GetSpatialRef();
   g.geographic = srs && srs->IsGeographic();
+  if (srs && srs->IsProjected() &&
+      std::string(srs->GetAttrValue("PROJECTION") ? srs->GetAttrValue("PROJECTION") : "") == "Equirectangular") {
+    const double mPerDeg = body.semiMajorM * 3.14159265358979323846 / 180;
+    for (int k : {0, 1, 3, 5}) g.transform.c[k] /= mPerDeg;
+    g.transform.c[0] += srs->GetNormProjParm(SRS_PP_CENTRAL_MERIDIAN, 0.0);
+    g.geographic = true;
+  }
   g.body = body;
   GDALRasterBand* band = ds->GetRasterBand(1);
   r.values = gis::Grid<float>(g.width, g.height);
@@ -71,7 +78,7 @@ Result<gis::Raster> readDemForTest(const std::string& path, const gis::Body& bod
     if (hasNoData && double(v) == noData) {
       v = gis::kNoData;
     } else {
-      v = float(double(v) * scale + offset);
+      v = float(double(v) * scale + offset - subtractM);
     }
   }
   return r;

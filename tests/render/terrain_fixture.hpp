@@ -18,8 +18,10 @@ namespace strata::test {
 gis::Raster roughTerrain(int size, double cellM, double amplitudeM, uint32_t seed);
 
 /// Reads band 1 of a DEM with GDAL (scale/offset applied, nodata -> NaN), georeferenced with
-/// `body`. Test-only stand-in for strata::gis::readDem.
-Result<gis::Raster> readDemForTest(const std::string& path, const gis::Body& body);
+/// `body`. Test-only stand-in for strata::gis::readDem. A PDS product in an equirectangular
+/// projection in metres on the body's sphere (the LOLA LDEM) is turned into lon/lat degrees,
+/// and `subtractM` (e.g. the reference radius the file adds as an offset) is taken off.
+Result<gis::Raster> readDemForTest(const std::string& path, const gis::Body& body, double subtractM = 0);
 
 /// Golden comparison: a pixel differs when any channel differs by more than `maxChannelDiff`;
 /// passes when at most `allowedFraction` of the pixels differ. On failure (or when the golden

@@ -43,6 +43,11 @@ class FrameState {
   GLint previous_ = 0;
 };
 
+bool isGlobalInLongitude(const gis::Georef& g) {
+  // Within a tenth of a pixel of 360 degrees (products converted from metres are not exact).
+  return g.geographic && std::abs(std::abs(g.transform.c[1]) * g.width - 360.0) < 0.1 * std::abs(g.transform.c[1]);
+}
+
 void setCommonUniforms(const gl::Program& p, const TerrainScene& scene, const FrameGeometry& frame,
                        const Shading& shading, const glm::dmat4& viewProj) {
   const auto& c = scene.georef().transform.c;
@@ -54,6 +59,7 @@ void setCommonUniforms(const gl::Program& p, const TerrainScene& scene, const Fr
   p.set("uUvCam", glm::vec2(frame.uvCam));
   p.set("uUvPerMetre", glm::vec2(frame.uvPerMetre));
   p.set("uTexSize", glm::vec2(float(w), float(h)));
+  p.set("uWrapU", scene.planetary() && isGlobalInLongitude(scene.georef()) ? 1 : 0);
   p.set("uRadius", float(scene.radiusM()));
   p.set("uCamLonLat", glm::vec2(float(frame.lonRad), float(frame.latRad)));
   p.set("uGeoToUv", glm::vec4(float(c[0] * kDeg), float(1.0 / (c[1] * w * kDeg)), float(c[3] * kDeg),
@@ -68,7 +74,10 @@ void setCommonUniforms(const gl::Program& p, const TerrainScene& scene, const Fr
     const std::string name = "uLayerColour[" + std::to_string(k) + "]";
     p.set(name.c_str(), shading.layerColours[size_t(k)]);
   }
-  p.set("uElevRange", glm::vec2(scene.minElevationM(), scene.maxElevationM()));
+  glm::vec2 tint(scene.minElevationM(), scene.maxElevationM());
+  if (shading.seaLevelM) tint.x = std::max(tint.x, *shading.seaLevelM);
+  p.set("uElevRange", shading.tintRangeM.value_or(tint));
+  p.set("uPalette", int(shading.palette));
   p.set("uSunDir", glm::normalize(shading.sunDir));
   p.set("uPole", glm::vec3(0.0f, float(std::cos(frame.latRad)), float(std::sin(frame.latRad))));
   p.set("uSky", shading.sky);
@@ -76,10 +85,6 @@ void setCommonUniforms(const gl::Program& p, const TerrainScene& scene, const Fr
   scene.heightTexture().bind(0);
   if (scene.waterTexture()) scene.waterTexture()->bind(1);
   if (scene.layerTexture()) scene.layerTexture()->bind(2);
-}
-
-bool isGlobalInLongitude(const gis::Georef& g) {
-  return g.geographic && std::abs(std::abs(g.transform.c[1]) * g.width - 360.0) < 1e-6;
 }
 
 }  // namespace
@@ -204,6 +209,7 @@ FrameGeometry frameGeometry(const TerrainScene& scene, const CameraPose& camera,
     f.uvPerMetre = {1.0 / (c[1] * w), 1.0 / (c[5] * h)};
   }
   f.uvCam = {(camera.lon - c[0]) / c[1] / w, (camera.lat - c[3]) / c[5] / h};
+  if (scene.planetary() && isGlobalInLongitude(g)) f.uvCam.x -= std::floor(f.uvCam.x);
   f.groundM = shading.exaggeration * scene.heightAt(camera.lon, camera.lat);
   f.camZ = camera.heightM;
   f.heightAboveGroundM = std::max(camera.heightM - f.groundM, 0.0);

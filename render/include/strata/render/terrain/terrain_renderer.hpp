@@ -31,9 +31,15 @@ struct CameraPose {
   double fovYDeg = 45;    ///< vertical field of view (deg)
 };
 
+/// Colour ramp over elevation.
+enum class Palette { Hypsometric, Grey, Rust };
+
 /// How the terrain looks; uniform over a frame.
 struct Shading {
-  float exaggeration = 1;                                           ///< vertical exaggeration
+  Palette palette = Palette::Hypsometric;  ///< elevation tint
+  std::optional<glm::vec2> tintRangeM;     ///< elevations at the tint's ends (m); default: the scene's
+                                           ///< range, from sea level up when seaLevelM is set
+  float exaggeration = 1;                  ///< vertical exaggeration
   glm::vec3 sunDir = glm::normalize(glm::vec3(-0.5f, 0.4f, 0.6f));  ///< towards the sun, viewer's ENU frame
   glm::vec4 sky{0.62f, 0.74f, 0.88f, 1.0f};                         ///< background and haze colour
   float fogM = 0;                                                   ///< haze distance (m); 0: none
