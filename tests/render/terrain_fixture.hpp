@@ -13,10 +13,6 @@
 
 namespace strata::test {
 
-/// A rough fractal terrain (sum of value-noise octaves) on a projected grid of `size`^2 cells of
-/// `cellM` metres, origin at easting 500 km, northing 4000 km (realistic CRS magnitudes).
-gis::Raster roughTerrain(int size, double cellM, double amplitudeM, uint32_t seed);
-
 /// Reads band 1 of a DEM with GDAL (scale/offset applied, nodata -> NaN), georeferenced with
 /// `body`. Test-only stand-in for strata::gis::readDem. A PDS product in an equirectangular
 /// projection in metres on the body's sphere (the LOLA LDEM) is turned into lon/lat degrees,

@@ -8,6 +8,7 @@
 #include <numeric>
 
 #include <strata/render/image_io.hpp>
+#include <strata/render/terrain/synthetic_dem.hpp>
 #include <strata/render/terrain/terrain_renderer.hpp>
 
 #include "gl_fixture.hpp"
@@ -67,7 +68,7 @@ TEST_F(GlTest, RingRenderHasNoCrackOverMagenta) {
   // every pixel whose ray must meet the terrain inside the ring's disc is terrain-coloured.
   const int size = 256;
   const double cellM = 30;
-  auto scene = TerrainScene::create(test::roughTerrain(size, cellM, 250, 11));
+  auto scene = TerrainScene::create(syntheticDem(size, cellM, 250, 11));
   ASSERT_TRUE(scene) << scene.message();
   const double rangeM = 3600;  // the disc stays inside the 7.68 km DEM from its centre
   auto ring = RingRenderer::create({.circles = 64, .rangeM = rangeM});
@@ -341,7 +342,7 @@ TEST_F(GlTest, NoJitterTenThousandKilometresFromTheCentre) {
   // frame. Every step must change the image by about the same amount: rounding of absolute
   // coordinates (a float radian is 0.6 m here) would freeze some steps and jump others.
   const double radius = 9999950.0;
-  auto dem = test::roughTerrain(256, 1.0, 3.0, 5);
+  auto dem = syntheticDem(256, 1.0, 3.0, 5);
   dem.georef.geographic = true;
   dem.georef.body = gis::Body::fromEllipsoid(radius, 0.0, "test sphere");
   dem.georef.transform.c[0] = 100.3 - 128e-5;
@@ -390,6 +391,50 @@ TEST_F(GlTest, NoJitterTenThousandKilometresFromTheCentre) {
     EXPECT_GT(s, median / 1.5);
     EXPECT_LT(s, median * 1.5);
   }
+}
+
+TEST_F(GlTest, WaterAndMaterialLayersShowWhereTheyAre) {
+  // A gentle 128^2 terrain seen from straight above: 5 m of water over the western half, 3 m of
+  // sand over the eastern half. Water pixels are blue-green (blue 40/255 over red); sand
+  // pixels take the sand's hue (red > green > blue by 20/255), which the green-brown tint of
+  // this low terrain does not have.
+  const int n = 128;
+  auto dem = syntheticDem(n, 10, 5, 3);
+  auto scene = TerrainScene::create(dem);
+  ASSERT_TRUE(scene) << scene.message();
+  gis::Grid<float> water(n, n, 0.0f), sand(n, n, 0.0f);
+  for (int y = 0; y < n; ++y) {
+    for (int x = 0; x < n; ++x) (x < n / 2 ? water : sand).at(x, y) = x < n / 2 ? 5.0f : 3.0f;
+  }
+  ASSERT_TRUE(scene->setWaterDepth(water));
+  ASSERT_TRUE(scene->setMaterialLayers({sand}));
+  EXPECT_FALSE(scene->setWaterDepth(gis::Grid<float>(n - 1, n)));
+  EXPECT_FALSE(scene->setMaterialLayers({}));
+  auto ring = RingRenderer::create({.circles = 48});
+  ASSERT_TRUE(ring) << ring.message();
+  const int w = 64, h = 64;
+  auto target = OffscreenTarget::create(w, h);
+  ASSERT_TRUE(target) << target.message();
+  const double c = 500000 + n * 10 / 2.0, cy = 4000000 - n * 10 / 2.0;
+  // 1.2 km up with a 45 degree view: the image spans ~1 km, inside the 1.28 km DEM.
+  const CameraPose cam{.lon = c, .lat = cy, .heightM = 1200, .headingDeg = 0, .pitchDeg = -90};
+  Shading shading;
+  shading.sunDir = {0, 0, 1};
+  ASSERT_TRUE((*ring)->draw(*scene, cam, shading, *target));
+  const auto px = target->colour();
+  int blue = 0, sandy = 0, total = 0;
+  for (int y = 8; y < h - 8; ++y) {
+    for (int x = 4; x < w - 4; ++x) {
+      if (std::abs(x - w / 2) < 4) continue;  // the shore
+      const uint8_t* p = &px[(size_t(y) * size_t(w) + size_t(x)) * 4];
+      ++total;
+      if (x < w / 2) blue += p[2] > p[0] + 40;
+      if (x > w / 2) sandy += p[0] > p[1] && p[1] > p[2] + 20;
+    }
+  }
+  EXPECT_EQ(blue + sandy, total) << blue << " blue and " << sandy << " sand pixels of " << total;
+  auto img = colourImage(*target);
+  ASSERT_TRUE(writeImage8((test::outputDir("render") / "water_layers.png").string(), w, h, 4, img.pixels));
 }
 
 }  // namespace
