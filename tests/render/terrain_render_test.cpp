@@ -8,6 +8,7 @@
 #include <numeric>
 
 #include <strata/render/image_io.hpp>
+#include <strata/render/terrain/screen_error.hpp>
 #include <strata/render/terrain/synthetic_dem.hpp>
 #include <strata/render/terrain/terrain_renderer.hpp>
 
@@ -23,26 +24,6 @@ using test::GlTest;
 Image8 colourImage(const OffscreenTarget& t) { return {t.width(), t.height(), 4, t.colour()}; }
 
 constexpr double kPi = 3.14159265358979323846;
-
-// Viewer-relative ENU direction of the ray through the centre of pixel (x, y) (row 0 on top).
-glm::dvec3 pixelRay(const FrameGeometry& f, const CameraPose& cam, int x, int y, int w, int h) {
-  const double t = std::tan(0.5 * cam.fovYDeg * kPi / 180), aspect = double(w) / h;
-  const glm::dvec3 eye((2 * (x + 0.5) / w - 1) * t * aspect, (1 - 2 * (y + 0.5) / h) * t, -1);
-  return glm::normalize(glm::dvec3(glm::transpose(glm::dmat3(f.view)) * eye));
-}
-
-// Viewer-relative position of the surface seen at pixel (x, y) from its reversed-Z depth.
-glm::dvec3 unproject(const FrameGeometry& f, const CameraPose& cam, int x, int y, int w, int h, float depth) {
-  const glm::dvec3 ray = pixelRay(f, cam, x, y, w, h);
-  const glm::dvec3 axis = glm::transpose(glm::dmat3(f.view)) * glm::dvec3(0, 0, -1);
-  const double along = f.nearM / double(depth);  // distance along the view axis
-  return ray * (along / glm::dot(ray, axis));
-}
-
-glm::dvec2 toPixel(const glm::dmat4& viewProj, const glm::dvec3& p, int w, int h) {
-  const glm::dvec4 c = viewProj * glm::dvec4(p, 1.0);
-  return {(c.x / c.w * 0.5 + 0.5) * w, (0.5 - c.y / c.w * 0.5) * h};
-}
 
 double percentile(std::vector<double> v, double q) {
   if (v.empty()) return 0;
@@ -128,40 +109,6 @@ TEST_F(GlTest, GrandCanyonMatchesGoldenImage) {
   EXPECT_TRUE(r.ok) << r.message;
 }
 
-struct ErrorStats {
-  double meanPx = 0, p99Px = 0, maxPx = 0;
-  size_t pixels = 0;
-};
-
-// Screen-space error of a render against the full-resolution reference surface: for each
-// terrain pixel, the surface point drawn there and the reference surface's point at the same
-// horizontal position, both projected; their distance in pixels.
-ErrorStats screenSpaceError(const TerrainScene& scene, const CameraPose& cam, const Shading& shading,
-                            const OffscreenTarget& target) {
-  const int w = target.width(), h = target.height();
-  const auto f = frameGeometry(scene, cam, shading, w, h);
-  const auto depth = target.depth();
-  const glm::dmat4 vp = f.viewProj();
-  std::vector<double> err;
-  for (int y = 0; y < h; ++y) {
-    for (int x = 0; x < w; ++x) {
-      const float d = depth[size_t(y) * size_t(w) + size_t(x)];
-      if (d <= 0) continue;
-      const glm::dvec3 p = unproject(f, cam, x, y, w, h, d);
-      const glm::dvec2 uv = f.uvCam + glm::dvec2(p) * f.uvPerMetre;
-      if (uv.x < 0 || uv.y < 0 || uv.x > 1 || uv.y > 1) continue;
-      const glm::dvec3 q(p.x, p.y, shading.exaggeration * scene.gridSurfaceAt(uv.x, uv.y) - f.camZ);
-      err.push_back(glm::length(toPixel(vp, p, w, h) - toPixel(vp, q, w, h)));
-    }
-  }
-  ErrorStats s;
-  s.pixels = err.size();
-  s.meanPx = mean(err);
-  s.p99Px = percentile(err, 0.99);
-  s.maxPx = err.empty() ? 0 : *std::max_element(err.begin(), err.end());
-  return s;
-}
-
 TEST_F(GlTest, RingErrorAgainstBruteForceReference) {
   auto scene = grandCanyon();
   ASSERT_TRUE(scene) << scene.message();
@@ -184,7 +131,7 @@ TEST_F(GlTest, RingErrorAgainstBruteForceReference) {
   EXPECT_LT(ref.p99Px, 0.05);
   EXPECT_GT(ref.pixels, size_t(w * h / 2));
 
-  std::vector<ErrorStats> ringStats;
+  std::vector<ScreenError> ringStats;
   for (const int circles : {48, 96, 192}) {
     auto ring = RingRenderer::create({.circles = circles});
     ASSERT_TRUE(ring) << ring.message();
