@@ -21,6 +21,7 @@
 #include <strata/render/gl/context.hpp>
 #include <strata/render/gl/objects.hpp>
 #include <strata/render/terrain/screen_error.hpp>
+#include <strata/render/terrain/sliding_grid.hpp>
 #include <strata/render/terrain/synthetic_dem.hpp>
 #include <strata/render/terrain/terrain_renderer.hpp>
 
@@ -103,12 +104,17 @@ void runFrames(benchmark::State& state, TerrainRenderer& renderer, const Terrain
   state.counters["err_p99_px"] = e.p99Px;
 }
 
-// Ring (circles = range(0)) vs grid (range(0) = 0) on a synthetic DEM of range(1)^2 cells.
+// Ring (circles = range(0) > 0), sliding grid (range(0) = -levels, 2x64 cells a level) or the
+// full grid (range(0) = 0) on a synthetic DEM of range(1)^2 cells.
 void BM_Synthetic(benchmark::State& state) {
   Setup& s = synthetic(int(state.range(1)));
   const int circles = int(state.range(0));
   std::unique_ptr<TerrainRenderer> r;
-  if (circles == 0) {
+  if (circles < 0) {
+    auto g = SlidingGridRenderer::create({.halfCells = 64, .levels = -circles});
+    if (!g) return state.SkipWithError(g.message().c_str());
+    r = std::move(g).value();
+  } else if (circles == 0) {
     auto g = GridRenderer::create();
     if (!g) return state.SkipWithError(g.message().c_str());
     r = std::move(g).value();
@@ -117,7 +123,7 @@ void BM_Synthetic(benchmark::State& state) {
     if (!g) return state.SkipWithError(g.message().c_str());
     r = std::move(g).value();
   }
-  state.SetLabel(circles == 0 ? "grid" : "ring");
+  state.SetLabel(r->name());
   runFrames(state, *r, *s.scene, s.camera, int(state.range(2)), int(state.range(3)));
 }
 BENCHMARK(BM_Synthetic)
@@ -127,6 +133,8 @@ BENCHMARK(BM_Synthetic)
     ->Args({192, 512, 640, 360})
     ->Args({256, 512, 640, 360})
     ->Args({0, 512, 640, 360})
+    ->Args({-4, 512, 640, 360})
+    ->Args({-6, 2048, 640, 360})
     ->Args({128, 1024, 640, 360})
     ->Args({0, 1024, 640, 360})
     ->Args({128, 2048, 640, 360})

@@ -11,6 +11,7 @@
 #include <strata/render/gl/context.hpp>
 #include <strata/render/image_io.hpp>
 #include <strata/render/terrain/flight_path.hpp>
+#include <strata/render/terrain/sliding_grid.hpp>
 #include <strata/render/terrain/synthetic_dem.hpp>
 #include <strata/render/terrain/terrain_renderer.hpp>
 
@@ -64,7 +65,11 @@ Result<std::unique_ptr<TerrainRenderer>> makeRenderer(const RenderArgs& a) {
     STRATA_TRY(auto r, GridRenderer::create());
     return std::unique_ptr<TerrainRenderer>(std::move(r));
   }
-  if (a.renderer != "ring") return fail("--renderer '" + a.renderer + "': expected ring or grid");
+  if (a.renderer == "sliding") {
+    STRATA_TRY(auto r, SlidingGridRenderer::create());
+    return std::unique_ptr<TerrainRenderer>(std::move(r));
+  }
+  if (a.renderer != "ring") return fail("--renderer '" + a.renderer + "': expected ring, sliding or grid");
   STRATA_TRY(auto r, RingRenderer::create({.circles = a.circles}));
   return std::unique_ptr<TerrainRenderer>(std::move(r));
 }
@@ -181,7 +186,8 @@ void addRenderCommand(CLI::App& app) {
       ->check(CLI::Range(-90.0, 90.0));
   cmd->add_option("--fov", a->fov, "Vertical field of view (deg)")->check(CLI::Range(1.0, 170.0));
   cmd->add_option("--size", a->size, "Image size WxH");
-  cmd->add_option("--renderer", a->renderer, "ring (concentric rings) or grid (brute-force full grid)");
+  cmd->add_option("--renderer", a->renderer,
+                  "ring (concentric rings), sliding (sliding sampling grid) or grid (brute-force full grid)");
   cmd->add_option("--circles", a->circles, "Ring renderer: circles (6n^2 triangles)")->check(CLI::Range(1, 2048));
   cmd->add_flag("--planetary", a->planetary, "Draw on the body's sphere (geographic DEMs)");
   cmd->add_option("--exaggeration", a->exaggeration, "Vertical exaggeration");

@@ -7,6 +7,8 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "terrain/frame_state.hpp"
+
 namespace strata::render::terrain {
 namespace {
 
@@ -15,37 +17,32 @@ constexpr double kDeg = kPi / 180.0;
 
 glm::mat4 toFloat(const glm::dmat4& m) { return glm::mat4(m); }
 
-// Binds the target and sets the reversed-Z state; restores the previous framebuffer and the
-// default depth convention on destruction so other GL users are not surprised.
-class FrameState {
- public:
-  explicit FrameState(const OffscreenTarget& target, const glm::vec4& sky) {
-    glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &previous_);
-    target.bind();
-    glViewport(0, 0, target.width(), target.height());
-    glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
-    glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_GREATER);
-    glDepthMask(GL_TRUE);
-    glDisable(GL_CULL_FACE);
-    target.clear(sky);
-  }
-  ~FrameState() {
-    glClipControl(GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE);
-    glDepthFunc(GL_LESS);
-    glDisable(GL_DEPTH_TEST);
-    glBindFramebuffer(GL_FRAMEBUFFER, GLuint(previous_));
-  }
-  FrameState(const FrameState&) = delete;
-  FrameState& operator=(const FrameState&) = delete;
-
- private:
-  GLint previous_ = 0;
-};
-
 bool isGlobalInLongitude(const gis::Georef& g) {
   // Within a tenth of a pixel of 360 degrees (products converted from metres are not exact).
   return g.geographic && std::abs(std::abs(g.transform.c[1]) * g.width - 360.0) < 0.1 * std::abs(g.transform.c[1]);
+}
+
+}  // namespace
+
+namespace detail {
+
+FrameState::FrameState(const OffscreenTarget& target, const glm::vec4& sky) {
+  glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &previous_);
+  target.bind();
+  glViewport(0, 0, target.width(), target.height());
+  glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_GREATER);
+  glDepthMask(GL_TRUE);
+  glDisable(GL_CULL_FACE);
+  target.clear(sky);
+}
+
+FrameState::~FrameState() {
+  glClipControl(GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE);
+  glDepthFunc(GL_LESS);
+  glDisable(GL_DEPTH_TEST);
+  glBindFramebuffer(GL_FRAMEBUFFER, GLuint(previous_));
 }
 
 void setCommonUniforms(const gl::Program& p, const TerrainScene& scene, const FrameGeometry& frame,
@@ -87,7 +84,7 @@ void setCommonUniforms(const gl::Program& p, const TerrainScene& scene, const Fr
   if (scene.layerTexture()) scene.layerTexture()->bind(2);
 }
 
-}  // namespace
+}  // namespace detail
 
 // ---- TerrainScene ------------------------------------------------------------------------------
 
@@ -344,9 +341,9 @@ Status RingRenderer::draw(const TerrainScene& scene, const CameraPose& camera, c
                           const OffscreenTarget& target, const glm::dmat4* observer) {
   const FrameGeometry frame = frameGeometry(scene, camera, shading, target.width(), target.height());
   const RingLayout l = layout(scene, frame);
-  FrameState state(target, shading.sky);
+  detail::FrameState state(target, shading.sky);
   const auto& p = program_;
-  setCommonUniforms(p, scene, frame, shading, observer ? *observer : frame.viewProj());
+  detail::setCommonUniforms(p, scene, frame, shading, observer ? *observer : frame.viewProj());
   p.set("uCircles", float(params_.circles));
   p.set("uAlphaMax", float(l.alphaMax));
   p.set("uSoftH", float(l.softHeightM));
@@ -392,8 +389,8 @@ Status GridRenderer::draw(const TerrainScene& scene, const CameraPose& camera, c
     glVertexArrayElementBuffer(vao_.id(), indices_.id());
   }
   const FrameGeometry frame = frameGeometry(scene, camera, shading, target.width(), target.height());
-  FrameState state(target, shading.sky);
-  setCommonUniforms(program_, scene, frame, shading, observer ? *observer : frame.viewProj());
+  detail::FrameState state(target, shading.sky);
+  detail::setCommonUniforms(program_, scene, frame, shading, observer ? *observer : frame.viewProj());
   program_.use();
   vao_.bind();
   glDrawElements(GL_TRIANGLES, indexCount_, GL_UNSIGNED_INT, nullptr);
