@@ -183,7 +183,6 @@ class RingRenderer final : public TerrainRenderer {
               const OffscreenTarget& target, const glm::dmat4* observer = nullptr) override;
   size_t trianglesPerFrame(const TerrainScene&) const override { return RingMesh::triangleCount(params_.circles); }
   const RingParams& params() const { return params_; }
-  RingParams& params() { return params_; }
   /// The layout draw() uses for this frame.
   RingLayout layout(const TerrainScene& scene, const FrameGeometry& frame) const;
 
