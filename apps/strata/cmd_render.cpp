@@ -189,7 +189,7 @@ void addRenderCommand(CLI::App& app) {
   cmd->add_option("--renderer", a->renderer,
                   "ring (concentric rings), sliding (sliding sampling grid) or grid (brute-force full grid)");
   cmd->add_option("--circles", a->circles, "Ring renderer: circles (6n^2 triangles)")->check(CLI::Range(1, 2048));
-  cmd->add_flag("--planetary", a->planetary, "Draw on the body's sphere (geographic DEMs)");
+  cmd->add_flag("--planetary", a->planetary, "Draw on the body's ellipsoid (geographic DEMs)");
   cmd->add_option("--exaggeration", a->exaggeration, "Vertical exaggeration");
   cmd->add_option("--sea-level", a->seaLevel, "Water wherever the terrain is below this elevation (m)");
   cmd->add_option("--palette", a->palette, "hypsometric, grey or rust");

@@ -308,7 +308,9 @@ INSTANTIATE_TEST_SUITE_P(
                    10.0f, Palette::Hypsometric, true}),
     [](const ::testing::TestParamInfo<PlanetView>& p) { return std::string(p.param.name); });
 
-TEST_F(GlTest, NoJitterTenThousandKilometresFromTheCentre) {
+class NoJitter : public GlTest, public ::testing::WithParamInterface<double> {};
+
+TEST_P(NoJitter, TenThousandKilometresFromTheCentre) {
   // A body of radius 9,999,950 m, the viewer 50 m above it (10,000 km from the centre) at
   // lon 100.3, lat 40.2 over a rough patch of 1e-5 degree (1.75 m) cells, moving east 0.2 m a
   // frame. Every step must change the image by about the same amount: rounding of absolute
@@ -316,7 +318,7 @@ TEST_F(GlTest, NoJitterTenThousandKilometresFromTheCentre) {
   const double radius = 9999950.0;
   auto dem = syntheticDem(256, 1.0, 3.0, 5);
   dem.georef.geographic = true;
-  dem.georef.body = gis::Body::fromEllipsoid(radius, 0.0, "test sphere");
+  dem.georef.body = gis::Body::fromEllipsoid(radius, GetParam(), "test body");
   dem.georef.transform.c[0] = 100.3 - 128e-5;
   dem.georef.transform.c[1] = 1e-5;
   dem.georef.transform.c[3] = 40.2 + 128e-5;
@@ -351,8 +353,10 @@ TEST_F(GlTest, NoJitterTenThousandKilometresFromTheCentre) {
     }
     previous = std::move(elev);
   }
-  std::ofstream report(test::outputDir("render") / "jitter.txt");
-  report << "# mean |change| of rendered elevation per 0.2 m step (m), viewer 50 m up, 10,000 km from the centre\n";
+  std::ofstream report(test::outputDir("render") / (GetParam() == 0 ? "jitter_sphere.txt" : "jitter_ellipsoid.txt"));
+  report << "# mean |change| of rendered elevation per 0.2 m step (m), viewer 50 m up, 10,000 km from the centre, "
+            "flattening "
+         << GetParam() << "\n";
   for (double s : steps) report << s << "\n";
   const double median = percentile(steps, 0.5);
   EXPECT_GT(median, 0.0);
@@ -364,6 +368,9 @@ TEST_F(GlTest, NoJitterTenThousandKilometresFromTheCentre) {
     EXPECT_LT(s, median * 1.5);
   }
 }
+
+// A sphere, and an ellipsoid with the Earth's flattening.
+INSTANTIATE_TEST_SUITE_P(Bodies, NoJitter, ::testing::Values(0.0, 1 / 298.257223563));
 
 TEST_F(GlTest, WaterAndMaterialLayersShowWhereTheyAre) {
   // A gentle 128^2 terrain seen from straight above: 5 m of water over the western half, 3 m of
@@ -442,6 +449,44 @@ TEST_F(GlTest, RainierRidgeCloseViewMatchesGoldenImage) {
   // The golden image with the 1000 m floor (the last render); tolerances as for the canyon.
   const auto r = test::compareWithGolden("rainier_ridge", colourImage(*target), 24, 0.02, test::outputDir("render"));
   EXPECT_TRUE(r.ok) << r.message;
+}
+
+TEST_F(GlTest, PlanetaryModeDrawsTheEllipsoid) {
+  // A flat global DEM on a body with flattening 0.3, seen from above the equator at 21 equatorial
+  // radii: the silhouette's height over its width is b/a = 0.7 exactly for a pinhole camera
+  // (both limbs' tangents are b/sqrt(D^2 - a^2) and a/sqrt(D^2 - a^2)); a sphere would give 1.
+  const double a = 6.0e6, f = 0.3;
+  gis::Raster dem;
+  dem.georef.geographic = true;
+  dem.georef.body = gis::Body::fromEllipsoid(a, f, "squashed");
+  dem.georef.width = 360;
+  dem.georef.height = 180;
+  dem.georef.transform.c[0] = -180;
+  dem.georef.transform.c[1] = 1;
+  dem.georef.transform.c[3] = 90;
+  dem.georef.transform.c[5] = -1;
+  dem.values = gis::Grid<float>(360, 180, 0.0f);
+  auto scene = TerrainScene::create(dem, {.planetary = true});
+  ASSERT_TRUE(scene) << scene.message();
+  auto ring = RingRenderer::create({.circles = 96});
+  ASSERT_TRUE(ring) << ring.message();
+  const int n = 128;
+  auto target = OffscreenTarget::create(n, n);
+  ASSERT_TRUE(target) << target.message();
+  Shading shading;
+  shading.sky = {0, 0, 0, 1};
+  const CameraPose cam{.lon = 30, .lat = 0, .heightM = 20 * a, .headingDeg = 0, .pitchDeg = -90, .fovYDeg = 8};
+  ASSERT_TRUE((*ring)->draw(*scene, cam, shading, *target));
+  const auto elev = target->elevation();
+  auto covered = [&](int x, int y) { return std::isfinite(elev[size_t(y) * size_t(n) + size_t(x)]); };
+  int width = 0, height = 0;
+  for (int i = 0; i < n; ++i) {
+    width += covered(i, n / 2);
+    height += covered(n / 2, i);
+  }
+  // ~87 px wide: one pixel at each limb is 2.3% of the ratio.
+  EXPECT_NEAR(double(height) / double(width), 1 - f, 0.025) << height << " x " << width << " px";
+  EXPECT_GT(width, n / 2);
 }
 
 }  // namespace

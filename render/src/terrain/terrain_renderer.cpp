@@ -58,7 +58,11 @@ void setCommonUniforms(const gl::Program& p, const TerrainScene& scene, const Fr
   p.set("uTexSize", glm::vec2(float(w), float(h)));
   p.set("uWrapU", scene.planetary() && isGlobalInLongitude(scene.georef()) ? 1 : 0);
   p.set("uRadius", float(scene.radiusM()));
-  p.set("uCamLonLat", glm::vec2(float(frame.lonRad), float(frame.latRad)));
+  p.set("uCamLonLat", glm::vec2(float(frame.lonRad), float(frame.reducedLatRad)));
+  p.set("uFlattening", float(scene.georef().body.flattening));
+  p.set("uPoleAux", glm::vec3(frame.poleAux));
+  p.set("uNadirNormal", glm::vec3(frame.nadirNormal));
+  glProgramUniformMatrix3fv(p.id(), p.location("uFrameRot"), 1, GL_FALSE, &glm::mat3(frame.frameRot)[0][0]);
   p.set("uGeoToUv", glm::vec4(float(c[0] * kDeg), float(1.0 / (c[1] * w * kDeg)), float(c[3] * kDeg),
                               float(1.0 / (c[5] * h * kDeg))));
   p.set("uHasWater", scene.waterTexture() ? 1 : 0);
@@ -76,7 +80,7 @@ void setCommonUniforms(const gl::Program& p, const TerrainScene& scene, const Fr
   p.set("uElevRange", shading.tintRangeM.value_or(tint));
   p.set("uPalette", int(shading.palette));
   p.set("uSunDir", glm::normalize(shading.sunDir));
-  p.set("uPole", glm::vec3(0.0f, float(std::cos(frame.latRad)), float(std::sin(frame.latRad))));
+  p.set("uPole", glm::vec3(frame.frameRot * frame.poleAux));
   p.set("uSky", shading.sky);
   p.set("uFogM", shading.fogM);
   scene.heightTexture().bind(0);
@@ -212,6 +216,17 @@ FrameGeometry frameGeometry(const TerrainScene& scene, const CameraPose& camera,
   f.heightAboveGroundM = std::max(camera.heightM - f.groundM, 0.0);
   f.lonRad = camera.lon * kDeg;
   f.latRad = camera.lat * kDeg;
+  // The ellipsoid as the auxiliary sphere of radius a squashed along the polar axis: the
+  // nadir's reduced latitude, the pole and the ellipsoid normal in the sphere's nadir frame,
+  // and the rotation that makes that normal the viewer's up.
+  const double squash = 1.0 - g.body.flattening;
+  f.reducedLatRad = std::atan2(squash * std::sin(f.latRad), std::cos(f.latRad));
+  f.poleAux = {0.0, std::cos(f.reducedLatRad), std::sin(f.reducedLatRad)};
+  glm::dvec3 q0(0.0, 0.0, radius);
+  q0 -= g.body.flattening * glm::dot(q0, f.poleAux) * f.poleAux;
+  f.nadirNormal = glm::normalize(q0 + (1.0 / (squash * squash) - 1.0) * glm::dot(q0, f.poleAux) * f.poleAux);
+  const double theta = std::atan2(f.nadirNormal.y, f.nadirNormal.z);
+  f.frameRot = glm::dmat3(1, 0, 0, 0, std::cos(theta), std::sin(theta), 0, -std::sin(theta), std::cos(theta));
   for (double u : {0.0, 1.0}) {
     for (double v : {0.0, 1.0}) {
       const glm::dvec2 m = (glm::dvec2(u, v) - f.uvCam) / f.uvPerMetre;

@@ -51,8 +51,8 @@ struct Shading {
 };
 
 struct SceneOptions {
-  /// Draw on a sphere (the DEM's body, radius = semi-major axis) instead of a tangent plane.
-  /// Needs a geographic DEM.
+  /// Draw on the DEM's body (its ellipsoid: a sphere when the flattening is 0) instead of a
+  /// tangent plane. Needs a geographic DEM.
   bool planetary = false;
 };
 
@@ -99,16 +99,20 @@ class TerrainScene {
 
 /// Everything the shaders need about one frame's view, computed in double on the CPU.
 struct FrameGeometry {
-  glm::dmat4 view{1.0};           ///< viewer-relative ENU -> eye (rotation only)
-  glm::dmat4 projection{1.0};     ///< reversed-Z infinite perspective (depth 1 at near, 0 at infinity)
-  double nearM = 1;               ///< near plane distance (m)
-  double groundM = 0;             ///< elevation under the viewer (m, exaggerated)
-  double heightAboveGroundM = 0;  ///< h (m)
-  glm::dvec2 uvCam{0};            ///< planar: texture coordinates under the viewer
-  glm::dvec2 uvPerMetre{0};       ///< planar: d(u, v) / d(east, north)
-  double camZ = 0;                ///< planar: viewer z (m); planetary: height above the sphere (m)
-  double lonRad = 0, latRad = 0;  ///< planetary: the viewer's nadir
-  double farthestM = 0;           ///< planar: distance to the DEM's farthest corner (m)
+  glm::dmat4 view{1.0};             ///< viewer-relative ENU -> eye (rotation only)
+  glm::dmat4 projection{1.0};       ///< reversed-Z infinite perspective (depth 1 at near, 0 at infinity)
+  double nearM = 1;                 ///< near plane distance (m)
+  double groundM = 0;               ///< elevation under the viewer (m, exaggerated)
+  double heightAboveGroundM = 0;    ///< h (m)
+  glm::dvec2 uvCam{0};              ///< planar: texture coordinates under the viewer
+  glm::dvec2 uvPerMetre{0};         ///< planar: d(u, v) / d(east, north)
+  double camZ = 0;                  ///< planar: viewer z (m); planetary: height above the sphere (m)
+  double lonRad = 0, latRad = 0;    ///< planetary: the viewer's nadir (geodetic latitude)
+  double reducedLatRad = 0;         ///< planetary: the nadir's reduced latitude, atan((1 - f) tan(lat))
+  glm::dvec3 poleAux{0, 0, 1};      ///< planetary: polar axis in the auxiliary sphere's nadir frame
+  glm::dvec3 nadirNormal{0, 0, 1};  ///< planetary: ellipsoid normal at the nadir, same frame
+  glm::dmat3 frameRot{1.0};         ///< planetary: that frame -> the viewer's ENU frame (normal up)
+  double farthestM = 0;             ///< planar: distance to the DEM's farthest corner (m)
   glm::dmat4 viewProj() const { return projection * view; }
 };
 
