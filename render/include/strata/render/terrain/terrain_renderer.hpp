@@ -1,9 +1,9 @@
 #pragma once
 // Terrain renderers behind one interface: the concentric-ring renderer (RingRenderer, the fixed
 // polar mesh displaced in the vertex shader) and the brute-force full grid (GridRenderer, the
-// reference). Both draw a TerrainScene (a DEM on the GPU) seen from a CameraPose into an
-// OffscreenTarget (colour RGBA8, reversed-Z float depth, elevation r32f). The maths:
-// docs/render-rings.md.
+// reference); the sliding sampling grid (sliding_grid.hpp) is the third. All draw a TerrainScene
+// (a DEM on the GPU) seen from a CameraPose into an OffscreenTarget (colour RGBA8, reversed-Z
+// float depth, elevation r32f). The maths: docs/render-rings.md.
 
 #include <array>
 #include <cstdint>
@@ -25,7 +25,7 @@ namespace strata::render::terrain {
 struct CameraPose {
   double lon = 0;         ///< geographic DEM: longitude (deg); projected DEM: easting in the CRS (m)
   double lat = 0;         ///< geographic DEM: latitude (deg); projected DEM: northing in the CRS (m)
-  double heightM = 1000;  ///< above the datum (planetary: above the sphere) (m)
+  double heightM = 1000;  ///< above the datum (planetary: above the body's ellipsoid) (m)
   double headingDeg = 0;  ///< view direction, clockwise from north (deg)
   double pitchDeg = -30;  ///< view direction above the horizontal (deg; negative looks down)
   double fovYDeg = 45;    ///< vertical field of view (deg)
@@ -50,6 +50,7 @@ struct Shading {
                                         glm::vec3(0.30f, 0.45f, 0.20f), glm::vec3(0.9f, 0.9f, 0.95f)};
 };
 
+/// How a DEM is drawn.
 struct SceneOptions {
   /// Draw on the DEM's body (its ellipsoid: a sphere when the flattening is 0) instead of a
   /// tangent plane. Needs a geographic DEM.
@@ -104,9 +105,9 @@ struct FrameGeometry {
   double nearM = 1;                 ///< near plane distance (m)
   double groundM = 0;               ///< elevation under the viewer (m, exaggerated)
   double heightAboveGroundM = 0;    ///< h (m)
-  glm::dvec2 uvCam{0};              ///< planar: texture coordinates under the viewer
+  glm::dvec2 uvCam{0};              ///< texture coordinates under the viewer
   glm::dvec2 uvPerMetre{0};         ///< planar: d(u, v) / d(east, north)
-  double camZ = 0;                  ///< planar: viewer z (m); planetary: height above the sphere (m)
+  double camZ = 0;                  ///< planar: viewer z (m); planetary: height above the ellipsoid (m)
   double lonRad = 0, latRad = 0;    ///< planetary: the viewer's nadir (geodetic latitude)
   double reducedLatRad = 0;         ///< planetary: the nadir's reduced latitude, atan((1 - f) tan(lat))
   glm::dvec3 poleAux{0, 0, 1};      ///< planetary: polar axis in the auxiliary sphere's nadir frame
@@ -166,7 +167,7 @@ struct RingParams {
   double rangeM = 0;        ///< planar: radius of the disc (m); 0: to the DEM's farthest corner
   int maxSamples = 8;       ///< cap on the elevation samples per vertex
   bool multiSample = true;  ///< average several samples between neighbouring circles
-  bool mipSelect = true;    ///< pick the MIP level from the sample spacing
+  bool mipSelect = true;    ///< pick the MIP level from the circle spacing
 };
 
 /// Per-frame ring layout (what ring.vert gets), computed on the CPU; exposed for tests.
@@ -179,8 +180,10 @@ struct RingLayout {
   double radiusAt(double rho, bool planetary, double radiusM) const;
 };
 
+/// The concentric-ring renderer: the RingMesh, built once, placed around the viewer by ring.vert.
 class RingRenderer final : public TerrainRenderer {
  public:
+  /// Compiles the shaders and uploads the mesh; fails on out-of-range parameters.
   static Result<std::unique_ptr<RingRenderer>> create(const RingParams& params = {});
   std::string name() const override { return "ring"; }
   Status draw(const TerrainScene& scene, const CameraPose& camera, const Shading& shading,
@@ -202,6 +205,7 @@ class RingRenderer final : public TerrainRenderer {
 /// scenes only.
 class GridRenderer final : public TerrainRenderer {
  public:
+  /// Compiles the shaders; the index buffer is built for each scene size on first draw.
   static Result<std::unique_ptr<GridRenderer>> create();
   std::string name() const override { return "grid"; }
   Status draw(const TerrainScene& scene, const CameraPose& camera, const Shading& shading,
