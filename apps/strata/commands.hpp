@@ -6,6 +6,7 @@
 namespace strata::app {
 
 void addGpuInfoCommand(CLI::App& app);
+void addInfoCommand(CLI::App& app);
 void addRenderCommand(CLI::App& app);
 
 }  // namespace strata::app
