@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include <strata/gis/dem_io.hpp>
 #include <strata/render/gl/context.hpp>
 #include <strata/render/image_io.hpp>
 #include <strata/render/terrain/flight_path.hpp>
@@ -45,7 +46,8 @@ struct RenderArgs {
   throw CLI::RuntimeError(1);
 }
 
-// "synthetic:SIZE[:SEED]" (a rough fractal terrain of SIZE^2 cells of 30 m), else a DEM file.
+// "synthetic:SIZE[:SEED]" (a rough fractal terrain of SIZE^2 cells of 30 m), else a DEM file
+// (any raster GDAL reads, through strata::gis::readDem).
 Result<gis::Raster> loadDem(const std::string& spec) {
   if (spec.rfind("synthetic:", 0) == 0) {
     int size = 0;
@@ -55,9 +57,7 @@ Result<gis::Raster> loadDem(const std::string& spec) {
     }
     return syntheticDem(size, 30.0, 400.0, seed);
   }
-  return fail("DEM '" + spec +
-              "': reading DEM files needs strata::gis::readDem, which this build does not have yet; use "
-              "synthetic:SIZE[:SEED]");
+  return gis::readDem(spec);
 }
 
 Result<std::unique_ptr<TerrainRenderer>> makeRenderer(const RenderArgs& a) {

@@ -1,50 +1,30 @@
 #include "terrain_fixture.hpp"
 
-#include <gdal_priv.h>
+#include <strata/gis/dem_io.hpp>
 
 #include <algorithm>
 #include <cmath>
 
 namespace strata::test {
 
-Result<gis::Raster> readDemForTest(const std::string& path, const gis::Body& body, double subtractM) {
-  GDALAllRegister();
-  std::unique_ptr<GDALDataset> ds(GDALDataset::Open(path.c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY));
-  if (!ds) return fail(path + ": GDAL cannot open it");
-  gis::Raster r;
-  auto& g = r.georef;
-  g.width = ds->GetRasterXSize();
-  g.height = ds->GetRasterYSize();
-  if (ds->GetGeoTransform(g.transform.c) != CE_None) return fail(path + ": no geotransform");
-  const OGRSpatialReference* srs = ds->GetSpatialRef();
-  g.geographic = srs && srs->IsGeographic();
-  if (srs && srs->IsProjected() &&
-      std::string(srs->GetAttrValue("PROJECTION") ? srs->GetAttrValue("PROJECTION") : "") == "Equirectangular") {
-    const double mPerDeg = body.semiMajorM * 3.14159265358979323846 / 180;
-    for (int k : {0, 1, 3, 5}) g.transform.c[k] /= mPerDeg;
-    g.transform.c[0] += srs->GetNormProjParm(SRS_PP_CENTRAL_MERIDIAN, 0.0);
-    g.geographic = true;
+Result<gis::Raster> readDemLonLat(const std::string& path) {
+  STRATA_TRY(auto dem, gis::readDem(path));
+  auto& g = dem.georef;
+  if (g.geographic) return dem;
+  const bool equirectangular = g.crsWkt.find("Equirectangular") != std::string::npos ||
+                               g.crsWkt.find("Equidistant Cylindrical") != std::string::npos;
+  if (!equirectangular || !g.body.isSphere()) {
+    return fail(path + ": not geographic and not equirectangular on a sphere (" + g.crsName + ")");
   }
-  g.body = body;
-  GDALRasterBand* band = ds->GetRasterBand(1);
-  r.values = gis::Grid<float>(g.width, g.height);
-  if (band->RasterIO(GF_Read, 0, 0, g.width, g.height, r.values.data.data(), g.width, g.height, GDT_Float32, 0, 0) !=
-      CE_None) {
-    return fail(path + ": band 1 read failed");
-  }
-  int hasNoData = 0, hasScale = 0, hasOffset = 0;
-  const double noData = band->GetNoDataValue(&hasNoData);
-  double scale = band->GetScale(&hasScale), offset = band->GetOffset(&hasOffset);
-  if (!hasScale) scale = 1;
-  if (!hasOffset) offset = 0;
-  for (float& v : r.values.data) {
-    if (hasNoData && double(v) == noData) {
-      v = gis::kNoData;
-    } else {
-      v = float(double(v) * scale + offset - subtractM);
-    }
-  }
-  return r;
+  const std::string key = "\"Longitude of natural origin\",";
+  const auto at = g.crsWkt.find(key);
+  if (at == std::string::npos) return fail(path + ": equirectangular CRS without a longitude of natural origin");
+  const double centralDeg = std::stod(g.crsWkt.substr(at + key.size()));
+  const double mPerDeg = g.body.semiMajorM * 3.14159265358979323846 / 180;
+  for (int k : {0, 1, 3, 5}) g.transform.c[k] /= mPerDeg;
+  g.transform.c[0] += centralDeg;
+  g.geographic = true;
+  return dem;
 }
 
 GoldenResult compareWithGolden(const std::string& name, const render::Image8& actual, int maxChannelDiff,

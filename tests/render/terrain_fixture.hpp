@@ -1,6 +1,5 @@
 #pragma once
-// Helpers for the terrain renderer tests: synthetic DEMs, a minimal GDAL DEM reader (a stand-in
-// until strata::gis::readDem lands on main; delete it then), and golden-image comparison.
+// Helpers for the terrain renderer tests: DEMs as lon/lat grids, and golden-image comparison.
 
 #include <cstdint>
 #include <filesystem>
@@ -13,11 +12,10 @@
 
 namespace strata::test {
 
-/// Reads band 1 of a DEM with GDAL (scale/offset applied, nodata -> NaN), georeferenced with
-/// `body`. Test-only stand-in for strata::gis::readDem. A PDS product in an equirectangular
-/// projection in metres on the body's sphere (the LOLA LDEM) is turned into lon/lat degrees,
-/// and `subtractM` (e.g. the reference radius the file adds as an offset) is taken off.
-Result<gis::Raster> readDemForTest(const std::string& path, const gis::Body& body, double subtractM = 0);
+/// Reads a DEM with strata::gis::readDem. A grid in an equirectangular projection on a sphere
+/// (the LOLA LDEM: metres from a central meridian) is re-expressed in lon/lat degrees (its cells
+/// are already parallels and meridians), for planetary mode.
+Result<gis::Raster> readDemLonLat(const std::string& path);
 
 /// Golden comparison: a pixel differs when any channel differs by more than `maxChannelDiff`;
 /// passes when at most `allowedFraction` of the pixels differ. On failure (or when the golden

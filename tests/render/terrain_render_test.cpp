@@ -37,7 +37,7 @@ double mean(const std::vector<double>& v) {
 }
 
 Result<TerrainScene> grandCanyon() {
-  STRATA_TRY(auto dem, test::readDemForTest(test::dataPath("grand_canyon/grand_canyon_512.tif"), gis::Body::wgs84()));
+  STRATA_TRY(auto dem, test::readDemLonLat(test::dataPath("grand_canyon/grand_canyon_512.tif")));
   return TerrainScene::create(dem);
 }
 
@@ -251,8 +251,7 @@ TEST_F(GlTest, UndulationWithAndWithoutMultiSamplingAndMip) {
 struct PlanetView {
   const char* name;
   const char* path;
-  gis::Body body;
-  double subtractM;  // reference radius the file adds to its heights
+  gis::Body body;  // the body readDem must find in the file's CRS
   CameraPose camera;
   float exaggeration;
   Palette palette;
@@ -265,8 +264,9 @@ class PlanetGolden : public GlTest, public ::testing::WithParamInterface<PlanetV
 
 TEST_P(PlanetGolden, FromOrbitMatchesGoldenImage) {
   const PlanetView& v = GetParam();
-  auto dem = test::readDemForTest(test::dataPath(v.path), v.body, v.subtractM);
+  auto dem = test::readDemLonLat(test::dataPath(v.path));
   ASSERT_TRUE(dem) << dem.message();
+  EXPECT_EQ(dem->georef.body.name, v.body.name);
   auto scene = TerrainScene::create(*dem, {.planetary = true});
   ASSERT_TRUE(scene) << scene.message();
   auto ring = RingRenderer::create({.circles = 128});
@@ -299,11 +299,11 @@ TEST_P(PlanetGolden, FromOrbitMatchesGoldenImage) {
 INSTANTIATE_TEST_SUITE_P(
     Bodies, PlanetGolden,
     ::testing::Values(
-        PlanetView{"moon", "moon/LDEM_4.LBL", gis::Body::moon(), 1737400.0,
+        PlanetView{"moon", "moon/LDEM_4.LBL", gis::Body::moon(),
                    CameraPose{.lon = 0, .lat = 0, .heightM = 4.0e6, .pitchDeg = -90}, 3.0f, Palette::Grey, false},
-        PlanetView{"mars", "mars/mola_megdr_4ppd.vrt", gis::Body::mars(), 0.0,
+        PlanetView{"mars", "mars/mola_megdr_4ppd.vrt", gis::Body::mars(),
                    CameraPose{.lon = -70, .lat = -10, .heightM = 7.0e6, .pitchDeg = -90}, 3.0f, Palette::Rust, false},
-        PlanetView{"earth", "earth/etopo20.tif", gis::Body::wgs84(), 0.0,
+        PlanetView{"earth", "earth/etopo20.tif", gis::Body::wgs84(),
                    CameraPose{.lon = -40, .lat = 20, .heightM = 2.0e7 - 6378137.0, .pitchDeg = -90, .fovYDeg = 40},
                    10.0f, Palette::Hypsometric, true}),
     [](const ::testing::TestParamInfo<PlanetView>& p) { return std::string(p.param.name); });
@@ -421,7 +421,7 @@ TEST_F(GlTest, RainierRidgeCloseViewMatchesGoldenImage) {
   // south-west of the summit, looking at it. Ground-level views need a larger softening floor
   // than the default 50 m: with H = 50 m the circles 8 km out are ~8 km apart (spacing grows as
   // r^2 / H) and the 4,392 m summit is averaged away. The error report shows the effect.
-  auto dem = test::readDemForTest(test::dataPath("rainier/mt_rainier_90m.tif"), gis::Body::wgs84());
+  auto dem = test::readDemLonLat(test::dataPath("rainier/mt_rainier_90m.tif"));
   ASSERT_TRUE(dem) << dem.message();
   auto scene = TerrainScene::create(*dem);
   ASSERT_TRUE(scene) << scene.message();
