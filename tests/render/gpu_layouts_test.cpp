@@ -8,6 +8,8 @@
 #include <sstream>
 
 #include <strata/render/gpu_layouts.hpp>
+#include <strata/terrain/sim/sim_host.hpp>
+#include <strata/terrain/sim/sim_params.hpp>
 
 namespace strata::render {
 namespace {
@@ -67,6 +69,77 @@ TEST(GpuLayouts, GridParamsMatchesGlsl) {
     EXPECT_EQ(fields[i].offset, cpp[i].offset) << cpp[i].name;
   }
   EXPECT_EQ(size, sizeof(GridParams));
+}
+
+}  // namespace
+}  // namespace strata::render
+
+namespace strata::render {
+namespace {
+
+// The simulation's std430 blocks (terrain/sim/sim_params.hpp, sim_host.hpp) against
+// shaders/common/sim.glsl.
+template <class T>
+void expectSimLayout(const std::string& name, const std::vector<Field>& cpp) {
+  size_t size = 0;
+  const auto fields = glslLayout(std::string(STRATA_SOURCE_DIR) + "/shaders/common/sim.glsl", name, size);
+  ASSERT_EQ(fields.size(), cpp.size()) << name;
+  for (size_t i = 0; i < cpp.size(); ++i) {
+    EXPECT_EQ(fields[i].name, cpp[i].name) << name;
+    EXPECT_EQ(fields[i].offset, cpp[i].offset) << name << "." << cpp[i].name;
+  }
+  EXPECT_EQ(size, sizeof(T)) << name;
+}
+
+#define STRATA_FIELD(T, f) \
+  Field { #f, offsetof(T, f) }
+
+TEST(GpuLayouts, SimParamsMatchesGlsl) {
+  using terrain::sim::SimParams;
+  expectSimLayout<SimParams>("SimParams", {STRATA_FIELD(SimParams, width),
+                                           STRATA_FIELD(SimParams, height),
+                                           STRATA_FIELD(SimParams, layerCount),
+                                           STRATA_FIELD(SimParams, waterModel),
+                                           STRATA_FIELD(SimParams, openEdges),
+                                           STRATA_FIELD(SimParams, erosionEnabled),
+                                           STRATA_FIELD(SimParams, thermalEnabled),
+                                           STRATA_FIELD(SimParams, diagonalPipes),
+                                           STRATA_FIELD(SimParams, dyM),
+                                           STRATA_FIELD(SimParams, gravityMS2),
+                                           STRATA_FIELD(SimParams, dtS),
+                                           STRATA_FIELD(SimParams, maxDtS),
+                                           STRATA_FIELD(SimParams, cflAlpha),
+                                           STRATA_FIELD(SimParams, dryDepthM),
+                                           STRATA_FIELD(SimParams, pipeAreaM2),
+                                           STRATA_FIELD(SimParams, manningN),
+                                           STRATA_FIELD(SimParams, rainMmPerHour),
+                                           STRATA_FIELD(SimParams, evaporationMmPerHour),
+                                           STRATA_FIELD(SimParams, capacityK),
+                                           STRATA_FIELD(SimParams, erosionRate),
+                                           STRATA_FIELD(SimParams, depositionRate),
+                                           STRATA_FIELD(SimParams, deepWaterM),
+                                           STRATA_FIELD(SimParams, minSinTilt),
+                                           STRATA_FIELD(SimParams, slowWaterMS),
+                                           STRATA_FIELD(SimParams, thermalRate),
+                                           STRATA_FIELD(SimParams, wetTalusScale),
+                                           STRATA_FIELD(SimParams, maxErosionPerStepM),
+                                           STRATA_FIELD(SimParams, pad1)});
+}
+
+TEST(GpuLayouts, SimMaterialAndSourceEntryMatchGlsl) {
+  using terrain::sim::SimMaterial;
+  using terrain::sim::SourceEntry;
+  expectSimLayout<SimMaterial>("SimMaterial",
+                               {STRATA_FIELD(SimMaterial, erodibility), STRATA_FIELD(SimMaterial, dissolutionRate),
+                                STRATA_FIELD(SimMaterial, tanTalus), STRATA_FIELD(SimMaterial, pad)});
+  // SourceEntry is 8 bytes: its std430 struct alignment is 4, not the 16 the generic parser
+  // assumes for structs holding vec4s, so only the offsets are compared.
+  size_t size = 0;
+  const auto fields = glslLayout(std::string(STRATA_SOURCE_DIR) + "/shaders/common/sim.glsl", "SourceEntry", size);
+  ASSERT_EQ(fields.size(), 2u);
+  EXPECT_EQ(fields[0].offset, offsetof(SourceEntry, cell));
+  EXPECT_EQ(fields[1].offset, offsetof(SourceEntry, rateM3S));
+  EXPECT_EQ(sizeof(SourceEntry), 8u);
 }
 
 }  // namespace

@@ -1,0 +1,76 @@
+#pragma once
+// GPU water and erosion simulation (GL 4.5 compute, shaders/sim/*.comp): the same model, API and
+// parameters as the CPU reference strata::terrain::sim::CpuSimulation, which tests compare it
+// with. All state lives in GPU buffers; a step reads nothing back unless the time step is
+// adaptive (cflAlpha > 0: one 4-byte read of the max wave speed per step). Needs a current
+// GL 4.5 context (render::gl::HeadlessContext or a window) for its whole life.
+
+#include <memory>
+#include <vector>
+
+#include <strata/core/result.hpp>
+#include <strata/gis/raster.hpp>
+#include <strata/terrain/sim/cpu_simulation.hpp>
+#include <strata/terrain/sim/sim_params.hpp>
+
+namespace strata::render::sim {
+
+using terrain::sim::SimInput;
+using terrain::sim::SimParams;
+using terrain::sim::SimStats;
+using terrain::sim::Source;
+using terrain::sim::VelocityField;
+
+class Simulation {
+ public:
+  /// Validates the input, compiles the kernels and uploads the state.
+  static Result<Simulation> create(const SimInput& input, const SimParams& params);
+  Simulation(Simulation&&) noexcept;
+  Simulation& operator=(Simulation&&) noexcept;
+  ~Simulation();
+
+  /// Adds an inflow source (spring, inflow line with a hydrograph); cells must be inside.
+  Status addSource(const Source& source);
+  /// Changes the run-time parameters (rain, evaporation, friction, erosion constants, edges, time
+  /// step rule) from the next step on; grid size, layers and water model stay as created.
+  Status setParams(const SimParams& params);
+  /// Takes `n` steps (each of terrain::sim::stepDt, W10).
+  void step(int n = 1);
+  /// Steps until `seconds` more have been simulated (the last step is shortened to land on it).
+  void advance(double seconds);
+
+  gis::Grid<float> readWaterDepth() const;           ///< m
+  VelocityField readVelocity() const;                ///< m/s
+  std::vector<gis::Grid<float>> readLayers() const;  ///< thicknesses, bottom to top (m)
+  gis::Grid<float> readSuspended() const;            ///< suspended sediment (m of material)
+  gis::Grid<float> readBed() const;                  ///< bed elevation above datumM() (m)
+  double datumM() const;                             ///< the datum elevations are stored against (m)
+  /// Volumes since the start (reads the state back; summed in double on the CPU).
+  SimStats stats() const;
+  const SimParams& params() const;
+  /// Bytes of GPU buffers this simulation holds.
+  size_t gpuBytes() const;
+
+  /// For tiled runs (TiledSimulation): the persistent per-cell state as stored on the GPU.
+  struct RawState {
+    std::vector<float> state;     ///< 4 per cell: h, s, hu, hv
+    std::vector<float> flux;      ///< 4 per cell: pipe outflows W, E, N, S
+    std::vector<float> fluxDiag;  ///< diagonal pipes NW, NE, SW, SE: 4 per cell (4 floats in all without them)
+    std::vector<float> layers;    ///< layer-major: layers[l * cells + cell]
+    std::vector<float> accum;     ///< 8 per cell: (sum, error) of outflow, evaporation, sediment outflow
+  };
+  RawState readRaw() const;
+  /// Replaces state, flux and layers (accum is kept) and recomputes the bed from them.
+  void writeRaw(const RawState& raw);
+  /// max over cells of |u| + sqrt(g h) (m/s), as the adaptive step uses it (W10).
+  double maxWaveSpeedMS();
+  /// One step of exactly `dtS` seconds (tiles must all take the same step).
+  void stepWithDt(double dtS);
+
+ private:
+  struct Impl;
+  explicit Simulation(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace strata::render::sim

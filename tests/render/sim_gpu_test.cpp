@@ -1,0 +1,304 @@
+// The GPU simulation (shaders/sim/*.comp) on whatever GL the machine has (llvmpipe in CI):
+// the invariants the CPU reference is held to, and agreement with the CPU reference on the
+// same inputs (tests/terrain/sim_*_test.cpp pin the reference to analytic solutions).
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+
+#include <strata/render/sim/simulation.hpp>
+#include <strata/render/sim/tiled_simulation.hpp>
+#include <strata/terrain/sim/cpu_simulation.hpp>
+
+#include "gl_fixture.hpp"
+#include "sim_scenes.hpp"
+#include "strata_test.hpp"
+
+namespace strata::render::sim {
+namespace {
+
+using terrain::sim::CpuSimulation;
+using terrain::sim::WaterModel;
+using test::GlTest;
+
+SimParams pipeParams() {
+  SimParams p;
+  p.waterModel = int32_t(WaterModel::kVirtualPipes);
+  p.maxDtS = 0.1f;
+  p.pipeAreaM2 = 25.0f;
+  return p;
+}
+
+SimParams floodParams() {
+  SimParams p;
+  p.waterModel = int32_t(WaterModel::kFiniteVolume);
+  p.maxDtS = 10.0f;
+  p.cflAlpha = 0.45f;
+  return p;
+}
+
+double maxAbsDiff(const gis::Grid<float>& a, const gis::Grid<float>& b) {
+  double m = 0;
+  for (size_t i = 0; i < a.size(); ++i) m = std::max(m, std::abs(double(a.data[i]) - double(b.data[i])));
+  return m;
+}
+
+double seconds(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+TEST_F(GlTest, SimLakeAtRestStaysFlat) {
+  for (const auto& params : {pipeParams(), floodParams()}) {
+    auto sim = Simulation::create(test::lakeAtRest(48, 2000.0), params);
+    ASSERT_TRUE(sim) << sim.message();
+    sim->step(1000);
+    const auto h = sim->readWaterDepth();
+    const auto bed = sim->readBed();
+    const auto vel = sim->readVelocity();
+    double maxDev = 0, maxSpeed = 0;
+    for (size_t i = 0; i < h.size(); ++i) {
+      maxSpeed = std::max(maxSpeed, double(std::hypot(vel.uMS.data[i], vel.vMS.data[i])));
+      if (h.data[i] > 0.0f) maxDev = std::max(maxDev, std::abs(double(bed.data[i]) + double(h.data[i]) - 3.0));
+    }
+    std::printf("GPU lake at rest (model %d): max surface deviation %.3g m, max speed %.3g m/s\n", params.waterModel,
+                maxDev, maxSpeed);
+    // Issue 5's bounds (see the CPU test for why they leave room for rounding only).
+    EXPECT_LT(maxDev, 1e-5);
+    EXPECT_LT(maxSpeed, 1e-5);
+  }
+}
+
+TEST_F(GlTest, SimClosedBoxConservesVolume) {
+  // llvmpipe spends ~1 ms per dispatch whatever the grid, so the GPU runs issue 5's 10,000
+  // steps with pipes (3 passes a step) and 1,000 in flood mode (6 passes and a read-back a
+  // step); the CPU reference runs 10,000 of both.
+  for (auto [params, n, steps] : {std::tuple{pipeParams(), 32, 10000}, std::tuple{floodParams(), 32, 1000}}) {
+    auto sim = Simulation::create(test::sloshingBox(n), params);
+    ASSERT_TRUE(sim) << sim.message();
+    const double v0 = sim->stats().storedWaterM3;
+    const auto t0 = std::chrono::steady_clock::now();
+    sim->step(steps);
+    const auto st = sim->stats();
+    const double rel = std::abs(st.storedWaterM3 - v0) / v0;
+    std::printf(
+        "GPU closed box (model %d, %dx%d): %lld steps in %.2f s wall, %.1f s simulated, relative volume "
+        "change %.3g\n",
+        params.waterModel, n, n, st.steps, seconds(t0), st.timeS, rel);
+    // Issue 5's bound; the CPU reference measures 1e-8 (pipes) and 1.4e-7 (flood).
+    EXPECT_LT(rel, 1e-6);
+  }
+}
+
+TEST_F(GlTest, SimRainAndSourcesBalance) {
+  auto in = test::sloshingBox(32);
+  in.rainMmPerHour = gis::Grid<float>(32, 32, 30.0f);
+  auto params = pipeParams();
+  params.rainMmPerHour = 100.0f;
+  params.openEdges = terrain::sim::kEdgeSouth;
+  params.evaporationMmPerHour = 20.0f;
+  auto sim = Simulation::create(in, params);
+  ASSERT_TRUE(sim) << sim.message();
+  terrain::sim::Source spring;
+  spring.cells = {{3, 3}, {4, 3}};
+  spring.hydrographM3S = {{0.0, 1.0}, {50.0, 4.0}};
+  ASSERT_TRUE(sim->addSource(spring));
+  EXPECT_FALSE(sim->addSource(terrain::sim::Source{{{-1, 0}}, {}}));
+  sim->advance(100.0);
+  // The rain stops and evaporation doubles half-way (what a scenario's rain end time does).
+  auto later = sim->params();
+  later.rainMmPerHour = 0.0f;
+  later.evaporationMmPerHour = 40.0f;
+  ASSERT_TRUE(sim->setParams(later));
+  const double rainBefore = sim->stats().rainM3;
+  later.thermalRate = 2.0f;
+  EXPECT_FALSE(sim->setParams(later));  // bad values are refused and change nothing
+  sim->advance(100.0);
+  const auto st = sim->stats();
+  // Raster rain (30 mm/h) keeps falling; the uniform 100 mm/h stopped at 100 s.
+  EXPECT_NEAR(st.rainM3 - rainBefore, 30.0 / 3.6e6 * 100.0 * 160.0 * 160.0, 1e-6 * st.rainM3);
+  const double moved = st.initialWaterM3 + st.rainM3 + st.inflowM3 + st.outflowM3 + st.evaporatedM3;
+  std::printf(
+      "GPU balance: rain %.3f inflow %.3f outflow %.3f evaporated %.3f stored %.3f -> %.3f, imbalance %.3g m3\n",
+      st.rainM3, st.inflowM3, st.outflowM3, st.evaporatedM3, st.initialWaterM3, st.storedWaterM3, st.waterBalanceM3());
+  EXPECT_NEAR(st.timeS, 200.0, 1e-9);
+  // The hydrograph's integral (zero after 50 s), with float32 per-cell rates (1e-7 relative).
+  EXPECT_NEAR(st.inflowM3, 0.5 * 5.0 * 50.0, 1e-6 * 125.0);
+  EXPECT_GT(st.outflowM3, 1.0);
+  EXPECT_GT(st.evaporatedM3, 0.1);
+  // Float32 depth updates of ~2e4 m3 over 2000 steps; same bound as the CPU reference (1e-5).
+  EXPECT_LT(std::abs(st.waterBalanceM3()), 1e-5 * moved);
+}
+
+// GPU and CPU run the same passes in float32; they differ only where the GPU compiler fuses a
+// multiply-add or orders a sum differently (~1 ulp per operation), which the dynamics then
+// amplify a little each step.
+void expectAgreement(const terrain::sim::SimInput& in, const SimParams& params, int steps, double depthTol,
+                     double layerTol, const terrain::sim::Source* source) {
+  auto gpu = Simulation::create(in, params);
+  ASSERT_TRUE(gpu) << gpu.message();
+  auto cpu = CpuSimulation::create(in, params);
+  ASSERT_TRUE(cpu) << cpu.message();
+  if (source) {
+    ASSERT_TRUE(gpu->addSource(*source));
+    ASSERT_TRUE(cpu->addSource(*source));
+  }
+  gpu->step(steps);
+  cpu->step(steps);
+  const double dh = maxAbsDiff(gpu->readWaterDepth(), cpu->readWaterDepth());
+  const double ds = maxAbsDiff(gpu->readSuspended(), cpu->readSuspended());
+  double dl = 0;
+  const auto lg = gpu->readLayers(), lc = cpu->readLayers();
+  for (size_t l = 0; l < lg.size(); ++l) dl = std::max(dl, maxAbsDiff(lg[l], lc[l]));
+  const auto sg = gpu->stats(), sc = cpu->stats();
+  std::printf(
+      "GPU vs CPU (model %d, erosion %u, %d steps, t %.2f / %.2f s): max |dh| %.3g m, |ds| %.3g m, |dlayer| "
+      "%.3g m, stored %.6f / %.6f m3\n",
+      params.waterModel, params.erosionEnabled, steps, sg.timeS, sc.timeS, dh, ds, dl, sg.storedWaterM3,
+      sc.storedWaterM3);
+  EXPECT_NEAR(sg.timeS, sc.timeS, 1e-3 * sc.timeS);
+  EXPECT_LT(dh, depthTol);
+  EXPECT_LT(ds, layerTol);
+  EXPECT_LT(dl, layerTol);
+  EXPECT_NEAR(sg.storedWaterM3, sc.storedWaterM3, 1e-5 * sc.storedWaterM3);
+  EXPECT_NEAR(sg.materialM3, sc.materialM3, 1e-6 * sc.materialM3);
+}
+
+TEST_F(GlTest, SimPipesAgreeWithCpuReference) {
+  // 300 steps of a sloshing box with a spring, rain and an open edge: depths of ~1.5 m agree
+  // to 1e-4 m (measured ~1e-6; rounding differences grow slowly in this undamped model).
+  auto in = test::sloshingBox(32);
+  auto p = pipeParams();
+  p.openEdges = terrain::sim::kEdgeEast;
+  p.rainMmPerHour = 40.0f;
+  terrain::sim::Source spring{{{5, 5}}, {{0.0, 2.0}, {30.0, 0.5}}};
+  expectAgreement(in, p, 300, 1e-4, 1e-6, &spring);
+  p.diagonalPipes = 1;
+  expectAgreement(in, p, 300, 1e-4, 1e-6, &spring);
+}
+
+TEST_F(GlTest, SimFloodAgreesWithCpuReference) {
+  // A dam break in the sloshing box (wet/dry fronts, adaptive dt read back from the GPU).
+  auto in = test::sloshingBox(32);
+  for (int y = 0; y < 32; ++y) {
+    for (int x = 0; x < 32; ++x) in.waterDepthM.at(x, y) = x < 10 ? 2.0f : 0.0f;
+  }
+  expectAgreement(in, floodParams(), 150, 1e-4, 1e-6, nullptr);
+}
+
+TEST_F(GlTest, SimErosionAgreesWithCpuReference) {
+  // Erosion, transport, deposition and thermal weathering on. Step by step the two agree to an
+  // ulp, but thresholds (a layer present or not, load above or below capacity) flip on 1-ulp
+  // differences and the flips grow: after 50 steps the measured gaps are ~1e-6 m.
+  const int n = 32;
+  auto spring = test::valleySpring(n);
+  expectAgreement(test::erodingValley(n), test::erosionParams(), 50, 1e-4, 1e-4, &spring);
+}
+
+TEST_F(GlTest, SimErosionConservesMaterial) {
+  // 2,000 steps on the GPU (6 passes a step at ~1 ms each on llvmpipe); the CPU reference runs
+  // issue 5's 10,000.
+  const int n = 32;
+  auto sim = Simulation::create(test::erodingValley(n), test::erosionParams());
+  ASSERT_TRUE(sim) << sim.message();
+  ASSERT_TRUE(sim->addSource(test::valleySpring(n)));
+  const auto before = sim->readLayers();
+  const auto t0 = std::chrono::steady_clock::now();
+  sim->step(2000);
+  const auto st = sim->stats();
+  const auto after = sim->readLayers();
+  double moved = 0;
+  for (size_t l = 0; l < after.size(); ++l) {
+    for (size_t i = 0; i < after[l].size(); ++i)
+      moved += std::abs(double(after[l].data[i]) - double(before[l].data[i])) * 16.0;
+  }
+  const double rel = std::abs(st.materialM3 - st.initialMaterialM3) / st.initialMaterialM3;
+  std::printf(
+      "GPU erosion: %lld steps in %.2f s wall, material rel change %.3g, suspended %.3f m3, layers changed by "
+      "%.1f m3\n",
+      st.steps, seconds(t0), rel, st.suspendedM3, moved);
+  EXPECT_GT(moved, 10.0);
+  // Issue 5's bound; pure float transfers (the CPU reference measures 3e-7 over 10,000 steps).
+  EXPECT_LT(rel, 1e-5);
+}
+
+}  // namespace
+}  // namespace strata::render::sim
+
+namespace strata::render::sim {
+namespace {
+
+// A region run as tiles of 27 x 20 cells (uneven at the far edges) with 8-cell halos equals
+// the untiled run: the same kernels see the same values. A 1-cell halo, too narrow for what
+// one step reads, must differ: that shows the comparison can fail.
+void expectTiledEqualsUntiled(const SimInput& in, const SimParams& params, int steps, const Source* source) {
+  auto whole = Simulation::create(in, params);
+  ASSERT_TRUE(whole) << whole.message();
+  auto tiled = TiledSimulation::create(in, params, TileOptions{27, 20, 8});
+  ASSERT_TRUE(tiled) << tiled.message();
+  auto narrow = TiledSimulation::create(in, params, TileOptions{27, 20, 1});
+  ASSERT_TRUE(narrow) << narrow.message();
+  const int w = in.baseM.width, h = in.baseM.height;
+  EXPECT_EQ(tiled->tileCount(), ((w + 26) / 27) * ((h + 19) / 20));
+  if (source) {
+    ASSERT_TRUE(whole->addSource(*source));
+    ASSERT_TRUE(tiled->addSource(*source));
+    ASSERT_TRUE(narrow->addSource(*source));
+  }
+  whole->step(steps);
+  tiled->step(steps);
+  narrow->step(steps);
+  const double dh = maxAbsDiff(whole->readWaterDepth(), tiled->readWaterDepth());
+  const double dhNarrow = maxAbsDiff(whole->readWaterDepth(), narrow->readWaterDepth());
+  double dl = 0;
+  const auto lw = whole->readLayers(), lt = tiled->readLayers();
+  for (size_t l = 0; l < lw.size(); ++l) dl = std::max(dl, maxAbsDiff(lw[l], lt[l]));
+  const auto sw = whole->stats(), st = tiled->stats();
+  std::printf(
+      "tiled vs untiled (model %d, erosion %u, %d tiles, %d steps): max |dh| %.3g m (1-cell halo: %.3g m), "
+      "|dlayer| %.3g m, stored %.6f / %.6f, material %.6f / %.6f, outflow %.6f / %.6f\n",
+      params.waterModel, params.erosionEnabled, tiled->tileCount(), steps, dh, dhNarrow, dl, sw.storedWaterM3,
+      st.storedWaterM3, sw.materialM3, st.materialM3, sw.outflowM3, st.outflowM3);
+  // Float tolerance: one float32 ulp of the values involved (depths ~2 m, layers ~3 m); the
+  // kernels are the same, so the measured difference is 0.
+  EXPECT_LE(dh, 5e-7);
+  EXPECT_LE(dl, 5e-7);
+  EXPECT_GT(dhNarrow, 1e-4);
+  EXPECT_NEAR(st.storedWaterM3, sw.storedWaterM3, 1e-9 * sw.storedWaterM3);
+  EXPECT_NEAR(st.materialM3, sw.materialM3, 1e-9 * sw.materialM3);
+  EXPECT_NEAR(st.outflowM3, sw.outflowM3, 1e-9 * std::max(1.0, sw.outflowM3));
+  EXPECT_NEAR(st.timeS, sw.timeS, 1e-12 * sw.timeS);
+}
+
+TEST_F(GlTest, SimTiledFloodEqualsUntiled) {
+  // 48 x 40 cells, a dam break towards an open west edge, with friction.
+  const auto box = test::sloshingBox(48);
+  SimInput in = box;
+  in.baseM = gis::Grid<float>(48, 40);
+  in.waterDepthM = gis::Grid<float>(48, 40);
+  for (auto& l : in.layersM) l = gis::Grid<float>(48, 40);
+  for (int y = 0; y < 40; ++y) {
+    for (int x = 0; x < 48; ++x) {
+      in.baseM.at(x, y) = box.baseM.at(x, y);
+      in.waterDepthM.at(x, y) = x > 20 ? 2.0f : 0.0f;
+      for (size_t l = 0; l < in.layersM.size(); ++l) in.layersM[l].at(x, y) = box.layersM[l].at(x, y);
+    }
+  }
+  auto p = floodParams();
+  p.openEdges = terrain::sim::kEdgeWest;
+  p.manningN = 0.03f;
+  expectTiledEqualsUntiled(in, p, 80, nullptr);
+}
+
+TEST_F(GlTest, SimTiledErosionEqualsUntiled) {
+  const int n = 48;
+  auto in = test::erodingValley(n);
+  auto p = test::erosionParams();
+  p.openEdges = terrain::sim::kEdgeSouth;
+  auto spring = test::valleySpring(n);
+  expectTiledEqualsUntiled(in, p, 40, &spring);
+  p.diagonalPipes = 1;
+  expectTiledEqualsUntiled(in, p, 40, &spring);
+}
+
+}  // namespace
+}  // namespace strata::render::sim

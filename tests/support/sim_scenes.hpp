@@ -1,0 +1,127 @@
+#pragma once
+// Small simulation scenes shared by the CPU reference tests (tests/terrain) and the GPU tests
+// (tests/render): the same inputs go to both solvers.
+#include <cmath>
+#include <numbers>
+
+#include <strata/terrain/material.hpp>
+#include <strata/terrain/sim/sim_params.hpp>
+
+namespace strata::test {
+
+/// Four layers (rock, soil, sand, sediment) of the given thicknesses everywhere.
+inline void fourLayers(terrain::sim::SimInput& in, float rock, float soil, float sand, float sediment) {
+  const int w = in.baseM.width, h = in.baseM.height;
+  in.materials = terrain::defaultMaterials();
+  in.layersM = {gis::Grid<float>(w, h, rock), gis::Grid<float>(w, h, soil), gis::Grid<float>(w, h, sand),
+                gis::Grid<float>(w, h, sediment)};
+}
+
+/// A lake at rest at `datumM + 3 m` over a bumpy bed (datum + 0..5 m) with islands above the
+/// surface; 10 m cells. Depth is surface - bed where positive.
+inline terrain::sim::SimInput lakeAtRest(int n, double datumM) {
+  terrain::sim::SimInput in;
+  in.baseM = gis::Grid<float>(n, n);
+  in.waterDepthM = gis::Grid<float>(n, n);
+  in.rowDxM = {10.0};
+  in.dyM = 10.0;
+  in.datumM = datumM;
+  const double surface = 3.0;
+  fourLayers(in, 0.5f, 0.5f, 0.5f, 0.0f);
+  for (int y = 0; y < n; ++y) {
+    for (int x = 0; x < n; ++x) {
+      const double fx = double(x) / n, fy = double(y) / n;
+      double b = 1.5 + 1.2 * std::sin(7.0 * fx) * std::cos(5.0 * fy) + 0.6 * std::sin(19.0 * fx + 3.0 * fy);
+      // Two islands rising to 5 m above the datum.
+      for (auto [cx, cy] : {std::pair{0.3, 0.35}, std::pair{0.7, 0.6}}) {
+        const double r2 = (fx - cx) * (fx - cx) + (fy - cy) * (fy - cy);
+        b = std::max(b, 5.0 - 40.0 * r2 * 10.0);
+      }
+      const double base = b - 1.5;  // the layers add 1.5 m
+      in.baseM.at(x, y) = float(datumM + base);
+      // The depth as the solver will see it: the input holds absolute float32 elevations (0.12 mm
+      // steps at 2000 m); the solver subtracts the datum and adds the layers in float.
+      const float baseRel = float(double(in.baseM.at(x, y)) - datumM);
+      const float bedF = baseRel + 0.5f + 0.5f + 0.5f + 0.0f;
+      in.waterDepthM.at(x, y) = float(std::max(0.0, surface - double(bedF)));
+    }
+  }
+  return in;
+}
+
+/// A flat-bottomed closed box with a bumpy surface of water (a sloshing basin), 5 m cells.
+inline terrain::sim::SimInput sloshingBox(int n) {
+  terrain::sim::SimInput in;
+  in.baseM = gis::Grid<float>(n, n);
+  in.waterDepthM = gis::Grid<float>(n, n);
+  in.rowDxM = {5.0};
+  in.dyM = 5.0;
+  in.datumM = 1000.0;
+  fourLayers(in, 1.0f, 0.5f, 0.5f, 0.1f);
+  for (int y = 0; y < n; ++y) {
+    for (int x = 0; x < n; ++x) {
+      const double fx = double(x) / n, fy = double(y) / n;
+      in.baseM.at(x, y) = float(1000.0 + 0.5 * fx + 0.3 * std::sin(6.0 * fy));
+      in.waterDepthM.at(x, y) =
+          float(1.0 + 0.5 * std::exp(-30.0 * ((fx - 0.3) * (fx - 0.3) + (fy - 0.4) * (fy - 0.4))));
+    }
+  }
+  return in;
+}
+
+}  // namespace strata::test
+
+namespace strata::test {
+
+/// A valley draining north to south with four layers (rock, soil, sand, sediment), rain and
+/// a spring at its head: water keeps flowing, so erosion, transport and deposition stay busy.
+inline terrain::sim::SimInput erodingValley(int n) {
+  terrain::sim::SimInput in;
+  in.baseM = gis::Grid<float>(n, n);
+  in.rowDxM = {4.0};
+  in.dyM = 4.0;
+  in.datumM = 2600.0;
+  in.materials = terrain::defaultMaterials();
+  in.layersM = {gis::Grid<float>(n, n), gis::Grid<float>(n, n), gis::Grid<float>(n, n), gis::Grid<float>(n, n)};
+  in.waterDepthM = gis::Grid<float>(n, n);
+  for (int y = 0; y < n; ++y) {
+    for (int x = 0; x < n; ++x) {
+      const double fx = double(x) / n - 0.5, fy = double(y) / n;
+      in.baseM.at(x, y) = float(2600.0 + 20.0 * (1.0 - fy) + 30.0 * fx * fx + 0.3 * std::sin(13.0 * fx + 7.0 * fy));
+      in.layersM[0].at(x, y) = 2.0f;
+      in.layersM[1].at(x, y) = float(0.5 + 0.4 * std::sin(5.0 * fy));
+      in.layersM[2].at(x, y) = float(0.3 + 0.3 * std::cos(9.0 * fx));
+      in.layersM[3].at(x, y) = (x + y) % 3 == 0 ? 0.1f : 0.0f;
+      in.waterDepthM.at(x, y) = fy > 0.8 ? 0.5f : 0.0f;
+    }
+  }
+  return in;
+}
+
+/// Erosion parameters for erodingValley (pipes, erosion and thermal weathering on).
+inline terrain::sim::SimParams erosionParams() {
+  terrain::sim::SimParams p;
+  p.waterModel = int32_t(terrain::sim::WaterModel::kVirtualPipes);
+  p.maxDtS = 0.05f;
+  p.pipeAreaM2 = 16.0f;
+  p.rainMmPerHour = 50.0f;
+  p.erosionEnabled = 1;
+  p.thermalEnabled = 1;
+  p.capacityK = 0.05f;
+  p.erosionRate = 0.5f;
+  p.depositionRate = 0.3f;
+  p.deepWaterM = 2.0f;
+  p.slowWaterMS = 0.05f;
+  p.dryDepthM = 1e-3f;  // no velocities (and so no erosion) from films of rain
+  return p;
+}
+
+/// A spring at the valley head feeding erodingValley.
+inline terrain::sim::Source valleySpring(int n) {
+  terrain::sim::Source s;
+  for (int x = n / 2 - 2; x <= n / 2 + 2; ++x) s.cells.push_back({x, 1});
+  s.hydrographM3S = {{0.0, 2.0}, {200.0, 5.0}, {1000.0, 5.0}};
+  return s;
+}
+
+}  // namespace strata::test
