@@ -8,5 +8,6 @@ namespace strata::app {
 void addGpuInfoCommand(CLI::App& app);
 void addInfoCommand(CLI::App& app);
 void addGenerateCommand(CLI::App& app);
+void addRenderCommand(CLI::App& app);
 
 }  // namespace strata::app

@@ -7,6 +7,7 @@ int main(int argc, char** argv) {
   strata::app::addGpuInfoCommand(app);
   strata::app::addInfoCommand(app);
   strata::app::addGenerateCommand(app);
+  strata::app::addRenderCommand(app);
   CLI11_PARSE(app, argc, argv);
   return 0;
 }
