@@ -9,5 +9,6 @@ void addGpuInfoCommand(CLI::App& app);
 void addInfoCommand(CLI::App& app);
 void addFloodCommands(CLI::App& app);
 void addGenerateCommand(CLI::App& app);
+void addRenderCommand(CLI::App& app);
 
 }  // namespace strata::app

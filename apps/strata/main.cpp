@@ -8,6 +8,7 @@ int main(int argc, char** argv) {
   strata::app::addInfoCommand(app);
   strata::app::addFloodCommands(app);
   strata::app::addGenerateCommand(app);
+  strata::app::addRenderCommand(app);
   CLI11_PARSE(app, argc, argv);
   return 0;
 }

@@ -1,0 +1,202 @@
+// strata render: offscreen terrain rendering through EGL to PNG (colour) and EXR (depth,
+// elevation), from one camera or along a keyframed flight path.
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <strata/gis/dem_io.hpp>
+#include <strata/render/gl/context.hpp>
+#include <strata/render/image_io.hpp>
+#include <strata/render/terrain/flight_path.hpp>
+#include <strata/render/terrain/sliding_grid.hpp>
+#include <strata/render/terrain/synthetic_dem.hpp>
+#include <strata/render/terrain/terrain_renderer.hpp>
+
+#include "commands.hpp"
+
+namespace strata::app {
+namespace {
+
+using namespace strata::render::terrain;
+
+struct RenderArgs {
+  std::string dem;
+  std::string output = "render.png";
+  std::string depthOut, elevationOut;
+  std::optional<double> lon, lat, height, agl;
+  double heading = 0, pitch = -30, fov = 45;
+  std::string size = "1280x720";
+  std::string renderer = "ring";
+  int circles = 256;
+  bool planetary = false;
+  float exaggeration = 1;
+  std::optional<float> seaLevel;
+  std::string palette = "hypsometric";
+  float fogM = 0;
+  std::string path;
+  int frames = 0;
+};
+
+[[noreturn]] void die(const std::string& message) {
+  std::fprintf(stderr, "strata render: %s\n", message.c_str());
+  throw CLI::RuntimeError(1);
+}
+
+// "synthetic:SIZE[:SEED]" (a rough fractal terrain of SIZE^2 cells of 30 m), else a DEM file
+// (any raster GDAL reads, through strata::gis::readDem).
+Result<gis::Raster> loadDem(const std::string& spec) {
+  if (spec.rfind("synthetic:", 0) == 0) {
+    int size = 0;
+    unsigned seed = 1;
+    if (std::sscanf(spec.c_str() + 10, "%d:%u", &size, &seed) < 1 || size < 4 || size > 8192) {
+      return fail("DEM '" + spec + "': expected synthetic:SIZE[:SEED] with SIZE in 4..8192");
+    }
+    return syntheticDem(size, 30.0, 400.0, seed);
+  }
+  return gis::readDem(spec);
+}
+
+Result<std::unique_ptr<TerrainRenderer>> makeRenderer(const RenderArgs& a) {
+  if (a.renderer == "grid") {
+    STRATA_TRY(auto r, GridRenderer::create());
+    return std::unique_ptr<TerrainRenderer>(std::move(r));
+  }
+  if (a.renderer == "sliding") {
+    STRATA_TRY(auto r, SlidingGridRenderer::create());
+    return std::unique_ptr<TerrainRenderer>(std::move(r));
+  }
+  if (a.renderer != "ring") return fail("--renderer '" + a.renderer + "': expected ring, sliding or grid");
+  STRATA_TRY(auto r, RingRenderer::create({.circles = a.circles}));
+  return std::unique_ptr<TerrainRenderer>(std::move(r));
+}
+
+// Replaces the one printf-style integer field of `pattern` (e.g. frame_%04d.png) with `i`.
+Result<std::string> frameName(const std::string& pattern, int i) {
+  const auto pos = pattern.find('%');
+  const auto end = pattern.find('d', pos == std::string::npos ? 0 : pos);
+  if (pos == std::string::npos || end == std::string::npos || pattern.find('%', pos + 1) != std::string::npos ||
+      pattern.find_first_not_of("0123456789", pos + 1) != end) {
+    return fail("-o '" + pattern + "': with --path it needs one integer field such as frame_%04d.png");
+  }
+  std::vector<char> buf(pattern.size() + 32);
+  std::snprintf(buf.data(), buf.size(), pattern.c_str(), i);
+  return std::string(buf.data());
+}
+
+Status writeOutputs(const OffscreenTarget& target, const FrameGeometry& frame, const std::string& colourPath,
+                    const std::string& depthPath, const std::string& elevationPath) {
+  const int w = target.width(), h = target.height();
+  STRATA_TRY_STATUS(render::writeImage8(colourPath, w, h, 4, target.colour()));
+  if (!depthPath.empty()) {
+    // Distance along the view axis (m) from the reversed depth; NaN where nothing was drawn.
+    auto depth = target.depth();
+    for (float& d : depth) d = d > 0 ? float(frame.nearM / double(d)) : std::numeric_limits<float>::quiet_NaN();
+    STRATA_TRY_STATUS(render::writeImageFloat(depthPath, w, h, 1, depth));
+  }
+  if (!elevationPath.empty()) STRATA_TRY_STATUS(render::writeImageFloat(elevationPath, w, h, 1, target.elevation()));
+  return {};
+}
+
+void run(const RenderArgs& a) {
+  int w = 0, h = 0;
+  if (std::sscanf(a.size.c_str(), "%dx%d", &w, &h) != 2 || w < 1 || h < 1 || w > 16384 || h > 16384) {
+    die("--size '" + a.size + "': expected WxH, e.g. 1280x720");
+  }
+  if (a.height && a.agl) die("--height and --agl: give one of them");
+  Shading shading;
+  shading.exaggeration = a.exaggeration;
+  shading.seaLevelM = a.seaLevel;
+  shading.fogM = a.fogM;
+  if (a.palette == "grey") {
+    shading.palette = Palette::Grey;
+  } else if (a.palette == "rust") {
+    shading.palette = Palette::Rust;
+  } else if (a.palette != "hypsometric") {
+    die("--palette '" + a.palette + "': expected hypsometric, grey or rust");
+  }
+  if (a.planetary) shading.sky = {0, 0, 0, 1};
+
+  auto ctx = render::gl::HeadlessContext::create({.debugOutput = false});
+  if (!ctx) die(ctx.message());
+  auto dem = loadDem(a.dem);
+  if (!dem) die(dem.message());
+  auto scene = TerrainScene::create(*dem, {.planetary = a.planetary});
+  if (!scene) die(a.dem + ": " + scene.message());
+  auto renderer = makeRenderer(a);
+  if (!renderer) die(renderer.message());
+  auto target = OffscreenTarget::create(w, h);
+  if (!target) die(target.message());
+
+  // The camera: default over the DEM's centre, 1000 m above the ground.
+  const auto& c = scene->georef().transform.c;
+  CameraPose cam;
+  cam.lon = a.lon.value_or(c[0] + c[1] * scene->width() / 2.0);
+  cam.lat = a.lat.value_or(c[3] + c[5] * scene->height() / 2.0);
+  const double ground = shading.exaggeration * scene->heightAt(cam.lon, cam.lat);
+  cam.heightM = a.height ? *a.height : ground + a.agl.value_or(1000.0);
+  cam.headingDeg = a.heading;
+  cam.pitchDeg = a.pitch;
+  cam.fovYDeg = a.fov;
+
+  if (a.path.empty()) {
+    if (auto s = (*renderer)->draw(*scene, cam, shading, *target); !s) die(s.message());
+    const auto frame = frameGeometry(*scene, cam, shading, w, h);
+    if (auto s = writeOutputs(*target, frame, a.output, a.depthOut, a.elevationOut); !s) die(s.message());
+    std::printf("%s: %dx%d, %zu triangles (%s)\n", a.output.c_str(), w, h, (*renderer)->trianglesPerFrame(*scene),
+                (*renderer)->name().c_str());
+    return;
+  }
+  auto path = FlightPath::load(a.path);
+  if (!path) die(path.message());
+  if (a.frames < 2) die("--frames " + std::to_string(a.frames) + ": a flight path needs at least 2 frames");
+  for (int i = 0; i < a.frames; ++i) {
+    const CameraPose pose = path->at(double(i) / double(a.frames - 1));
+    if (auto s = (*renderer)->draw(*scene, pose, shading, *target); !s) die(s.message());
+    auto name = frameName(a.output, i);
+    if (!name) die(name.message());
+    auto depthName = a.depthOut.empty() ? Result<std::string>(std::string()) : frameName(a.depthOut, i);
+    auto elevName = a.elevationOut.empty() ? Result<std::string>(std::string()) : frameName(a.elevationOut, i);
+    if (!depthName) die(depthName.message());
+    if (!elevName) die(elevName.message());
+    const auto frame = frameGeometry(*scene, pose, shading, w, h);
+    if (auto s = writeOutputs(*target, frame, *name, *depthName, *elevName); !s) die(s.message());
+  }
+  std::printf("%d frames %dx%d along %s\n", a.frames, w, h, a.path.c_str());
+}
+
+}  // namespace
+
+void addRenderCommand(CLI::App& app) {
+  auto a = std::make_shared<RenderArgs>();
+  auto* cmd = app.add_subcommand("render", "Render a DEM offscreen to PNG (and EXR depth/elevation)");
+  cmd->add_option("dem", a->dem, "DEM file, or synthetic:SIZE[:SEED] for a generated terrain")->required();
+  cmd->add_option("-o,--output", a->output, "Colour PNG (with --path: a pattern such as frame_%04d.png)");
+  cmd->add_option("--depth", a->depthOut, "Also write the distance along the view axis (m) to this EXR");
+  cmd->add_option("--elevation", a->elevationOut, "Also write the rendered elevation (m) to this EXR");
+  cmd->add_option("--lon", a->lon, "Camera longitude (deg); easting (m) for projected DEMs; default: DEM centre");
+  cmd->add_option("--lat", a->lat, "Camera latitude (deg); northing (m) for projected DEMs; default: DEM centre");
+  cmd->add_option("--height", a->height, "Camera height above the datum (m)");
+  cmd->add_option("--agl", a->agl, "Camera height above the ground (m; default 1000)");
+  cmd->add_option("--heading", a->heading, "View direction, clockwise from north (deg)");
+  cmd->add_option("--pitch", a->pitch, "View direction above the horizontal (deg; negative looks down)")
+      ->check(CLI::Range(-90.0, 90.0));
+  cmd->add_option("--fov", a->fov, "Vertical field of view (deg)")->check(CLI::Range(1.0, 170.0));
+  cmd->add_option("--size", a->size, "Image size WxH");
+  cmd->add_option("--renderer", a->renderer,
+                  "ring (concentric rings), sliding (sliding sampling grid) or grid (brute-force full grid)");
+  cmd->add_option("--circles", a->circles, "Ring renderer: circles (6n^2 triangles)")->check(CLI::Range(1, 2048));
+  cmd->add_flag("--planetary", a->planetary, "Draw on the body's ellipsoid (geographic DEMs)");
+  cmd->add_option("--exaggeration", a->exaggeration, "Vertical exaggeration");
+  cmd->add_option("--sea-level", a->seaLevel, "Water wherever the terrain is below this elevation (m)");
+  cmd->add_option("--palette", a->palette, "hypsometric, grey or rust");
+  cmd->add_option("--fog", a->fogM, "Haze distance (m); 0: none");
+  cmd->add_option("--path", a->path, "Keyframe file (lon lat height heading pitch [fov] per line)");
+  cmd->add_option("--frames", a->frames, "Frames to render along --path");
+  cmd->callback([a] { run(*a); });
+}
+
+}  // namespace strata::app

@@ -1,0 +1,225 @@
+#pragma once
+// Terrain renderers behind one interface: the concentric-ring renderer (RingRenderer, the fixed
+// polar mesh displaced in the vertex shader) and the brute-force full grid (GridRenderer, the
+// reference); the sliding sampling grid (sliding_grid.hpp) is the third. All draw a TerrainScene
+// (a DEM on the GPU) seen from a CameraPose into an OffscreenTarget (colour RGBA8, reversed-Z
+// float depth, elevation r32f). The maths: docs/render-rings.md.
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include <strata/core/result.hpp>
+#include <strata/gis/raster.hpp>
+#include <strata/render/gl/objects.hpp>
+#include <strata/render/terrain/ring_mesh.hpp>
+
+namespace strata::render::terrain {
+
+/// Where the viewer is and where it looks.
+struct CameraPose {
+  double lon = 0;         ///< geographic DEM: longitude (deg); projected DEM: easting in the CRS (m)
+  double lat = 0;         ///< geographic DEM: latitude (deg); projected DEM: northing in the CRS (m)
+  double heightM = 1000;  ///< above the datum (planetary: above the body's ellipsoid) (m)
+  double headingDeg = 0;  ///< view direction, clockwise from north (deg)
+  double pitchDeg = -30;  ///< view direction above the horizontal (deg; negative looks down)
+  double fovYDeg = 45;    ///< vertical field of view (deg)
+};
+
+/// Colour ramp over elevation.
+enum class Palette { Hypsometric, Grey, Rust };
+
+/// How the terrain looks; uniform over a frame.
+struct Shading {
+  Palette palette = Palette::Hypsometric;  ///< elevation tint
+  std::optional<glm::vec2> tintRangeM;     ///< elevations at the tint's ends (m); default: the scene's
+                                           ///< range, from sea level up when seaLevelM is set
+  float exaggeration = 1;                  ///< vertical exaggeration
+  glm::vec3 sunDir = glm::normalize(glm::vec3(-0.5f, 0.4f, 0.6f));  ///< towards the sun, viewer's ENU frame
+  glm::vec4 sky{0.62f, 0.74f, 0.88f, 1.0f};                         ///< background and haze colour
+  float fogM = 0;                                                   ///< haze distance (m); 0: none
+  std::optional<float> seaLevelM;                                   ///< water wherever the terrain is below (m)
+  float waterDepthScaleM = 20;  ///< depth at which water is 1/e of the way to deep blue (m)
+  float layerOpaqueM = 0.5f;    ///< thickness at which a layer hides 1/e of what is below (m)
+  std::array<glm::vec3, 4> layerColours{glm::vec3(0.76f, 0.70f, 0.50f), glm::vec3(0.45f, 0.35f, 0.25f),
+                                        glm::vec3(0.30f, 0.45f, 0.20f), glm::vec3(0.9f, 0.9f, 0.95f)};
+};
+
+/// How a DEM is drawn.
+struct SceneOptions {
+  /// Draw on the DEM's body (its ellipsoid: a sphere when the flattening is 0) instead of a
+  /// tangent plane. Needs a geographic DEM.
+  bool planetary = false;
+};
+
+/// A DEM on the GPU (r32f, full mip chain) plus the CPU copy for height queries. No data is
+/// filled with the lowest valid elevation.
+class TerrainScene {
+ public:
+  static Result<TerrainScene> create(const gis::Raster& dem, const SceneOptions& options = {});
+
+  /// Water depth (m) over the terrain, same grid as the DEM.
+  Status setWaterDepth(const gis::Grid<float>& depthM);
+  /// Thicknesses (m) of up to four material layers (bottom first), same grid as the DEM;
+  /// drawn with Shading::layerColours.
+  Status setMaterialLayers(const std::vector<gis::Grid<float>>& thicknessM);
+
+  /// Elevation (m) at a camera position (lon/lat or easting/northing as in CameraPose),
+  /// bilinear between texel centres, clamped at the edges.
+  double heightAt(double lon, double lat) const;
+  /// The elevation of the full-grid reference surface (two triangles per cell, split along the
+  /// cell's main diagonal, as GridRenderer draws it) at texture coordinates (u, v).
+  double gridSurfaceAt(double u, double v) const;
+
+  const gis::Georef& georef() const { return georef_; }
+  const gis::Grid<float>& heights() const { return heights_; }
+  bool planetary() const { return planetary_; }
+  float minElevationM() const { return minM_; }
+  float maxElevationM() const { return maxM_; }
+  int width() const { return heights_.width; }
+  int height() const { return heights_.height; }
+  /// Radius of the body (m) used for the local frame and planetary mode.
+  double radiusM() const { return georef_.body.semiMajorM; }
+
+  const gl::Texture& heightTexture() const { return height_; }
+  const gl::Texture* waterTexture() const { return water_ ? &water_ : nullptr; }
+  const gl::Texture* layerTexture() const { return layers_ ? &layers_ : nullptr; }
+
+ private:
+  gis::Georef georef_;
+  gis::Grid<float> heights_;
+  bool planetary_ = false;
+  float minM_ = 0, maxM_ = 0;
+  gl::Texture height_, water_, layers_;
+};
+
+/// Everything the shaders need about one frame's view, computed in double on the CPU.
+struct FrameGeometry {
+  glm::dmat4 view{1.0};             ///< viewer-relative ENU -> eye (rotation only)
+  glm::dmat4 projection{1.0};       ///< reversed-Z infinite perspective (depth 1 at near, 0 at infinity)
+  double nearM = 1;                 ///< near plane distance (m)
+  double groundM = 0;               ///< elevation under the viewer (m, exaggerated)
+  double heightAboveGroundM = 0;    ///< h (m)
+  glm::dvec2 uvCam{0};              ///< texture coordinates under the viewer
+  glm::dvec2 uvPerMetre{0};         ///< planar: d(u, v) / d(east, north)
+  double camZ = 0;                  ///< planar: viewer z (m); planetary: height above the ellipsoid (m)
+  double lonRad = 0, latRad = 0;    ///< planetary: the viewer's nadir (geodetic latitude)
+  double reducedLatRad = 0;         ///< planetary: the nadir's reduced latitude, atan((1 - f) tan(lat))
+  glm::dvec3 poleAux{0, 0, 1};      ///< planetary: polar axis in the auxiliary sphere's nadir frame
+  glm::dvec3 nadirNormal{0, 0, 1};  ///< planetary: ellipsoid normal at the nadir, same frame
+  glm::dmat3 frameRot{1.0};         ///< planetary: that frame -> the viewer's ENU frame (normal up)
+  double farthestM = 0;             ///< planar: distance to the DEM's farthest corner (m)
+  glm::dmat4 viewProj() const { return projection * view; }
+};
+
+/// Builds a frame's geometry for a `width` x `height` image.
+FrameGeometry frameGeometry(const TerrainScene& scene, const CameraPose& camera, const Shading& shading, int width,
+                            int height);
+
+/// Reversed-Z infinite perspective: clip z = near, w = -z_eye (depth = near / distance along the axis).
+glm::dmat4 reversedInfinitePerspective(double fovYRad, double aspect, double nearM);
+
+/// An offscreen framebuffer: colour RGBA8, elevation r32f (m, NaN where no terrain), depth
+/// 32F (reversed: 1 at the near plane, 0 = nothing drawn).
+class OffscreenTarget {
+ public:
+  static Result<OffscreenTarget> create(int width, int height);
+  int width() const { return width_; }
+  int height() const { return height_; }
+  void bind() const;
+  /// Clears colour to `sky`, depth to 0 and elevation to NaN.
+  void clear(const glm::vec4& sky) const;
+  /// Pixels, top row first.
+  std::vector<uint8_t> colour() const;
+  std::vector<float> depth() const;
+  std::vector<float> elevation() const;
+
+ private:
+  int width_ = 0, height_ = 0;
+  gl::Texture colour_, elevation_, depth_;
+  gl::Framebuffer fbo_;
+};
+
+/// A terrain renderer. draw() clears `target` and draws the scene.
+class TerrainRenderer {
+ public:
+  virtual ~TerrainRenderer() = default;
+  virtual std::string name() const = 0;
+  /// `observer`: if given, a viewer-relative -> clip matrix that replaces the camera's own
+  /// (the terrain is still laid out around `camera`); the undulation test looks at the rings
+  /// from a fixed orthographic observer this way.
+  virtual Status draw(const TerrainScene& scene, const CameraPose& camera, const Shading& shading,
+                      const OffscreenTarget& target, const glm::dmat4* observer = nullptr) = 0;
+  /// Triangles submitted per frame for `scene`.
+  virtual size_t trianglesPerFrame(const TerrainScene& scene) const = 0;
+};
+
+/// The concentric-ring renderer's parameters.
+struct RingParams {
+  int circles = 128;        ///< n: the mesh has 6n^2 triangles
+  double softFactor = 5;    ///< f(h) = max(softFactor * h, softMinM): the softened viewer height
+  double softMinM = 50;     ///< (m)
+  double rangeM = 0;        ///< planar: radius of the disc (m); 0: to the DEM's farthest corner
+  int maxSamples = 8;       ///< cap on the elevation samples per vertex
+  bool multiSample = true;  ///< average several samples between neighbouring circles
+  bool mipSelect = true;    ///< pick the MIP level from the circle spacing
+};
+
+/// Per-frame ring layout (what ring.vert gets), computed on the CPU; exposed for tests.
+struct RingLayout {
+  double softHeightM = 0;    ///< H = f(h)
+  double alphaMax = 0;       ///< half-angle of the cap seen from the softened viewpoint (rad)
+  double firstSpacingM = 0;  ///< radius of circle 1 (m)
+  double texelM = 0;         ///< texel size of level 0 (m)
+  /// Distance from the nadir of the circle at normalised radius rho (metres; of arc when planetary).
+  double radiusAt(double rho, bool planetary, double radiusM) const;
+};
+
+/// The concentric-ring renderer: the RingMesh, built once, placed around the viewer by ring.vert.
+class RingRenderer final : public TerrainRenderer {
+ public:
+  /// Compiles the shaders and uploads the mesh; fails on out-of-range parameters.
+  static Result<std::unique_ptr<RingRenderer>> create(const RingParams& params = {});
+  std::string name() const override { return "ring"; }
+  Status draw(const TerrainScene& scene, const CameraPose& camera, const Shading& shading,
+              const OffscreenTarget& target, const glm::dmat4* observer = nullptr) override;
+  size_t trianglesPerFrame(const TerrainScene&) const override { return RingMesh::triangleCount(params_.circles); }
+  const RingParams& params() const { return params_; }
+  /// The layout draw() uses for this frame.
+  RingLayout layout(const TerrainScene& scene, const FrameGeometry& frame) const;
+
+ private:
+  RingParams params_;
+  gl::Program program_;
+  gl::VertexArray vao_;
+  gl::Buffer vertices_, indices_;
+  GLsizei indexCount_ = 0;
+};
+
+/// The brute-force reference: every texel of level 0 a vertex, two triangles per cell. Planar
+/// scenes only.
+class GridRenderer final : public TerrainRenderer {
+ public:
+  /// Compiles the shaders; the index buffer is built for each scene size on first draw.
+  static Result<std::unique_ptr<GridRenderer>> create();
+  std::string name() const override { return "grid"; }
+  Status draw(const TerrainScene& scene, const CameraPose& camera, const Shading& shading,
+              const OffscreenTarget& target, const glm::dmat4* observer = nullptr) override;
+  size_t trianglesPerFrame(const TerrainScene& scene) const override {
+    return 2 * size_t(scene.width() - 1) * size_t(scene.height() - 1);
+  }
+
+ private:
+  gl::Program program_;
+  gl::VertexArray vao_;
+  gl::Buffer indices_;
+  int gridW_ = 0, gridH_ = 0;
+  GLsizei indexCount_ = 0;
+};
+
+}  // namespace strata::render::terrain

@@ -1,0 +1,26 @@
+#pragma once
+// Private to the terrain renderers: the per-frame GL state and the uniforms every terrain
+// shader shares (shaders/terrain/terrain_common.glsl).
+
+#include <strata/render/terrain/terrain_renderer.hpp>
+
+namespace strata::render::terrain::detail {
+
+/// Binds the target and sets the reversed-Z state; restores the previous framebuffer and the
+/// default depth convention on destruction so other GL users are not surprised.
+class FrameState {
+ public:
+  FrameState(const OffscreenTarget& target, const glm::vec4& sky);
+  ~FrameState();
+  FrameState(const FrameState&) = delete;
+  FrameState& operator=(const FrameState&) = delete;
+
+ private:
+  GLint previous_ = 0;
+};
+
+/// Sets terrain_common.glsl's and terrain.frag's uniforms and binds the scene's textures.
+void setCommonUniforms(const gl::Program& p, const TerrainScene& scene, const FrameGeometry& frame,
+                       const Shading& shading, const glm::dmat4& viewProj);
+
+}  // namespace strata::render::terrain::detail
