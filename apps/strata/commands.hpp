@@ -6,5 +6,6 @@
 namespace strata::app {
 
 void addGpuInfoCommand(CLI::App& app);
+void addCheckCommand(CLI::App& app);
 
 }  // namespace strata::app

@@ -212,7 +212,11 @@ Result<DecodedPtr> loadTileLevel(const fs::path& dir, const std::vector<std::str
   return DecodedPtr(std::move(d));
 }
 
-Status writeFileAtomic(const fs::path& path, const char* data, size_t size) {
+// Writes `path` through a temporary and a rename, so the name never shows a partial file. With
+// `sync`, the data is on disk before the rename; tile files skip that (one fsync per tile would
+// dominate an ingest) because commit() flushes the whole file system before the manifest that
+// names them is renamed into place.
+Status writeFileAtomic(const fs::path& path, const char* data, size_t size, bool sync) {
   fs::path tmp = path;
   tmp += ".tmp";
   const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
@@ -228,18 +232,20 @@ Status writeFileAtomic(const fs::path& path, const char* data, size_t size) {
     }
     done += size_t(n);
   }
-  // fsync before the rename: the name must never point at data that is not on disk yet.
-  if (::fsync(fd) != 0 || ::close(fd) != 0) return fail(tmp.string() + ": fsync/close failed: " + std::strerror(errno));
+  if ((sync && ::fsync(fd) != 0) || ::close(fd) != 0) {
+    return fail(tmp.string() + ": fsync/close failed: " + std::strerror(errno));
+  }
   if (::rename(tmp.c_str(), path.c_str()) != 0) {
     return fail(path.string() + ": rename from temporary failed: " + std::strerror(errno));
   }
   return {};
 }
 
-void syncDir(const fs::path& dir) {
+// fsync of a folder (its entries), or syncfs of its whole file system.
+void syncDir(const fs::path& dir, bool wholeFileSystem) {
   const int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
   if (fd >= 0) {
-    ::fsync(fd);
+    wholeFileSystem ? ::syncfs(fd) : ::fsync(fd);
     ::close(fd);
   }
 }
@@ -397,7 +403,7 @@ struct TileStore::Impl {
     const uint64_t gen = man.nextGeneration++;
     const std::string file =
         "tiles/x" + std::to_string(tx) + "_y" + std::to_string(ty) + "_g" + std::to_string(gen) + ".exr";
-    STRATA_TRY_STATUS(writeFileAtomic(dir / file, bytes.data(), bytes.size()));
+    STRATA_TRY_STATUS(writeFileAtomic(dir / file, bytes.data(), bytes.size(), false));
     r.present = true;
     r.exp = exp;
     r.generation = gen;
@@ -679,10 +685,11 @@ Status TileStore::reevaluate() {
 Status TileStore::commit() {
   auto& I = *impl_;
   const fs::path tiles = I.dir / "tiles";
-  syncDir(tiles);  // the renames of the tile files first, then the manifest naming them
+  // The tile files' data and names reach the disk before the manifest that names them.
+  syncDir(tiles, true);
   const std::string text = detail::manifestToToml(I.man);
-  STRATA_TRY_STATUS(writeFileAtomic(I.dir / detail::kManifestName, text.data(), text.size()));
-  syncDir(I.dir);
+  STRATA_TRY_STATUS(writeFileAtomic(I.dir / detail::kManifestName, text.data(), text.size(), true));
+  syncDir(I.dir, false);
   // Superseded tiles, and leftovers of writers that died before their commit.
   std::set<std::string> live;
   for (const auto& r : I.man.tiles) {

@@ -1,0 +1,257 @@
+// The store on real DEMs (Grand Canyon, Mount Rainier) and a synthetic scene: resolution maps,
+// memory saved against dense storage, exact reads in complex tiles, and ingest memory bounded by
+// the tile size rather than the input size.
+#include <gtest/gtest.h>
+
+#include <OpenImageIO/imagebuf.h>
+#include <OpenImageIO/imageio.h>
+
+#include <malloc.h>
+
+#include <cmath>
+#include <fstream>
+#include <set>
+
+#include <strata/terrain/ingest.hpp>
+#include <strata/terrain/synthetic.hpp>
+#include <strata/terrain/tile_store.hpp>
+
+#include "strata_test.hpp"
+
+namespace strata::terrain {
+namespace {
+
+namespace fs = std::filesystem;
+using gis::Grid;
+
+// Pixel values of a single-band GeoTIFF (through OpenImageIO, which ignores the georeference;
+// the values are all these tests need). int16 nodata -32768 becomes NaN.
+Grid<float> readPixels(const std::string& path) {
+  auto in = OIIO::ImageInput::open(path);
+  STRATA_CHECK(in) << path << ": " << OIIO::geterror();
+  const auto& spec = in->spec();
+  Grid<float> g(spec.width, spec.height);
+  if (spec.format == OIIO::TypeDesc::INT16) {
+    std::vector<int16_t> raw(g.size());
+    STRATA_CHECK(in->read_image(0, 0, 0, 1, OIIO::TypeDesc::INT16, raw.data())) << path;
+    for (size_t i = 0; i < raw.size(); ++i) g.data[i] = raw[i] == -32768 ? gis::kNoData : float(raw[i]);
+  } else {
+    STRATA_CHECK(in->read_image(0, 0, 0, 1, OIIO::TypeDesc::FLOAT, g.data.data())) << path;
+  }
+  return g;
+}
+
+// The shared data folder. STRATA_DATA_DIR is compiled into this test binary; dataFile()
+// lives in the support library, which is built without it and falls back to a relative path.
+std::string dataFile(const std::string& relative) { return std::string(STRATA_DATA_DIR) + "/" + relative; }
+
+WindowReader gridReader(const Grid<float>& src) {
+  return [&src](int x0, int y0, int w, int h) -> Result<Grid<float>> {
+    Grid<float> g(w, h);
+    for (int y = 0; y < h; ++y) std::copy_n(&src.data[src.index(x0, y0 + y)], w, &g.data[g.index(0, y)]);
+    return g;
+  };
+}
+
+gis::Georef gridGeoref(int w, int h) {
+  gis::Georef g;
+  g.epsg = 4326;
+  g.crsName = "WGS 84";
+  g.geographic = true;
+  g.width = w;
+  g.height = h;
+  return g;
+}
+
+// Writes the tile exponents as a PNG: one `scale`-pixel block per tile, grey from black (2^min)
+// to white (2^max), red where the tile is absent.
+void writeResolutionMap(const TileStore& store, const fs::path& png, int scale) {
+  const auto map = store.resolutionMap();
+  const int lo = store.desc().metric.minExp, hi = store.desc().metric.maxExp;
+  OIIO::ImageSpec spec(map.width * scale, map.height * scale, 3, OIIO::TypeDesc::UINT8);
+  std::vector<uint8_t> px(size_t(spec.width) * size_t(spec.height) * 3);
+  for (int y = 0; y < spec.height; ++y) {
+    for (int x = 0; x < spec.width; ++x) {
+      const float e = map.at(x / scale, y / scale);
+      uint8_t* p = &px[(size_t(y) * size_t(spec.width) + size_t(x)) * 3];
+      if (std::isnan(e)) {
+        p[0] = 200, p[1] = 30, p[2] = 30;
+      } else {
+        const auto v = uint8_t(std::lround(255.0 * (e - lo) / std::max(1, hi - lo)));
+        p[0] = p[1] = p[2] = v;
+      }
+    }
+  }
+  auto out = OIIO::ImageOutput::create(png.string());
+  STRATA_CHECK(out && out->open(png.string(), spec)) << png;
+  STRATA_CHECK(out->write_image(OIIO::TypeDesc::UINT8, px.data())) << png;
+  out->close();
+}
+
+// The same number of metric bins as the seed's 2^5..2^10 (six), on tiles small enough that a
+// 512 x 512 DEM has 8 x 8 of them.
+IngestOptions realDataOptions() {
+  IngestOptions o;
+  o.metric = {1, 6};
+  o.cache.prefetch = false;
+  return o;
+}
+
+void report(const std::string& name, const TileStore& store) {
+  const auto fp = store.footprintStats();
+  std::ofstream(test::outputDir("terrain") / "memory_saved.txt", std::ios::app)
+      << name << ": " << store.width() << "x" << store.height() << " cells, tiles of " << store.footprint() << ", 2^"
+      << store.desc().metric.minExp << "..2^" << store.desc().metric.maxExp << ": stored " << fp.storedSamples << " of "
+      << fp.denseSamples << " samples, " << 100.0 * fp.savedFraction() << "% saved; with mips "
+      << 100.0 * (1.0 - double(fp.storedWithMips) / double(fp.denseSamples)) << "% saved; files " << fp.fileBytes
+      << " B vs " << fp.denseSamples * 4 << " B dense float32\n";
+  std::cout << name << ": " << 100.0 * fp.savedFraction() << "% saved against dense\n";
+}
+
+TEST(StoreOnRealData, GrandCanyonResolutionFollowsTheCanyon) {
+  const auto dem = readPixels(dataFile("grand_canyon/grand_canyon_512.tif"));
+  ASSERT_EQ(dem.width, 512);
+  const auto dir = test::tempDir("gc");
+  auto rep = ingest(dir, gridGeoref(dem.width, dem.height), {{{"bedrock", LayerKind::Bedrock, ""}, gridReader(dem)}},
+                    realDataOptions());
+  ASSERT_TRUE(rep) << rep.message();
+  auto store = TileStore::open(dir, realDataOptions().cache);
+  ASSERT_TRUE(store);
+  writeResolutionMap(*store, test::outputDir("terrain") / "grand_canyon_resolution.png", 32);
+  report("grand_canyon_512", *store);
+  // The tile with the largest relief gets a high exponent and the flattest the lowest, and the
+  // map uses several levels (a canyon cut into plateaus is not uniform).
+  std::set<int> exps;
+  float maxRange = -1, minRange = 1e9f;
+  int expAtMax = 0, expAtMin = 0;
+  for (int ty = 0; ty < store->tilesY(); ++ty) {
+    for (int tx = 0; tx < store->tilesX(); ++tx) {
+      const auto& t = store->tile(tx, ty);
+      exps.insert(t.exp);
+      const float r = t.maxV[0] - t.minV[0];
+      if (r > maxRange) maxRange = r, expAtMax = t.exp;
+      if (r < minRange) minRange = r, expAtMin = t.exp;
+    }
+  }
+  EXPECT_GE(exps.size(), 3u);
+  EXPECT_GT(expAtMax, expAtMin);
+  const auto [lo, hi] = store->globalRange(0);
+  EXPECT_EQ(expAtMax, chooseTileExp({maxRange}, {hi - lo}, 1, 6));
+  // Full-resolution reads give each tile's box means of the source, replicated: no tile of the
+  // Grand Canyon spans 5/6 of its 2265 m range, so none is stored at 2^6.
+  auto all = store->readWindow(0, {0, 0, 512, 512}, 0);
+  ASSERT_TRUE(all);
+  for (int ty = 0; ty < 8; ++ty) {
+    for (int tx = 0; tx < 8; ++tx) {
+      const int k = 64 >> store->tile(tx, ty).exp;
+      for (int y = ty * 64; y < ty * 64 + 64; y += k) {
+        for (int x = tx * 64; x < tx * 64 + 64; x += k) {
+          double sum = 0;
+          for (int yy = 0; yy < k; ++yy) {
+            for (int xx = 0; xx < k; ++xx) sum += dem.at(x + xx, y + yy);
+          }
+          // float32 mean of up to 1024 values near 2000 m: within 1e-3 m of the double mean
+          // (the sum is accumulated in double; one final rounding of ~1e-4 m).
+          ASSERT_NEAR(all->at(x + k - 1, y + k - 1), sum / (k * k), 1e-3) << x << "," << y;
+        }
+      }
+    }
+  }
+}
+
+TEST(StoreOnRealData, RainierAndASyntheticSceneSaveMemory) {
+  const auto dem = readPixels(dataFile("rainier/mt_rainier_90m.tif"));
+  ASSERT_EQ(dem.width, 1201);
+  const auto dir = test::tempDir("rainier");
+  ASSERT_TRUE(ingest(dir, gridGeoref(dem.width, dem.height), {{{"bedrock", LayerKind::Bedrock, ""}, gridReader(dem)}},
+                     realDataOptions()));
+  auto store = TileStore::open(dir, realDataOptions().cache);
+  ASSERT_TRUE(store);
+  writeResolutionMap(*store, test::outputDir("terrain") / "rainier_resolution.png", 16);
+  report("rainier_90m", *store);
+  // Rainier's edge tiles reach past the 1201-cell grid: those cells must read as no data.
+  auto edge = store->readWindow(0, {1199, 1199, 4, 4}, 0);
+  ASSERT_TRUE(edge);
+  EXPECT_FALSE(std::isnan(edge->at(1, 1)));
+  EXPECT_TRUE(std::isnan(edge->at(2, 1)));
+  EXPECT_TRUE(std::isnan(edge->at(1, 2)));
+
+  SyntheticScene s;  // the benchmark's scene at 2048^2: 20% rough, 30% ramps, 50% flat blocks
+  s.blockCells = 64;
+  const auto sdir = test::tempDir("synthetic");
+  ASSERT_TRUE(ingest(sdir, gridGeoref(2048, 2048), {{{"bedrock", LayerKind::Bedrock, ""}, syntheticReader(s)}},
+                     realDataOptions()));
+  auto syn = TileStore::open(sdir, realDataOptions().cache);
+  ASSERT_TRUE(syn);
+  report("synthetic_2048", *syn);
+  // Rough blocks stay at 2^6 (4096 samples), ramps at 2^2 (16: 30% of the amplitude is bin 1 of
+  // 6), flat blocks at 2^1 (4): the saving is 1 - E[samples]/4096 over the block mix.
+  double expect = 0;
+  for (int by = 0; by < 32; ++by) {
+    for (int bx = 0; bx < 32; ++bx) {
+      const auto k = syntheticBlockKind(s, bx, by);
+      expect += k == SyntheticBlock::Rough ? 4096 : k == SyntheticBlock::Ramp ? 16 : 4;
+    }
+  }
+  EXPECT_DOUBLE_EQ(syn->footprintStats().savedFraction(), 1.0 - expect / (2048.0 * 2048.0));
+}
+
+// Peak resident memory of this process (kB), since the last resetPeak().
+long peakRssKb() {
+  std::ifstream in("/proc/self/status");
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.rfind("VmHWM:", 0) == 0) return std::stol(line.substr(6));
+  }
+  return -1;
+}
+long rssKb() {
+  std::ifstream in("/proc/self/status");
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.rfind("VmRSS:", 0) == 0) return std::stol(line.substr(6));
+  }
+  return -1;
+}
+void resetPeak() { std::ofstream("/proc/self/clear_refs") << "5"; }
+
+TEST(Ingest, PeakMemoryIsBoundedByTheTileNotTheInput) {
+  // 4096 x 4096 float32 = 64 MiB of input, tiles of 256 cells (256 KiB per field). The ingest
+  // holds a few tiles at a time; bench/bench_store.cpp checks the same at 32768^2 (4 GiB).
+  SyntheticScene s;
+  s.blockCells = 256;
+  const auto dir = test::tempDir("big");
+  IngestOptions o;
+  o.metric = {3, 8};
+  o.cache.prefetch = false;
+  malloc_trim(0);  // hand freed heap back, so that reuse of it cannot hide the ingest's growth
+  resetPeak();
+  const long before = rssKb();
+  auto rep = ingest(dir, gridGeoref(4096, 4096), {{{"bedrock", LayerKind::Bedrock, ""}, syntheticReader(s)}}, o);
+  ASSERT_TRUE(rep) << rep.message();
+  const long grewKb = peakRssKb() - before;
+  std::cout << "ingest of 64 MiB: peak RSS grew by " << grewKb << " kB\n";
+  // 1/8 of the input (8 MiB = 32 tiles' worth) is far above what a tile-at-a-time ingest needs
+  // and far below a whole-input copy.
+  EXPECT_LT(grewKb, 64 * 1024 / 8);
+  // Complex tiles read back cell for cell at full resolution.
+  auto store = TileStore::open(dir, o.cache);
+  ASSERT_TRUE(store);
+  int checked = 0;
+  for (int by = 0; by < 16 && checked < 4; ++by) {
+    for (int bx = 0; bx < 16 && checked < 4; ++bx) {
+      if (syntheticBlockKind(s, bx, by) != SyntheticBlock::Rough) continue;
+      ASSERT_EQ(store->tile(bx, by).exp, 8);
+      auto g = store->readWindow(0, {bx * 256, by * 256, 256, 256}, 0);
+      ASSERT_TRUE(g);
+      for (int y = 0; y < 256; ++y) {
+        for (int x = 0; x < 256; ++x) ASSERT_EQ(g->at(x, y), syntheticElevation(s, bx * 256 + x, by * 256 + y));
+      }
+      ++checked;
+    }
+  }
+  EXPECT_EQ(checked, 4);
+}
+
+}  // namespace
+}  // namespace strata::terrain
