@@ -5,6 +5,7 @@
 #include <zlib.h>
 
 #include <algorithm>
+#include <bit>
 #include <cerrno>
 #include <cmath>
 #include <condition_variable>
@@ -370,8 +371,14 @@ struct TileStore::Impl {
         STRATA_TRY(DecodedPtr d, get(tx, ty, need, true));
         const auto& g = d->fields[size_t(field)];
         for (int y = y0; y < y1; ++y) {
-          const int ly = (y - ty * tileCells) / rep;
-          for (int x = x0; x < x1; ++x) dst.at(dx + x - sx, dy + y - sy) = g.at((x - tx * tileCells) / rep, ly);
+          const float* src = &g.data[g.index(0, (y - ty * tileCells) / rep)];
+          float* out = &dst.data[dst.index(dx + x0 - sx, dy + y - sy)];
+          if (rep == 1) {
+            std::copy(src + (x0 - tx * tileCells), src + (x1 - tx * tileCells), out);
+          } else {
+            const int shift = std::countr_zero(unsigned(rep));  // rep is a power of two
+            for (int x = x0; x < x1; ++x) out[x - x0] = src[(x - tx * tileCells) >> shift];
+          }
         }
       }
     }
