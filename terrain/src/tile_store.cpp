@@ -19,6 +19,7 @@
 #include <thread>
 #include <unordered_map>
 
+#include <strata/core/files.hpp>
 #include <strata/core/log.hpp>
 
 #include "exr_codec.hpp"
@@ -213,11 +214,10 @@ Result<DecodedPtr> loadTileLevel(const fs::path& dir, const std::vector<std::str
   return DecodedPtr(std::move(d));
 }
 
-// Writes `path` through a temporary and a rename, so the name never shows a partial file. With
-// `sync`, the data is on disk before the rename; tile files skip that (one fsync per tile would
-// dominate an ingest) because commit() flushes the whole file system before the manifest that
-// names them is renamed into place.
-Status writeFileAtomic(const fs::path& path, const char* data, size_t size, bool sync) {
+// Writes a tile file through a temporary and a rename, so its name never shows a partial file.
+// No fsync per tile (it would dominate an ingest): commit() flushes the whole file system before
+// the manifest that names the new tiles is renamed into place.
+Status writeTileFile(const fs::path& path, const char* data, size_t size) {
   fs::path tmp = path;
   tmp += ".tmp";
   const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
@@ -233,9 +233,7 @@ Status writeFileAtomic(const fs::path& path, const char* data, size_t size, bool
     }
     done += size_t(n);
   }
-  if ((sync && ::fsync(fd) != 0) || ::close(fd) != 0) {
-    return fail(tmp.string() + ": fsync/close failed: " + std::strerror(errno));
-  }
+  if (::close(fd) != 0) return fail(tmp.string() + ": close failed: " + std::strerror(errno));
   if (::rename(tmp.c_str(), path.c_str()) != 0) {
     return fail(path.string() + ": rename from temporary failed: " + std::strerror(errno));
   }
@@ -410,7 +408,7 @@ struct TileStore::Impl {
     const uint64_t gen = man.nextGeneration++;
     const std::string file =
         "tiles/x" + std::to_string(tx) + "_y" + std::to_string(ty) + "_g" + std::to_string(gen) + ".exr";
-    STRATA_TRY_STATUS(writeFileAtomic(dir / file, bytes.data(), bytes.size(), false));
+    STRATA_TRY_STATUS(writeTileFile(dir / file, bytes.data(), bytes.size()));
     r.present = true;
     r.exp = exp;
     r.generation = gen;
@@ -695,7 +693,7 @@ Status TileStore::commit() {
   // The tile files' data and names reach the disk before the manifest that names them.
   syncDir(tiles, true);
   const std::string text = detail::manifestToToml(I.man);
-  STRATA_TRY_STATUS(writeFileAtomic(I.dir / detail::kManifestName, text.data(), text.size(), true));
+  STRATA_TRY_STATUS(writeFileAtomic(I.dir / detail::kManifestName, text));
   syncDir(I.dir, false);
   // Superseded tiles, and leftovers of writers that died before their commit.
   std::set<std::string> live;
@@ -705,6 +703,9 @@ Status TileStore::commit() {
   std::error_code ec;
   for (const auto& e : fs::directory_iterator(tiles, ec)) {
     if (!live.count(e.path().filename().string())) fs::remove(e.path(), ec);
+  }
+  for (const auto& e : fs::directory_iterator(I.dir, ec)) {
+    if (e.path().filename().string().rfind(std::string(detail::kManifestName) + ".tmp", 0) == 0) fs::remove(e.path(), ec);
   }
   return {};
 }

@@ -79,7 +79,8 @@ using Status = Result<void>;
 
 }  // namespace strata
 
-/// Propagates an error: `STRATA_TRY(auto dem, readDem(path));`
+/// Propagates an error: `STRATA_TRY(auto dem, readDem(path));` or `STRATA_TRY(existing, expr);`.
+/// It expands to several statements: under an `if`, put it in braces.
 #define STRATA_TRY_CONCAT_(a, b) a##b
 #define STRATA_TRY_NAME_(line) STRATA_TRY_CONCAT_(strata_try_result_, line)
 #define STRATA_TRY(decl, expr)                                                \

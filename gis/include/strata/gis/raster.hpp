@@ -27,10 +27,10 @@ struct GeoTransform {
 
 /// Where a raster lies: CRS, geotransform, size, and the body it lives on.
 struct Georef {
-  std::string crsWkt;          ///< WKT2 of the horizontal CRS (empty: none)
-  std::optional<int> epsg;     ///< EPSG code when the CRS has one
-  std::string crsName;         ///< e.g. "WGS 84", "WGS 84 / Pseudo-Mercator"
-  bool geographic = false;     ///< lon/lat degrees (true) or projected metres (false)
+  std::string crsWkt;       ///< WKT2 of the horizontal CRS (empty: none)
+  std::optional<int> epsg;  ///< EPSG code when the CRS has one
+  std::string crsName;      ///< e.g. "WGS 84", "WGS 84 / Pseudo-Mercator"
+  bool geographic = false;  ///< lon/lat degrees (true) or projected metres (false)
   GeoTransform transform;
   int width = 0, height = 0;
   Body body = Body::wgs84();

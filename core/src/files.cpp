@@ -1,0 +1,54 @@
+#include <strata/core/files.hpp>
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+
+namespace strata {
+
+std::filesystem::path temporaryPathFor(const std::filesystem::path& target) {
+  static std::atomic<int> counter{0};
+  auto tmp = target;
+  tmp += ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
+  return tmp;
+}
+
+Status commitTemporary(const std::filesystem::path& temporary, const std::filesystem::path& target) {
+  const int fd = ::open(temporary.c_str(), O_RDONLY);
+  if (fd < 0)
+    return fail(target.string() + ": cannot reopen temporary " + temporary.string() + ": " + std::strerror(errno));
+  const bool synced = ::fsync(fd) == 0;
+  ::close(fd);
+  if (!synced || std::rename(temporary.c_str(), target.c_str()) != 0) {
+    const std::string why = std::strerror(errno);
+    std::error_code ec;
+    std::filesystem::remove(temporary, ec);
+    return fail(target.string() + ": cannot write: " + why);
+  }
+  // Make the rename itself durable.
+  if (const int dir = ::open(target.parent_path().empty() ? "." : target.parent_path().c_str(), O_RDONLY); dir >= 0) {
+    ::fsync(dir);
+    ::close(dir);
+  }
+  return {};
+}
+
+Status writeFileAtomic(const std::filesystem::path& target, std::string_view content) {
+  const auto tmp = temporaryPathFor(target);
+  FILE* f = std::fopen(tmp.c_str(), "wb");
+  if (!f) return fail(target.string() + ": cannot write: " + std::strerror(errno));
+  const bool ok = std::fwrite(content.data(), 1, content.size(), f) == content.size();
+  const bool closed = std::fclose(f) == 0;
+  if (!ok || !closed) {
+    std::error_code ec;
+    std::filesystem::remove(tmp, ec);
+    return fail(target.string() + ": cannot write (disk full?)");
+  }
+  return commitTemporary(tmp, target);
+}
+
+}  // namespace strata

@@ -1,0 +1,90 @@
+#!/usr/bin/python3
+"""Plots a Strata run's time series (series.csv) as PNG figures with matplotlib.
+
+    plot_series.py RUN/series.csv OUTDIR
+
+Writes water.png (stored volume, cumulative inflow/rain/outflow), area.png (flooded area),
+balance.png (volume balance error) and, when the run moved sediment, sediment.png.
+"""
+import csv
+import sys
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+
+def read(path):
+    with open(path, newline="") as f:
+        rows = list(csv.DictReader(f))
+    if not rows:
+        sys.exit(f"plot_series: {path}: no rows")
+    cols = {k: [float(r[k]) for r in rows] for k in rows[0]}
+    return cols
+
+
+def hours(cols):
+    return [t / 3600.0 for t in cols["time_s"]]
+
+
+def save(fig, out, name):
+    fig.tight_layout()
+    tmp = out / (name + ".tmp.png")
+    fig.savefig(tmp, dpi=110)
+    tmp.replace(out / (name + ".png"))
+    plt.close(fig)
+
+
+def main():
+    if len(sys.argv) != 3:
+        sys.exit(__doc__)
+    cols = read(sys.argv[1])
+    out = Path(sys.argv[2])
+    out.mkdir(parents=True, exist_ok=True)
+    t = hours(cols)
+
+    fig, ax = plt.subplots(figsize=(7, 4))
+    ax.plot(t, [v / 1e6 for v in cols["water_volume_m3"]], label="stored", lw=2)
+    for key, label in (("inflow_m3", "inflow (cumulative)"), ("rain_m3", "rain (cumulative)"),
+                       ("outflow_m3", "outflow (cumulative)"), ("evaporation_m3", "evaporated (cumulative)")):
+        if key in cols and max(cols[key]) > 0:
+            ax.plot(t, [v / 1e6 for v in cols[key]], label=label, ls="--")
+    ax.set_xlabel("time (h)")
+    ax.set_ylabel("volume (million m³)")
+    ax.set_title("Water volume")
+    ax.grid(alpha=0.3)
+    ax.legend()
+    save(fig, out, "water")
+
+    fig, ax = plt.subplots(figsize=(7, 4))
+    ax.plot(t, cols["flooded_area_km2"], color="tab:blue", lw=2)
+    ax.set_xlabel("time (h)")
+    ax.set_ylabel("flooded area (km²)")
+    ax.set_title("Flooded area (depth above the wet threshold)")
+    ax.grid(alpha=0.3)
+    save(fig, out, "area")
+
+    fig, ax = plt.subplots(figsize=(7, 4))
+    ax.plot(t, cols["balance_error_rel"], color="tab:red")
+    ax.set_xlabel("time (h)")
+    ax.set_ylabel("(in - out - stored) / in")
+    ax.set_title("Volume balance error")
+    ax.grid(alpha=0.3)
+    save(fig, out, "balance")
+
+    if "eroded_m3" in cols and max(cols["eroded_m3"]) > 0:
+        fig, ax = plt.subplots(figsize=(7, 4))
+        for key, label in (("eroded_m3", "eroded"), ("deposited_m3", "deposited"), ("sediment_m3", "in suspension")):
+            ax.plot(t, cols[key], label=label)
+        ax.set_xlabel("time (h)")
+        ax.set_ylabel("volume (m³)")
+        ax.set_title("Material moved")
+        ax.grid(alpha=0.3)
+        ax.legend()
+        save(fig, out, "sediment")
+
+
+if __name__ == "__main__":
+    main()
