@@ -705,7 +705,8 @@ Status TileStore::commit() {
     if (!live.count(e.path().filename().string())) fs::remove(e.path(), ec);
   }
   for (const auto& e : fs::directory_iterator(I.dir, ec)) {
-    if (e.path().filename().string().rfind(std::string(detail::kManifestName) + ".tmp", 0) == 0) fs::remove(e.path(), ec);
+    if (e.path().filename().string().rfind(std::string(detail::kManifestName) + ".tmp", 0) == 0)
+      fs::remove(e.path(), ec);
   }
   return {};
 }
