@@ -7,5 +7,6 @@ namespace strata::app {
 
 void addGpuInfoCommand(CLI::App& app);
 void addCheckCommand(CLI::App& app);
+void addIngestCommand(CLI::App& app);
 
 }  // namespace strata::app

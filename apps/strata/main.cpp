@@ -6,6 +6,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   strata::app::addGpuInfoCommand(app);
   strata::app::addCheckCommand(app);
+  strata::app::addIngestCommand(app);
   CLI11_PARSE(app, argc, argv);
   return 0;
 }
