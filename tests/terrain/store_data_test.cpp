@@ -196,6 +196,42 @@ TEST(StoreOnRealData, RainierAndASyntheticSceneSaveMemory) {
   EXPECT_DOUBLE_EQ(syn->footprintStats().savedFraction(), 1.0 - expect / (2048.0 * 2048.0));
 }
 
+TEST(StoreOnRealData, EtopoAsAGlobalLayoutWrapsAtTheDateLine) {
+  // ETOPO 20': 1080 x 540, -180..180 x -90..90; tiles of 64 cells leave a partial tile column
+  // at the seam, which reads must cross seamlessly.
+  const auto dem = readPixels(dataFile("earth/etopo20.tif"));
+  ASSERT_EQ(dem.width, 1080);
+  gis::Georef g = gridGeoref(dem.width, dem.height);
+  g.transform = {{-180.0, 1.0 / 3.0, 0.0, 90.0, 0.0, -1.0 / 3.0}};
+  auto opts = realDataOptions();
+  opts.layout = TileLayout::Global;
+  opts.metric = {6, 6};  // full resolution everywhere: reads compare exactly
+  const auto dir = test::tempDir("etopo");
+  ASSERT_TRUE(ingest(dir, g, {{{"bedrock", LayerKind::Bedrock, ""}, gridReader(dem)}}, opts));
+  auto store = TileStore::open(dir, opts.cache);
+  ASSERT_TRUE(store);
+  auto seam = store->readWindow(0, {1070, 200, 20, 4}, 0);
+  ASSERT_TRUE(seam);
+  for (int y = 0; y < 4; ++y) {
+    for (int x = 0; x < 20; ++x) ASSERT_EQ(seam->at(x, y), dem.at((1070 + x) % 1080, 200 + y)) << x << "," << y;
+  }
+  // Two rows beyond the north pole at 0 E: rows 1 and 0 at 180 E.
+  auto pole = store->readWindow(0, {540, -2, 1, 3}, 0);
+  ASSERT_TRUE(pole);
+  EXPECT_EQ(pole->at(0, 0), dem.at(0, 1));
+  EXPECT_EQ(pole->at(0, 1), dem.at(0, 0));
+  EXPECT_EQ(pole->at(0, 2), dem.at(540, 0));
+
+  // The same grid under the metric (bins as for the other real DEMs) for the memory figures.
+  const auto mdir = test::tempDir("etopo-metric");
+  opts.metric = realDataOptions().metric;
+  ASSERT_TRUE(ingest(mdir, g, {{{"bedrock", LayerKind::Bedrock, ""}, gridReader(dem)}}, opts));
+  auto metric = TileStore::open(mdir, opts.cache);
+  ASSERT_TRUE(metric);
+  writeResolutionMap(*metric, test::outputDir("terrain") / "etopo20_resolution.png", 16);
+  report("etopo20_global", *metric);
+}
+
 // Peak resident memory of this process (kB), since the last resetPeak().
 long peakRssKb() {
   std::ifstream in("/proc/self/status");
