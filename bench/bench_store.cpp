@@ -68,6 +68,29 @@ double percentile(std::vector<double> v, double p) {
 
 }  // namespace
 
+// Reads every rough (2^10) tile of a store built from the default synthetic scene at full
+// resolution and compares it with the generator cell for cell. Returns {tiles, mismatching cells}.
+std::pair<int, long> checkRoughTiles(const fs::path& store) {
+  auto s = TileStore::open(store, {.budgetBytes = size_t(64) << 20, .prefetch = false});
+  if (!s) die(s.message());
+  const SyntheticScene scene;
+  int tiles = 0;
+  long bad = 0;
+  for (int ty = 0; ty < s->tilesY(); ++ty) {
+    for (int tx = 0; tx < s->tilesX(); ++tx) {
+      if (syntheticBlockKind(scene, tx, ty) != SyntheticBlock::Rough) continue;
+      if (s->tile(tx, ty).exp != 10) ++bad;
+      auto g = s->readWindow(0, {tx * 1024, ty * 1024, 1024, 1024}, 0);
+      if (!g) die(g.message());
+      for (int y = 0; y < 1024; ++y) {
+        for (int x = 0; x < 1024; ++x) bad += g->at(x, y) != syntheticElevation(scene, tx * 1024 + x, ty * 1024 + y);
+      }
+      ++tiles;
+    }
+  }
+  return {tiles, bad};
+}
+
 int main(int argc, char** argv) {
   int n = 32768;
   fs::path dir = fs::temp_directory_path() / "strata-bench-store";
@@ -80,8 +103,12 @@ int main(int argc, char** argv) {
       dir = argv[++i];
     } else if (a == "--no-gdal") {
       gdal = false;
+    } else if (a == "--check" && i + 1 < argc) {
+      const auto [tiles, bad] = checkRoughTiles(argv[++i]);
+      std::printf("{\"rough_tiles_checked\": %d, \"mismatching_cells\": %ld}\n", tiles, bad);
+      return bad ? 1 : 0;
     } else {
-      die("unknown argument '" + a + "' (use --size N, --dir DIR, --no-gdal)");
+      die("unknown argument '" + a + "' (use --size N, --dir DIR, --no-gdal, or --check STORE)");
     }
   }
   if (n < 1024 || n % 1024) die("--size must be a multiple of 1024");
@@ -100,15 +127,17 @@ int main(int argc, char** argv) {
   const double genSeconds = since(t0);
   const double genPeakRss = peakRssMiB();
   std::fprintf(stderr, "generated ingest: %.1f s, peak RSS %.0f MiB\n", genSeconds, genPeakRss);
+  const auto [roughTiles, mismatches] = checkRoughTiles(dir / "gen.store");
   fs::remove_all(dir / "gen.store");
 
   std::printf("{\"size\": %d, \"input_mb\": %.1f,\n", n, inputMB);
   std::printf(
       " \"generated_ingest\": {\"seconds\": %.2f, \"mb_per_s\": %.1f, \"peak_rss_mib\": %.1f, "
-      "\"saved_fraction\": %.4f, \"saved_fraction_with_mips\": %.4f, \"file_mb\": %.1f}",
+      "\"saved_fraction\": %.4f, \"saved_fraction_with_mips\": %.4f, \"file_mb\": %.1f, "
+      "\"rough_tiles_checked\": %d, \"mismatching_cells\": %ld}",
       genSeconds, inputMB / genSeconds, genPeakRss, gen->footprint.savedFraction(),
       1.0 - double(gen->footprint.storedWithMips) / double(gen->footprint.denseSamples),
-      double(gen->footprint.fileBytes) / 1e6);
+      double(gen->footprint.fileBytes) / 1e6, roughTiles, mismatches);
   if (!gdal) {
     std::printf("}\n");
     return 0;
