@@ -6,8 +6,6 @@
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imageio.h>
 
-#include <malloc.h>
-
 #include <cmath>
 #include <fstream>
 #include <set>
@@ -230,63 +228,6 @@ TEST(StoreOnRealData, EtopoAsAGlobalLayoutWrapsAtTheDateLine) {
   ASSERT_TRUE(metric);
   writeResolutionMap(*metric, test::outputDir("terrain") / "etopo20_resolution.png", 16);
   report("etopo20_global", *metric);
-}
-
-// Peak resident memory of this process (kB), since the last resetPeak().
-long peakRssKb() {
-  std::ifstream in("/proc/self/status");
-  std::string line;
-  while (std::getline(in, line)) {
-    if (line.rfind("VmHWM:", 0) == 0) return std::stol(line.substr(6));
-  }
-  return -1;
-}
-long rssKb() {
-  std::ifstream in("/proc/self/status");
-  std::string line;
-  while (std::getline(in, line)) {
-    if (line.rfind("VmRSS:", 0) == 0) return std::stol(line.substr(6));
-  }
-  return -1;
-}
-void resetPeak() { std::ofstream("/proc/self/clear_refs") << "5"; }
-
-TEST(Ingest, PeakMemoryIsBoundedByTheTileNotTheInput) {
-  // 4096 x 4096 float32 = 64 MiB of input, tiles of 256 cells (256 KiB per field). The ingest
-  // holds a few tiles at a time; bench/bench_store.cpp checks the same at 32768^2 (4 GiB).
-  SyntheticScene s;
-  s.blockCells = 256;
-  const auto dir = test::tempDir("big");
-  IngestOptions o;
-  o.metric = {3, 8};
-  o.cache.prefetch = false;
-  malloc_trim(0);  // hand freed heap back, so that reuse of it cannot hide the ingest's growth
-  resetPeak();
-  const long before = rssKb();
-  auto rep = ingest(dir, gridGeoref(4096, 4096), {{{"bedrock", LayerKind::Bedrock, ""}, syntheticReader(s)}}, o);
-  ASSERT_TRUE(rep) << rep.message();
-  const long grewKb = peakRssKb() - before;
-  std::cout << "ingest of 64 MiB: peak RSS grew by " << grewKb << " kB\n";
-  // 1/8 of the input (8 MiB = 32 tiles' worth) is far above what a tile-at-a-time ingest needs
-  // and far below a whole-input copy.
-  EXPECT_LT(grewKb, 64 * 1024 / 8);
-  // Complex tiles read back cell for cell at full resolution.
-  auto store = TileStore::open(dir, o.cache);
-  ASSERT_TRUE(store);
-  int checked = 0;
-  for (int by = 0; by < 16 && checked < 4; ++by) {
-    for (int bx = 0; bx < 16 && checked < 4; ++bx) {
-      if (syntheticBlockKind(s, bx, by) != SyntheticBlock::Rough) continue;
-      ASSERT_EQ(store->tile(bx, by).exp, 8);
-      auto g = store->readWindow(0, {bx * 256, by * 256, 256, 256}, 0);
-      ASSERT_TRUE(g);
-      for (int y = 0; y < 256; ++y) {
-        for (int x = 0; x < 256; ++x) ASSERT_EQ(g->at(x, y), syntheticElevation(s, bx * 256 + x, by * 256 + y));
-      }
-      ++checked;
-    }
-  }
-  EXPECT_EQ(checked, 4);
 }
 
 }  // namespace
