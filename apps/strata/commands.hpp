@@ -6,7 +6,9 @@
 namespace strata::app {
 
 void addGpuInfoCommand(CLI::App& app);
+void addInfoCommand(CLI::App& app);
 void addCheckCommand(CLI::App& app);
 void addIngestCommand(CLI::App& app);
+void addExportCommand(CLI::App& app);
 
 }  // namespace strata::app

@@ -1,0 +1,269 @@
+// DEM reading and GeoTIFF writing through GDAL. See docs/gis.md ("Reading", "Writing").
+#include <strata/gis/dem_io.hpp>
+
+#include <cpl_string.h>
+#include <cpl_vsi.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "gdal_util.hpp"
+
+namespace strata::gis {
+namespace {
+
+using detail::DatasetPtr;
+using detail::GdalErrorCapture;
+
+std::string lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  return s;
+}
+
+// Metres per unit of the band's vertical unit; nullopt when the unit is not a length we know.
+std::optional<double> metresPerUnit(const std::string& unit) {
+  const std::string u = lower(unit);
+  if (u.empty() || u == "m" || u == "metre" || u == "metres" || u == "meter" || u == "meters") return 1.0;
+  if (u == "ft" || u == "foot" || u == "feet" || u == "international foot") return 0.3048;
+  if (u == "us-ft" || u == "us survey foot" || u == "ftus") return 1200.0 / 3937.0;
+  if (u == "km" || u == "kilometre" || u == "kilometer") return 1000.0;
+  return std::nullopt;
+}
+
+struct Probed {
+  DemInfo info;
+  DatasetPtr ds;
+  double unitToMetres = 1;
+};
+
+Result<Probed> probe(const std::string& path, const ReadOptions& options) {
+  STRATA_TRY(DatasetPtr ds, detail::openRaster(path));
+  Probed p;
+  DemInfo& info = p.info;
+  info.path = path;
+  info.driver = ds->GetDriver() ? ds->GetDriver()->GetDescription() : "unknown";
+  info.bandCount = ds->GetRasterCount();
+  if (options.band < 1 || options.band > info.bandCount) {
+    return fail(path + ": band " + std::to_string(options.band) + " requested, the file has " +
+                std::to_string(info.bandCount));
+  }
+  Georef& g = info.georef;
+  g.width = ds->GetRasterXSize();
+  g.height = ds->GetRasterYSize();
+  if (g.width <= 0 || g.height <= 0)
+    return fail(path + ": empty raster (" + std::to_string(g.width) + "x" + std::to_string(g.height) + ")");
+
+  if (options.crs.has_value() != options.transform.has_value()) {
+    return fail(path + ": an explicit georeference needs both a CRS and a geotransform");
+  }
+  if (options.crs) {
+    auto srs = detail::parseCrs(*options.crs);
+    if (!srs) return fail(path + ": " + srs.message());
+    detail::fillCrs(*srs, g);
+    g.transform = *options.transform;
+  } else {
+    double gt[6];
+    const bool hasTransform = ds->GetGeoTransform(gt) == CE_None;
+    const OGRSpatialReference* srs = ds->GetSpatialRef();
+    if (!hasTransform || !srs) {
+      return fail(path + ": no georeference (" +
+                  std::string(!srs && !hasTransform ? "no CRS and no geotransform"
+                              : !srs                ? "no CRS"
+                                                    : "no geotransform") +
+                  "); pass an explicit CRS and geotransform to read it");
+    }
+    if (!srs->IsGeographic() && !srs->IsProjected()) {
+      return fail(path + ": unknown CRS '" + std::string(srs->GetName() ? srs->GetName() : "") +
+                  "' (neither geographic nor projected)");
+    }
+    detail::fillCrs(*srs, g);
+    std::copy(gt, gt + 6, g.transform.c);
+  }
+  const GeoTransform& t = g.transform;
+  if (!(std::isfinite(t.c[0]) && std::isfinite(t.c[1]) && std::isfinite(t.c[2]) && std::isfinite(t.c[3]) &&
+        std::isfinite(t.c[4]) && std::isfinite(t.c[5])) ||
+      t.c[1] * t.c[5] - t.c[2] * t.c[4] == 0) {
+    return fail(path + ": degenerate geotransform (zero or non-finite pixel size)");
+  }
+  if (!(g.body.semiMajorM > 0) || !(g.body.flattening >= 0 && g.body.flattening < 1)) {
+    return fail(path + ": unknown CRS '" + g.crsName + "' (no usable ellipsoid)");
+  }
+
+  GDALRasterBand* band = ds->GetRasterBand(options.band);
+  info.bandType = GDALGetDataTypeName(band->GetRasterDataType());
+  if (GDALDataTypeIsComplex(band->GetRasterDataType())) {
+    return fail(path + ": band type " + info.bandType + " is complex, not an elevation");
+  }
+  int ok = 0;
+  info.scale = band->GetScale(&ok);
+  if (!ok) info.scale = 1;
+  info.offset = band->GetOffset(&ok);
+  if (!ok) info.offset = 0;
+  if (!std::isfinite(info.scale) || !std::isfinite(info.offset) || info.scale == 0) {
+    return fail(path + ": invalid scale/offset " + std::to_string(info.scale) + "/" + std::to_string(info.offset));
+  }
+  int hasNoData = 0;
+  const double nd = band->GetNoDataValue(&hasNoData);
+  if (hasNoData) info.nodata = nd;
+  const std::string unit = band->GetUnitType() ? band->GetUnitType() : "";
+  const auto perUnit = metresPerUnit(unit);
+  if (!perUnit) return fail(path + ": unsupported vertical unit '" + unit + "' (expected metres or feet)");
+  p.unitToMetres = *perUnit;
+  g.verticalUnit = "m";
+  info.offsetIsBodyRadius = g.body.isSphere() && info.offset != 0 && std::abs(info.offset - g.body.semiMajorM) < 1.0;
+  p.ds = std::move(ds);
+  return p;
+}
+
+}  // namespace
+
+Result<DemInfo> probeDem(const std::string& path, const ReadOptions& options) {
+  STRATA_TRY(Probed p, probe(path, options));
+  return std::move(p.info);
+}
+
+Result<Raster> readDem(const std::string& path, const ReadOptions& options) {
+  STRATA_TRY(Probed p, probe(path, options));
+  const DemInfo& info = p.info;
+  const Georef& full = info.georef;
+  const PixelWindow w = options.window.value_or(PixelWindow{0, 0, full.width, full.height});
+  if (w.width <= 0 || w.height <= 0 || w.x < 0 || w.y < 0 || w.x > full.width - w.width ||
+      w.y > full.height - w.height) {
+    std::ostringstream m;
+    m << path << ": window " << w.width << "x" << w.height << "+" << w.x << "+" << w.y << " is outside the "
+      << full.width << "x" << full.height << " raster";
+    return fail(m.str());
+  }
+  // The byte budget is checked before anything is allocated: a header may claim any size.
+  const double bytes = double(w.width) * double(w.height) * sizeof(float);
+  if (bytes > double(options.maxBytes)) {
+    std::ostringstream m;
+    m << path << ": " << w.width << "x" << w.height << " pixels (" << bytes / double(1 << 20)
+      << " MiB as float32) exceed the read budget of " << double(options.maxBytes) / double(1 << 20)
+      << " MiB; read a window";
+    return fail(m.str());
+  }
+
+  Raster r;
+  r.georef = full;
+  r.georef.width = w.width;
+  r.georef.height = w.height;
+  GeoTransform& t = r.georef.transform;
+  t.c[0] = full.transform.x(w.x, w.y);
+  t.c[3] = full.transform.y(w.x, w.y);
+  r.values = Grid<float>(w.width, w.height);
+
+  {
+    GdalErrorCapture errors;
+    GDALRasterBand* band = p.ds->GetRasterBand(options.band);
+    // RasterIO on the window reads only the blocks that intersect it.
+    if (band->RasterIO(GF_Read, w.x, w.y, w.width, w.height, r.values.data.data(), w.width, w.height, GDT_Float32, 0,
+                       0) != CE_None) {
+      return fail(path + ": read failed (truncated or corrupt file?): " + errors.last());
+    }
+  }
+
+  const bool nodataIsNaN = info.nodata && std::isnan(*info.nodata);
+  const float nodataRaw = info.nodata && !nodataIsNaN ? float(*info.nodata) : 0.0f;
+  const bool hasNumericNoData = info.nodata && !nodataIsNaN;
+  const double offset =
+      info.offsetIsBodyRadius && !options.keepBodyRadius ? info.offset - full.body.semiMajorM : info.offset;
+  const double scale = info.scale * p.unitToMetres;
+  const double offsetM = offset * p.unitToMetres;
+  size_t valid = 0;
+  for (int y = 0; y < w.height; ++y) {
+    for (int x = 0; x < w.width; ++x) {
+      float& v = r.values.at(x, y);
+      if (std::isnan(v)) {
+        if (nodataIsNaN) continue;
+        std::ostringstream m;
+        m << path << ": NaN value at pixel (" << w.x + x << ", " << w.y + y
+          << ") and no NaN nodata value; NaN is not an elevation (set a nodata value)";
+        return fail(m.str());
+      }
+      if (hasNumericNoData && v == nodataRaw) {
+        v = kNoData;
+        continue;
+      }
+      if (!std::isfinite(v)) {
+        std::ostringstream m;
+        m << path << ": infinite value at pixel (" << w.x + x << ", " << w.y + y << ")";
+        return fail(m.str());
+      }
+      v = float(double(v) * scale + offsetM);
+      ++valid;
+    }
+  }
+  if (valid == 0 && !options.allowAllNoData) {
+    std::ostringstream m;
+    m << path << ": no data: all " << w.width << "x" << w.height << " cells" << (options.window ? " of the window" : "")
+      << " are nodata";
+    return fail(m.str());
+  }
+  return r;
+}
+
+Status writeGeoTiff(const std::string& path, const Raster& raster, const WriteOptions& options) {
+  detail::ensureGdal();
+  const Georef& g = raster.georef;
+  if (g.width <= 0 || g.height <= 0 || raster.values.width != g.width || raster.values.height != g.height) {
+    return fail(path + ": cannot write: raster is " + std::to_string(raster.values.width) + "x" +
+                std::to_string(raster.values.height) + ", georeference says " + std::to_string(g.width) + "x" +
+                std::to_string(g.height));
+  }
+  if (options.blockSize < 16 || options.blockSize > 4096 || (options.blockSize & (options.blockSize - 1))) {
+    return fail(path + ": block size " + std::to_string(options.blockSize) + " is not a power of two in 16..4096");
+  }
+  if (std::isnan(options.nodata)) return fail(path + ": the nodata value written must be a number");
+  // Substitute the nodata value for NaN; a real value equal to it would turn into nodata.
+  Grid<float> out = raster.values;
+  for (float& v : out.data) {
+    if (std::isnan(v)) {
+      v = options.nodata;
+    } else if (v == options.nodata) {
+      return fail(path + ": cannot write: the value " + std::to_string(options.nodata) +
+                  " occurs in the data and is the nodata value");
+    }
+  }
+  auto mem = detail::memDataset(g, &out);
+  if (!mem) return fail(path + ": cannot write: " + mem.message());
+  (*mem)->GetRasterBand(1)->SetNoDataValue(options.nodata);
+
+  GdalErrorCapture errors;
+  GDALDriver* driver = GetGDALDriverManager()->GetDriverByName(options.cog ? "COG" : "GTiff");
+  if (!driver) return fail(path + ": GDAL has no " + std::string(options.cog ? "COG" : "GTiff") + " driver");
+  const std::string block = std::to_string(options.blockSize);
+  CPLStringList co;
+  co.SetNameValue("COMPRESS", "DEFLATE");
+  co.SetNameValue("BIGTIFF", "IF_SAFER");
+  if (options.cog) {
+    co.SetNameValue("BLOCKSIZE", block.c_str());
+    co.SetNameValue("PREDICTOR", "YES");
+    co.SetNameValue("RESAMPLING", "AVERAGE");
+  } else {
+    co.SetNameValue("TILED", "YES");
+    co.SetNameValue("BLOCKXSIZE", block.c_str());
+    co.SetNameValue("BLOCKYSIZE", block.c_str());
+    co.SetNameValue("PREDICTOR", "3");
+  }
+  const std::string tmp = path + ".tmp" + std::to_string(::getpid());
+  DatasetPtr written(driver->CreateCopy(tmp.c_str(), mem->get(), FALSE, co.List(), nullptr, nullptr));
+  if (!written) {
+    VSIUnlink(tmp.c_str());
+    return fail(path + ": cannot write GeoTIFF: " + errors.last());
+  }
+  written.reset();  // flush and close before the rename
+  if (CPLGetLastErrorType() >= CE_Failure) {
+    VSIUnlink(tmp.c_str());
+    return fail(path + ": cannot write GeoTIFF: " + errors.last());
+  }
+  if (VSIRename(tmp.c_str(), path.c_str()) != 0) {
+    VSIUnlink(tmp.c_str());
+    return fail(path + ": cannot rename the written temporary into place");
+  }
+  return {};
+}
+
+}  // namespace strata::gis
