@@ -115,7 +115,7 @@ GdalInfo gdalInfo(const std::string& path) {
 }
 
 TEST(StrataExport, AWindowKeepsTheSourcesCrsAndGeotransform) {
-  const std::string dem = std::string(STRATA_DATA_DIR) + "/grand_canyon/grand_canyon_512.tif";
+  const std::string dem = test::dataPath("grand_canyon/grand_canyon_512.tif");
   const auto dir = test::tempDir("gc");
   const auto ing = runCli("ingest " + (dir / "store").string() + " --dem " + dem + " --min-exp 1 --max-exp 6");
   ASSERT_EQ(ing.status, 0) << ing.output;
@@ -148,7 +148,7 @@ TEST(StrataExport, AWindowKeepsTheSourcesCrsAndGeotransform) {
 }
 
 TEST(DemSources, MosaicWindowsMatchTheSource) {
-  const std::string dem = std::string(STRATA_DATA_DIR) + "/grand_canyon/grand_canyon_512.tif";
+  const std::string dem = test::dataPath("grand_canyon/grand_canyon_512.tif");
   auto info = gis::probeDem(dem);
   ASSERT_TRUE(info) << info.message();
   gis::ReadOptions window;

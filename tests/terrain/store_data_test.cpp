@@ -39,10 +39,6 @@ Grid<float> readPixels(const std::string& path) {
   return g;
 }
 
-// The shared data folder. STRATA_DATA_DIR is compiled into this test binary; dataFile()
-// lives in the support library, which is built without it and falls back to a relative path.
-std::string dataFile(const std::string& relative) { return std::string(STRATA_DATA_DIR) + "/" + relative; }
-
 WindowReader gridReader(const Grid<float>& src) {
   return [&src](int x0, int y0, int w, int h) -> Result<Grid<float>> {
     Grid<float> g(w, h);
@@ -107,7 +103,7 @@ void report(const std::string& name, const TileStore& store) {
 }
 
 TEST(StoreOnRealData, GrandCanyonResolutionFollowsTheCanyon) {
-  const auto dem = readPixels(dataFile("grand_canyon/grand_canyon_512.tif"));
+  const auto dem = readPixels(test::dataPath("grand_canyon/grand_canyon_512.tif"));
   ASSERT_EQ(dem.width, 512);
   const auto dir = test::tempDir("gc");
   auto rep = ingest(dir, gridGeoref(dem.width, dem.height), {{{"bedrock", LayerKind::Bedrock, ""}, gridReader(dem)}},
@@ -158,7 +154,7 @@ TEST(StoreOnRealData, GrandCanyonResolutionFollowsTheCanyon) {
 }
 
 TEST(StoreOnRealData, RainierAndASyntheticSceneSaveMemory) {
-  const auto dem = readPixels(dataFile("rainier/mt_rainier_90m.tif"));
+  const auto dem = readPixels(test::dataPath("rainier/mt_rainier_90m.tif"));
   ASSERT_EQ(dem.width, 1201);
   const auto dir = test::tempDir("rainier");
   ASSERT_TRUE(ingest(dir, gridGeoref(dem.width, dem.height), {{{"bedrock", LayerKind::Bedrock, ""}, gridReader(dem)}},
@@ -197,7 +193,7 @@ TEST(StoreOnRealData, RainierAndASyntheticSceneSaveMemory) {
 TEST(StoreOnRealData, EtopoAsAGlobalLayoutWrapsAtTheDateLine) {
   // ETOPO 20': 1080 x 540, -180..180 x -90..90; tiles of 64 cells leave a partial tile column
   // at the seam, which reads must cross seamlessly.
-  const auto dem = readPixels(dataFile("earth/etopo20.tif"));
+  const auto dem = readPixels(test::dataPath("earth/etopo20.tif"));
   ASSERT_EQ(dem.width, 1080);
   gis::Georef g = gridGeoref(dem.width, dem.height);
   g.transform = {{-180.0, 1.0 / 3.0, 0.0, 90.0, 0.0, -1.0 / 3.0}};
