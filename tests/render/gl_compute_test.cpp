@@ -81,7 +81,9 @@ TEST_F(GlTest, LaplacianStencilIsExact) {
       };
       const double expected = at(x - 1, y) + at(x + 1, y) + at(x, y - 1) + at(x, y + 1) - 4 * at(x, y);
       ASSERT_EQ(out[size_t(y * w + x)], float(expected)) << "at " << x << "," << y;
-      if (x > 0 && y > 0 && x < w - 1 && y < h - 1) ASSERT_EQ(out[size_t(y * w + x)], 8.0f);
+      if (x > 0 && y > 0 && x < w - 1 && y < h - 1) {
+        ASSERT_EQ(out[size_t(y * w + x)], 8.0f);
+      }
     }
   }
 }

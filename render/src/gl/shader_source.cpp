@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
-#include <regex>
 #include <sstream>
 
 namespace strata::render::gl {
@@ -114,24 +113,35 @@ ShaderFileReader directoryReader(std::string root) {
 }
 
 std::string mapInfoLog(std::string_view log, const std::vector<std::string>& files) {
-  // Mesa: "S:L(C): ..."; NVIDIA: "S(L) : ...". Only rewrite at the start of a line.
-  static const std::regex kMesa(R"(^(\d+):(\d+)\()");
-  static const std::regex kNvidia(R"(^(\d+)\((\d+)\))");
+  // Mesa: "S:L(C): ..."; NVIDIA: "S(L) : ...". Only rewritten at the start of a line.
+  auto digits = [](std::string_view t, size_t at) {
+    size_t e = at;
+    while (e < t.size() && t[e] >= '0' && t[e] <= '9') ++e;
+    return e;
+  };
   std::string out;
-  std::istringstream in{std::string(log)};
-  std::string line;
-  while (std::getline(in, line)) {
-    std::smatch m;
-    auto name = [&](const std::string& idx) {
-      const size_t i = std::stoul(idx);
-      return i < files.size() ? files[i] : idx;
-    };
-    if (std::regex_search(line, m, kMesa)) {
-      line = name(m[1]) + ":" + m[2].str() + "(" + m.suffix().str();
-    } else if (std::regex_search(line, m, kNvidia)) {
-      line = name(m[1]) + ":" + m[2].str() + m.suffix().str();
+  size_t start = 0;
+  while (start < log.size()) {
+    size_t end = log.find('\n', start);
+    if (end == std::string_view::npos) end = log.size();
+    std::string_view line = log.substr(start, end - start);
+    const size_t s1 = digits(line, 0);
+    std::string mapped(line);
+    if (s1 > 0 && s1 < line.size()) {
+      const size_t index = std::stoul(std::string(line.substr(0, s1)));
+      const std::string file = index < files.size() ? files[index] : std::string(line.substr(0, s1));
+      if (line[s1] == ':') {
+        const size_t l1 = digits(line, s1 + 1);
+        if (l1 > s1 + 1 && l1 < line.size() && line[l1] == '(') mapped = file + std::string(line.substr(s1));
+      } else if (line[s1] == '(') {
+        const size_t l1 = digits(line, s1 + 1);
+        if (l1 > s1 + 1 && l1 < line.size() && line[l1] == ')') {
+          mapped = file + ":" + std::string(line.substr(s1 + 1, l1 - s1 - 1)) + std::string(line.substr(l1 + 1));
+        }
+      }
     }
-    out += line + '\n';
+    out += mapped + '\n';
+    start = end + 1;
   }
   return out;
 }
