@@ -10,5 +10,8 @@ void addInfoCommand(CLI::App& app);
 void addFloodCommands(CLI::App& app);
 void addGenerateCommand(CLI::App& app);
 void addRenderCommand(CLI::App& app);
+void addCheckCommand(CLI::App& app);
+void addIngestCommand(CLI::App& app);
+void addExportCommand(CLI::App& app);
 
 }  // namespace strata::app

@@ -9,6 +9,9 @@ int main(int argc, char** argv) {
   strata::app::addFloodCommands(app);
   strata::app::addGenerateCommand(app);
   strata::app::addRenderCommand(app);
+  strata::app::addCheckCommand(app);
+  strata::app::addIngestCommand(app);
+  strata::app::addExportCommand(app);
   CLI11_PARSE(app, argc, argv);
   return 0;
 }

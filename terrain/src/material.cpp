@@ -18,4 +18,19 @@ int findMaterial(const std::vector<Material>& table, const std::string& name) {
   return -1;
 }
 
+Status validateMaterial(const Material& m) {
+  const std::string what = "material '" + m.name + "'";
+  if (m.name.empty()) return fail("material: empty name");
+  for (float c : m.colour) {
+    if (!(c >= 0 && c <= 1)) return fail(what + ": colour component " + std::to_string(c) + " outside [0,1]");
+  }
+  if (!(m.erodibility >= 0)) return fail(what + ": erodibility " + std::to_string(m.erodibility) + " < 0");
+  if (!(m.dissolutionRate >= 0)) return fail(what + ": dissolution_rate " + std::to_string(m.dissolutionRate) + " < 0");
+  if (!(m.talusAngleDeg > 0 && m.talusAngleDeg < 90)) {
+    return fail(what + ": talus_angle_deg " + std::to_string(m.talusAngleDeg) + " outside (0, 90)");
+  }
+  if (!(m.densityKgM3 > 0)) return fail(what + ": density_kg_m3 " + std::to_string(m.densityKgM3) + " <= 0");
+  return {};
+}
+
 }  // namespace strata::terrain

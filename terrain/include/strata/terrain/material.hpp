@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include <strata/core/result.hpp>
+
 namespace strata::terrain {
 
 struct Material {
@@ -22,5 +24,9 @@ std::vector<Material> defaultMaterials();
 
 /// Index of the material named `name` in `table`, or -1.
 int findMaterial(const std::vector<Material>& table, const std::string& name);
+
+/// Checks a material read from user data (a store manifest, a scenario): a non-empty name, colour
+/// in [0,1], erodibility and dissolution >= 0, talus angle in (0, 90) degrees, density > 0.
+Status validateMaterial(const Material& m);
 
 }  // namespace strata::terrain

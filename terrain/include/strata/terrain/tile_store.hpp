@@ -1,0 +1,179 @@
+#pragma once
+// The out-of-core layered terrain: a pyramid of equal-footprint tiles on disk whose resolution
+// follows their complexity (the seed metric), each with a mip chain, read and written through a
+// RAM cache with a byte budget. See docs/architecture.md, "Terrain store", for the layout, the
+// on-disk format and why.
+//
+// Grids and levels: the store's base grid (level 0) is georef.width x georef.height cells. A tile
+// covers footprint() = 2^maxExp base cells a side; level L has cells 2^L base cells wide, so a tile
+// spans footprint() >> L level-L cells. A tile of exponent e stores 2^e x 2^e samples per field
+// (box means of the base cells; e = maxExp is the base grid itself) plus its mip chain down to 1x1.
+
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <strata/core/result.hpp>
+#include <strata/gis/raster.hpp>
+#include <strata/terrain/layered_terrain.hpp>
+#include <strata/terrain/material.hpp>
+
+namespace strata::terrain {
+
+/// Planar: a projected CRS, the domain is a rectangle (cells outside are no data). Global: a
+/// geographic grid covering the whole body (360 x 180 degrees); reads wrap across the 0/360 seam
+/// and fold over the poles.
+enum class TileLayout { Planar, Global };
+
+/// The seed metric's parameters: tile resolutions are 2^minExp .. 2^maxExp cells a side.
+struct TileMetricParams {
+  int minExp = 5;
+  int maxExp = 10;
+};
+
+/// The seed metric. For each field f, m_f = tileRange[f] / globalRange[f] (0 where either is 0 or
+/// NaN); m = max_f m_f decides. [0,1] is cut into (maxExp - minExp + 1) equal bins, bin k giving
+/// exponent minExp + k (m = 1 gives maxExp).
+int chooseTileExp(const std::vector<float>& tileRange, const std::vector<float>& globalRange, int minExp, int maxExp);
+
+/// Box mean of `factor` x `factor` blocks, ignoring NaN cells (all-NaN blocks give NaN).
+/// Precondition: the grid's sides are multiples of `factor`.
+gis::Grid<float> boxDownsample(const gis::Grid<float>& src, int factor);
+/// Each cell repeated `factor` x `factor` times (piecewise-constant upsampling; keeps block means).
+gis::Grid<float> replicateUpsample(const gis::Grid<float>& src, int factor);
+
+/// One stored field: its name (letters, digits, '_' or '-'), kind and material name (material layers).
+struct StoreField {
+  std::string name;
+  LayerKind kind = LayerKind::Bedrock;
+  std::string material;
+};
+
+/// What a new store is: its base grid and georeference, layout, metric, fields and materials.
+struct StoreDesc {
+  gis::Georef georef;  ///< width x height = the base grid
+  TileLayout layout = TileLayout::Planar;
+  TileMetricParams metric;
+  std::vector<StoreField> fields;
+  std::vector<Material> materials = defaultMaterials();
+};
+
+/// The manifest's record of one tile.
+struct TileRecord {
+  bool present = false;           ///< false: the tile has no data (outside a non-rectangular domain)
+  int exp = 0;                    ///< stored resolution 2^exp
+  uint64_t generation = 0;        ///< bumped on every rewrite; part of the file name
+  std::string file;               ///< relative to the store folder
+  uint32_t crc32 = 0;             ///< zlib crc32 of the whole file
+  uint64_t bytes = 0;             ///< file size
+  std::vector<float> minV, maxV;  ///< per field, over the tile's valid base cells (NaN: none)
+};
+
+/// RAM cache settings.
+struct CacheOptions {
+  size_t budgetBytes = size_t(256) << 20;  ///< decoded tiles kept in RAM (bytes)
+  bool prefetch = true;                    ///< load the 8 neighbours of a missed tile in the background
+};
+
+/// Demand lookups of the decoded-tile cache since open (or resetCacheStats()).
+struct CacheStats {
+  uint64_t hits = 0, misses = 0;
+  uint64_t prefetchLoads = 0;  ///< tiles decoded by the prefetcher
+  uint64_t prefetchHits = 0;   ///< demand hits on a tile the prefetcher loaded
+  uint64_t evictions = 0;
+  size_t bytes = 0;  ///< decoded bytes held now
+  double hitRate() const { return hits + misses ? double(hits) / double(hits + misses) : 0.0; }
+};
+
+/// A rectangle of cells of one level.
+struct Window {
+  int x = 0, y = 0, width = 0, height = 0;
+};
+
+/// A tile that failed verification: its file (relative to the store) and why.
+struct TileProblem {
+  std::string file;
+  std::string message;
+};
+
+/// Sizes for "memory saved against a dense grid".
+struct StorageFootprint {
+  uint64_t denseSamples = 0;    ///< width x height x fields of the base grid
+  uint64_t storedSamples = 0;   ///< sum over present tiles of 4^exp x fields (finest level only)
+  uint64_t storedWithMips = 0;  ///< the same with each tile's mip chain
+  uint64_t fileBytes = 0;       ///< tile files on disk (zip compressed)
+  double savedFraction() const { return denseSamples ? 1.0 - double(storedSamples) / double(denseSamples) : 0.0; }
+};
+
+class TileStore {
+ public:
+  /// Creates an empty store (every tile absent) in `dir` (created; must not hold a manifest yet).
+  static Result<TileStore> create(const std::filesystem::path& dir, StoreDesc desc, CacheOptions cache = {});
+  /// Opens a store from its manifest. Fails, naming the file and field, on a bad manifest.
+  static Result<TileStore> open(const std::filesystem::path& dir, CacheOptions cache = {});
+
+  TileStore(TileStore&&) noexcept;
+  TileStore& operator=(TileStore&&) noexcept;
+  ~TileStore();
+
+  const StoreDesc& desc() const;
+  const std::filesystem::path& dir() const;
+  int width() const;  ///< base grid cells
+  int height() const;
+  int footprint() const;  ///< base cells per tile side (2^maxExp)
+  int tilesX() const;
+  int tilesY() const;
+  int maxLod() const;             ///< coarsest level (maxExp): one cell per tile
+  int levelWidth(int lod) const;  ///< ceil(width / 2^lod)
+  int levelHeight(int lod) const;
+  /// Index of the field called `name`, or -1.
+  int fieldIndex(const std::string& name) const;
+  const TileRecord& tile(int tx, int ty) const;
+  /// The range each tile's metric is evaluated against (the union of the tiles' ranges).
+  std::pair<float, float> globalRange(int field) const;
+
+  /// Reads `window` (cells of level `lod`) of field `field`. Touches only the tiles the window
+  /// covers. Planar: cells outside the grid are NaN. Global: x wraps at the seam and rows beyond
+  /// a pole continue on the other side of it. Fails naming the tile file when a tile is corrupt.
+  Result<gis::Grid<float>> readWindow(int field, Window window, int lod = 0);
+  /// Writes base-grid cells at (x, y) of field `field` (inside the grid). The affected tiles are
+  /// re-evaluated and rewritten (as new files); if the global range moves, every tile whose
+  /// metric changes is resampled. Nothing is visible to other openers before commit().
+  Status writeWindow(int field, int x, int y, const gis::Grid<float>& values);
+  /// Replaces tile (tx, ty): `fields` are footprint() x footprint() base grids, one per field
+  /// (NaN outside the domain). Its resolution comes from the current global range; call
+  /// reevaluate() afterwards (writeWindow does) to let range changes reach other tiles.
+  Status putTile(int tx, int ty, const std::vector<gis::Grid<float>>& fields);
+  /// Sets the range the metric is evaluated against before a bulk load (ingest knows it up front).
+  void setEvaluationRange(int field, float lo, float hi);
+  /// Recomputes the global ranges from the tiles; where they moved, resamples every tile whose
+  /// exponent changes.
+  Status reevaluate();
+  /// Makes all writes durable: the manifest is written to a temporary file and renamed into
+  /// place (after the tile files it names), then superseded tile files are removed.
+  Status commit();
+
+  /// Reads every present tile, checks its size, checksum and decoding. Empty: the store is sound.
+  std::vector<TileProblem> verify() const;
+  /// Tile exponents, tilesX() x tilesY() (NaN where absent).
+  gis::Grid<float> resolutionMap() const;
+  StorageFootprint footprintStats() const;
+  /// The georeference of a window read at `lod` (same CRS, scaled and shifted geotransform).
+  gis::Georef windowGeoref(Window window, int lod) const;
+  /// All fields of a base-grid window as a LayeredTerrain (materials from the store).
+  Result<LayeredTerrain> readTerrain(Window window);
+
+  CacheStats cacheStats() const;
+  void resetCacheStats();
+  /// Drops every decoded tile from RAM (for cold-read measurements).
+  void clearCache();
+
+ private:
+  struct Impl;
+  explicit TileStore(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace strata::terrain

@@ -1,0 +1,24 @@
+#pragma once
+// Private: tile files as multi-channel, MIP-mapped, tiled, zip-compressed float32 OpenEXR images
+// held in memory (so the checksum covers exactly the bytes written and read). Keeps OpenEXR's
+// headers out of the public ones.
+
+#include <string>
+#include <vector>
+
+#include <strata/core/result.hpp>
+#include <strata/gis/raster.hpp>
+
+namespace strata::terrain::detail {
+
+/// Encodes one tile: `levels[l][c]` is channel c at mip level l (level 0 square, each next level
+/// half the side, down to 1x1). Channel names must be valid EXR names without '.'.
+std::vector<char> encodeTileExr(const std::vector<std::string>& channels,
+                                const std::vector<std::vector<gis::Grid<float>>>& levels);
+
+/// Decodes mip level `level` of every channel in `channels` (in that order). `name` is used in
+/// error messages. Fails when the bytes are not such a tile, or the level or a channel is missing.
+Result<std::vector<gis::Grid<float>>> decodeTileExrLevel(const std::string& name, const std::vector<char>& bytes,
+                                                         const std::vector<std::string>& channels, int level);
+
+}  // namespace strata::terrain::detail

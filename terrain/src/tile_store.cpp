@@ -1,0 +1,803 @@
+#include <strata/terrain/tile_store.hpp>
+
+#include <fcntl.h>
+#include <unistd.h>
+#include <zlib.h>
+
+#include <algorithm>
+#include <bit>
+#include <cerrno>
+#include <cmath>
+#include <condition_variable>
+#include <cstring>
+#include <deque>
+#include <fstream>
+#include <list>
+#include <mutex>
+#include <set>
+#include <sstream>
+#include <thread>
+#include <unordered_map>
+
+#include <strata/core/files.hpp>
+#include <strata/core/log.hpp>
+
+#include "exr_codec.hpp"
+#include "manifest.hpp"
+
+namespace strata::terrain {
+
+namespace fs = std::filesystem;
+using gis::Grid;
+
+int chooseTileExp(const std::vector<float>& tileRange, const std::vector<float>& globalRange, int minExp, int maxExp) {
+  STRATA_CHECK(minExp <= maxExp) << "minExp " << minExp << " > maxExp " << maxExp;
+  double m = 0;
+  for (size_t f = 0; f < tileRange.size() && f < globalRange.size(); ++f) {
+    const double t = tileRange[f], g = globalRange[f];
+    if (!(t > 0) || !(g > 0)) continue;  // also skips NaN: a field without data is not complex
+    m = std::max(m, std::min(1.0, t / g));
+  }
+  const int bins = maxExp - minExp + 1;
+  return minExp + std::min(bins - 1, int(std::floor(m * bins)));
+}
+
+Grid<float> boxDownsample(const Grid<float>& src, int factor) {
+  STRATA_CHECK(factor >= 1 && src.width % factor == 0 && src.height % factor == 0)
+      << src.width << "x" << src.height << " by " << factor;
+  if (factor == 1) return src;
+  Grid<float> out(src.width / factor, src.height / factor, gis::kNoData);
+  std::vector<double> sum(size_t(out.width));
+  std::vector<int> count(size_t(out.width));
+  for (int oy = 0; oy < out.height; ++oy) {
+    std::fill(sum.begin(), sum.end(), 0.0);
+    std::fill(count.begin(), count.end(), 0);
+    for (int y = oy * factor; y < (oy + 1) * factor; ++y) {
+      const float* row = &src.data[src.index(0, y)];
+      for (int x = 0; x < src.width; ++x) {
+        if (!std::isnan(row[x])) {
+          sum[size_t(x / factor)] += row[x];
+          ++count[size_t(x / factor)];
+        }
+      }
+    }
+    for (int ox = 0; ox < out.width; ++ox) {
+      if (count[size_t(ox)]) out.at(ox, oy) = float(sum[size_t(ox)] / count[size_t(ox)]);
+    }
+  }
+  return out;
+}
+
+Grid<float> replicateUpsample(const Grid<float>& src, int factor) {
+  STRATA_CHECK(factor >= 1) << "factor " << factor;
+  if (factor == 1) return src;
+  Grid<float> out(src.width * factor, src.height * factor);
+  for (int y = 0; y < out.height; ++y) {
+    for (int x = 0; x < out.width; ++x) out.at(x, y) = src.at(x / factor, y / factor);
+  }
+  return out;
+}
+
+namespace {
+
+// One decoded mip level of one tile: every field at that level.
+struct Decoded {
+  std::vector<Grid<float>> fields;
+  size_t bytes = 0;
+};
+using DecodedPtr = std::shared_ptr<const Decoded>;
+
+struct CacheKey {
+  int tx = 0, ty = 0;
+  uint64_t generation = 0;  // a rewritten tile is a new key; stale entries age out
+  int mip = 0;
+  bool operator==(const CacheKey&) const = default;
+};
+struct CacheKeyHash {
+  size_t operator()(const CacheKey& k) const {
+    size_t h = std::hash<uint64_t>()(k.generation);
+    h ^= std::hash<int64_t>()((int64_t(k.tx) << 32) ^ (int64_t(k.ty) << 8) ^ k.mip) + 0x9e3779b97f4a7c15ULL + (h << 6);
+    return h;
+  }
+};
+
+// LRU of decoded tile levels under a byte budget. Thread-safe (the prefetcher inserts).
+class TileCache {
+ public:
+  explicit TileCache(size_t budget) : budget_(budget) {}
+
+  DecodedPtr lookup(const CacheKey& k) {
+    std::lock_guard lock(m_);
+    auto it = map_.find(k);
+    if (it == map_.end()) {
+      ++stats_.misses;
+      return nullptr;
+    }
+    ++stats_.hits;
+    if (it->second->prefetched) {
+      ++stats_.prefetchHits;
+      it->second->prefetched = false;
+    }
+    lru_.splice(lru_.begin(), lru_, it->second);
+    return it->second->tile;
+  }
+  bool contains(const CacheKey& k) {
+    std::lock_guard lock(m_);
+    return map_.count(k) != 0;
+  }
+  void insert(const CacheKey& k, DecodedPtr tile, bool prefetched) {
+    std::lock_guard lock(m_);
+    if (auto it = map_.find(k); it != map_.end()) {
+      bytes_ -= it->second->tile->bytes;
+      lru_.erase(it->second);
+      map_.erase(it);
+    }
+    if (prefetched) ++stats_.prefetchLoads;
+    bytes_ += tile->bytes;
+    lru_.push_front({k, std::move(tile), prefetched});
+    map_[k] = lru_.begin();
+    // Never evicts the entry just inserted: a caller holds it anyway, through its shared_ptr.
+    while (bytes_ > budget_ && lru_.size() > 1) {
+      bytes_ -= lru_.back().tile->bytes;
+      map_.erase(lru_.back().key);
+      lru_.pop_back();
+      ++stats_.evictions;
+    }
+  }
+  CacheStats stats() {
+    std::lock_guard lock(m_);
+    CacheStats s = stats_;
+    s.bytes = bytes_;
+    return s;
+  }
+  void resetStats() {
+    std::lock_guard lock(m_);
+    stats_ = {};
+  }
+  void clear() {
+    std::lock_guard lock(m_);
+    lru_.clear();
+    map_.clear();
+    bytes_ = 0;
+  }
+
+ private:
+  struct Entry {
+    CacheKey key;
+    DecodedPtr tile;
+    bool prefetched = false;
+  };
+  std::mutex m_;
+  size_t budget_;
+  size_t bytes_ = 0;
+  std::list<Entry> lru_;
+  std::unordered_map<CacheKey, std::list<Entry>::iterator, CacheKeyHash> map_;
+  CacheStats stats_;
+};
+
+// What a loader needs to know about a tile, copied so that a background load never reads the
+// (user-thread owned) records.
+struct TileRef {
+  int tx = 0, ty = 0;
+  uint64_t generation = 0;
+  std::string file;
+  uint32_t crc32 = 0;
+  uint64_t bytes = 0;
+};
+
+Result<std::vector<char>> readTileBytes(const fs::path& dir, const TileRef& ref) {
+  std::ifstream in(dir / ref.file, std::ios::binary);
+  if (!in) return fail(ref.file + ": missing or unreadable");
+  std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (bytes.size() != ref.bytes) {
+    return fail(ref.file + ": " + std::to_string(bytes.size()) + " bytes, the manifest says " +
+                std::to_string(ref.bytes) + " (truncated or replaced; corrupt tile not used)");
+  }
+  const uint32_t crc =
+      uint32_t(crc32_z(crc32_z(0L, Z_NULL, 0), reinterpret_cast<const Bytef*>(bytes.data()), bytes.size()));
+  if (crc != ref.crc32) {
+    char msg[96];
+    std::snprintf(msg, sizeof msg, ": checksum mismatch (crc32 %08x, manifest %08x); corrupt tile not used", crc,
+                  ref.crc32);
+    return fail(ref.file + msg);
+  }
+  return bytes;
+}
+
+Result<DecodedPtr> loadTileLevel(const fs::path& dir, const std::vector<std::string>& fieldNames, const TileRef& ref,
+                                 int mip) {
+  STRATA_TRY(auto bytes, readTileBytes(dir, ref));
+  STRATA_TRY(auto fields, detail::decodeTileExrLevel(ref.file, bytes, fieldNames, mip));
+  auto d = std::make_shared<Decoded>();
+  for (const auto& g : fields) d->bytes += g.size() * sizeof(float);
+  d->fields = std::move(fields);
+  return DecodedPtr(std::move(d));
+}
+
+// Writes a tile file through a temporary and a rename, so its name never shows a partial file.
+// No fsync per tile (it would dominate an ingest): commit() flushes the whole file system before
+// the manifest that names the new tiles is renamed into place.
+Status writeTileFile(const fs::path& path, const char* data, size_t size) {
+  fs::path tmp = path;
+  tmp += ".tmp";
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) return fail(tmp.string() + ": cannot create: " + std::strerror(errno));
+  size_t done = 0;
+  while (done < size) {
+    const ssize_t n = ::write(fd, data + done, size - done);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      const std::string err = std::strerror(errno);
+      ::close(fd);
+      return fail(tmp.string() + ": write failed: " + err);
+    }
+    done += size_t(n);
+  }
+  if (::close(fd) != 0) return fail(tmp.string() + ": close failed: " + std::strerror(errno));
+  if (::rename(tmp.c_str(), path.c_str()) != 0) {
+    return fail(path.string() + ": rename from temporary failed: " + std::strerror(errno));
+  }
+  return {};
+}
+
+// fsync of a folder (its entries), or syncfs of its whole file system.
+void syncDir(const fs::path& dir, bool wholeFileSystem) {
+  const int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd >= 0) {
+    wholeFileSystem ? ::syncfs(fd) : ::fsync(fd);
+    ::close(fd);
+  }
+}
+
+bool sameValue(float a, float b) { return (std::isnan(a) && std::isnan(b)) || a == b; }
+
+}  // namespace
+
+struct TileStore::Impl {
+  fs::path dir;
+  detail::Manifest man;
+  std::vector<std::string> fieldNames;
+  int footprint = 0;
+  CacheOptions cacheOptions;
+  TileCache cache;
+
+  // Neighbour prefetch: one background thread decoding queued tile levels into the cache.
+  struct Job {
+    TileRef ref;
+    int mip = 0;
+  };
+  std::mutex queueMutex;
+  std::condition_variable queueCv;
+  std::deque<Job> queue;
+  bool stopping = false;
+  std::thread worker;
+
+  Impl(fs::path d, detail::Manifest m, CacheOptions c)
+      : dir(std::move(d)), man(std::move(m)), cacheOptions(c), cache(c.budgetBytes) {
+    for (const auto& f : man.desc.fields) fieldNames.push_back(f.name);
+    footprint = 1 << man.desc.metric.maxExp;
+  }
+  ~Impl() {
+    {
+      std::lock_guard lock(queueMutex);
+      stopping = true;
+    }
+    queueCv.notify_all();
+    if (worker.joinable()) worker.join();
+  }
+
+  int maxExp() const { return man.desc.metric.maxExp; }
+  int minExp() const { return man.desc.metric.minExp; }
+  size_t nf() const { return fieldNames.size(); }
+  TileRecord& rec(int tx, int ty) { return man.tiles[size_t(ty) * size_t(man.tilesX) + size_t(tx)]; }
+  TileRef ref(int tx, int ty) {
+    const auto& r = rec(tx, ty);
+    return {tx, ty, r.generation, r.file, r.crc32, r.bytes};
+  }
+
+  void workerLoop() {
+    for (;;) {
+      Job job;
+      {
+        std::unique_lock lock(queueMutex);
+        queueCv.wait(lock, [&] { return stopping || !queue.empty(); });
+        if (stopping) return;
+        job = std::move(queue.front());
+        queue.pop_front();
+      }
+      const CacheKey key{job.ref.tx, job.ref.ty, job.ref.generation, job.mip};
+      if (cache.contains(key)) continue;
+      // A failed prefetch (corrupt tile, file superseded by a commit) is not reported here: the
+      // demand read of that tile reports it.
+      if (auto d = loadTileLevel(dir, fieldNames, job.ref, job.mip)) cache.insert(key, std::move(*d), true);
+    }
+  }
+
+  void prefetchAround(int tx, int ty, int need) {
+    std::vector<Job> jobs;
+    for (int dy = -1; dy <= 1; ++dy) {
+      for (int dx = -1; dx <= 1; ++dx) {
+        if (!dx && !dy) continue;
+        int nx = tx + dx;
+        const int ny = ty + dy;
+        if (man.desc.layout == TileLayout::Global) nx = (nx + man.tilesX) % man.tilesX;
+        if (nx < 0 || ny < 0 || nx >= man.tilesX || ny >= man.tilesY || !rec(nx, ny).present) continue;
+        const int mip = std::max(0, rec(nx, ny).exp - need);
+        if (cache.contains({nx, ny, rec(nx, ny).generation, mip})) continue;
+        jobs.push_back({ref(nx, ny), mip});
+      }
+    }
+    if (jobs.empty()) return;
+    {
+      std::lock_guard lock(queueMutex);
+      for (auto& j : jobs) queue.push_back(std::move(j));
+      // Old requests are for where the reader was, not where it is: keep the queue short.
+      while (queue.size() > 32) queue.pop_front();
+      if (!worker.joinable()) worker = std::thread([this] { workerLoop(); });
+    }
+    queueCv.notify_one();
+  }
+
+  // The level of tile (tx, ty) closest to resolution 2^need from above (its finest when coarser).
+  Result<DecodedPtr> get(int tx, int ty, int need, bool prefetch) {
+    const auto& r = rec(tx, ty);
+    const int mip = std::max(0, r.exp - need);
+    const CacheKey key{tx, ty, r.generation, mip};
+    if (auto hit = cache.lookup(key)) return hit;
+    STRATA_TRY(DecodedPtr d, loadTileLevel(dir, fieldNames, ref(tx, ty), mip));
+    cache.insert(key, d, false);
+    if (prefetch && cacheOptions.prefetch) prefetchAround(tx, ty, need);
+    return d;
+  }
+
+  // Copies rows [sy, sy+h) x cols [sx, sx+w) of level `lod` (inside the level grid) into dst at (dx, dy).
+  Status readRect(int field, int lod, int sx, int sy, int w, int h, Grid<float>& dst, int dx, int dy) {
+    const int tileCells = footprint >> lod;
+    const int need = maxExp() - lod;
+    for (int ty = sy / tileCells; ty <= (sy + h - 1) / tileCells; ++ty) {
+      for (int tx = sx / tileCells; tx <= (sx + w - 1) / tileCells; ++tx) {
+        const auto& r = rec(tx, ty);
+        const int x0 = std::max(sx, tx * tileCells), x1 = std::min(sx + w, (tx + 1) * tileCells);
+        const int y0 = std::max(sy, ty * tileCells), y1 = std::min(sy + h, (ty + 1) * tileCells);
+        if (!r.present) {
+          for (int y = y0; y < y1; ++y) {
+            for (int x = x0; x < x1; ++x) dst.at(dx + x - sx, dy + y - sy) = gis::kNoData;
+          }
+          continue;
+        }
+        const int rep = r.exp >= need ? 1 : 1 << (need - r.exp);  // piecewise-constant upsampling
+        STRATA_TRY(DecodedPtr d, get(tx, ty, need, true));
+        const auto& g = d->fields[size_t(field)];
+        for (int y = y0; y < y1; ++y) {
+          const float* src = &g.data[g.index(0, (y - ty * tileCells) / rep)];
+          float* out = &dst.data[dst.index(dx + x0 - sx, dy + y - sy)];
+          if (rep == 1) {
+            std::copy(src + (x0 - tx * tileCells), src + (x1 - tx * tileCells), out);
+          } else {
+            const int shift = std::countr_zero(unsigned(rep));  // rep is a power of two
+            for (int x = x0; x < x1; ++x) out[x - x0] = src[(x - tx * tileCells) >> shift];
+          }
+        }
+      }
+    }
+    return {};
+  }
+
+  // All fields of tile (tx, ty) at full resolution (footprint^2; NaN where absent).
+  Result<std::vector<Grid<float>>> loadFull(int tx, int ty) {
+    const auto& r = rec(tx, ty);
+    if (!r.present) return std::vector<Grid<float>>(nf(), Grid<float>(footprint, footprint, gis::kNoData));
+    STRATA_TRY(DecodedPtr d, get(tx, ty, maxExp(), false));
+    std::vector<Grid<float>> out;
+    for (const auto& g : d->fields) out.push_back(replicateUpsample(g, 1 << (maxExp() - r.exp)));
+    return out;
+  }
+
+  // Writes `fields` (2^exp a side) and their mip chain as a new file for tile (tx, ty).
+  Status store(int tx, int ty, std::vector<Grid<float>> fields, int exp, std::vector<float> minV,
+               std::vector<float> maxV) {
+    std::vector<std::vector<Grid<float>>> levels;
+    levels.push_back(std::move(fields));
+    while (levels.back()[0].width > 1) {
+      std::vector<Grid<float>> next;
+      for (const auto& g : levels.back()) next.push_back(boxDownsample(g, 2));
+      levels.push_back(std::move(next));
+    }
+    const auto bytes = detail::encodeTileExr(fieldNames, levels);
+    auto& r = rec(tx, ty);
+    const uint64_t gen = man.nextGeneration++;
+    const std::string file =
+        "tiles/x" + std::to_string(tx) + "_y" + std::to_string(ty) + "_g" + std::to_string(gen) + ".exr";
+    STRATA_TRY_STATUS(writeTileFile(dir / file, bytes.data(), bytes.size()));
+    r.present = true;
+    r.exp = exp;
+    r.generation = gen;
+    r.file = file;
+    r.crc32 = uint32_t(crc32_z(crc32_z(0L, Z_NULL, 0), reinterpret_cast<const Bytef*>(bytes.data()), bytes.size()));
+    r.bytes = bytes.size();
+    r.minV = std::move(minV);
+    r.maxV = std::move(maxV);
+    return {};
+  }
+
+  std::vector<float> evalRange() const {
+    std::vector<float> g(nf());
+    for (size_t f = 0; f < nf(); ++f) g[f] = man.rangeHi[f] - man.rangeLo[f];
+    return g;
+  }
+
+  static void stats(const std::vector<Grid<float>>& fields, std::vector<float>& lo, std::vector<float>& hi) {
+    lo.assign(fields.size(), gis::kNoData);
+    hi.assign(fields.size(), gis::kNoData);
+    for (size_t f = 0; f < fields.size(); ++f) {
+      float a = std::numeric_limits<float>::infinity(), b = -a;
+      for (float v : fields[f].data) {
+        if (std::isnan(v)) continue;
+        a = std::min(a, v);
+        b = std::max(b, v);
+      }
+      if (a <= b) lo[f] = a, hi[f] = b;
+    }
+  }
+
+  Status put(int tx, int ty, const std::vector<Grid<float>>& full) {
+    std::vector<float> lo, hi;
+    stats(full, lo, hi);
+    auto& r = rec(tx, ty);
+    if (std::all_of(lo.begin(), lo.end(), [](float v) { return std::isnan(v); })) {
+      r = TileRecord{};
+      return {};
+    }
+    std::vector<float> range(nf());
+    for (size_t f = 0; f < nf(); ++f) range[f] = hi[f] - lo[f];
+    const int exp = chooseTileExp(range, evalRange(), minExp(), maxExp());
+    std::vector<Grid<float>> fields;
+    for (const auto& g : full) fields.push_back(boxDownsample(g, 1 << (maxExp() - exp)));
+    return store(tx, ty, std::move(fields), exp, std::move(lo), std::move(hi));
+  }
+
+  // Rewrites a tile at a new exponent from what it stores (its mip chain going down, piecewise-
+  // constant upsampling going up: detail it never stored cannot come back).
+  Status resample(int tx, int ty, int newExp) {
+    const auto& r = rec(tx, ty);
+    STRATA_TRY(DecodedPtr d, get(tx, ty, newExp, false));
+    std::vector<Grid<float>> fields;
+    for (const auto& g : d->fields) fields.push_back(replicateUpsample(g, newExp > r.exp ? 1 << (newExp - r.exp) : 1));
+    log::debug("terrain") << "tile " << tx << "," << ty << ": 2^" << r.exp << " -> 2^" << newExp;
+    return store(tx, ty, std::move(fields), newExp, r.minV, r.maxV);
+  }
+
+  // Sets the evaluation range; every tile not in `skip` whose exponent changes is resampled.
+  Status applyRange(const std::vector<float>& lo, const std::vector<float>& hi, const std::set<size_t>& skip) {
+    bool changed = false;
+    for (size_t f = 0; f < nf(); ++f) changed |= !sameValue(lo[f], man.rangeLo[f]) || !sameValue(hi[f], man.rangeHi[f]);
+    if (!changed) return {};
+    man.rangeLo = lo;
+    man.rangeHi = hi;
+    const auto g = evalRange();
+    for (int ty = 0; ty < man.tilesY; ++ty) {
+      for (int tx = 0; tx < man.tilesX; ++tx) {
+        const size_t i = size_t(ty) * size_t(man.tilesX) + size_t(tx);
+        const auto& r = man.tiles[i];
+        if (!r.present || skip.count(i)) continue;
+        std::vector<float> range(nf());
+        for (size_t f = 0; f < nf(); ++f) range[f] = r.maxV[f] - r.minV[f];
+        const int e = chooseTileExp(range, g, minExp(), maxExp());
+        if (e != r.exp) STRATA_TRY_STATUS(resample(tx, ty, e));
+      }
+    }
+    return {};
+  }
+
+  // The union of the tiles' ranges, with `extraLo/Hi` (new stats of tiles in `skip`) instead of
+  // the records of the tiles in `skip`.
+  void unionRange(const std::set<size_t>& skip, const std::vector<std::vector<float>>& extraLo,
+                  const std::vector<std::vector<float>>& extraHi, std::vector<float>& lo, std::vector<float>& hi) {
+    lo.assign(nf(), std::numeric_limits<float>::infinity());
+    hi.assign(nf(), -std::numeric_limits<float>::infinity());
+    auto add = [&](const std::vector<float>& a, const std::vector<float>& b) {
+      for (size_t f = 0; f < nf(); ++f) {
+        if (std::isnan(a[f])) continue;
+        lo[f] = std::min(lo[f], a[f]);
+        hi[f] = std::max(hi[f], b[f]);
+      }
+    };
+    for (size_t i = 0; i < man.tiles.size(); ++i) {
+      if (man.tiles[i].present && !skip.count(i)) add(man.tiles[i].minV, man.tiles[i].maxV);
+    }
+    for (size_t k = 0; k < extraLo.size(); ++k) add(extraLo[k], extraHi[k]);
+    for (size_t f = 0; f < nf(); ++f) {
+      if (lo[f] > hi[f]) lo[f] = hi[f] = gis::kNoData;
+    }
+  }
+};
+
+TileStore::TileStore(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+TileStore::TileStore(TileStore&&) noexcept = default;
+TileStore& TileStore::operator=(TileStore&&) noexcept = default;
+TileStore::~TileStore() = default;
+
+Result<TileStore> TileStore::create(const fs::path& dir, StoreDesc desc, CacheOptions cache) {
+  auto valid = detail::validateDesc(desc);
+  if (!valid) return fail(dir.string() + ": " + valid.message());
+  std::error_code ec;
+  if (fs::exists(dir / detail::kManifestName, ec)) return fail(dir.string() + ": already holds a tile store");
+  fs::create_directories(dir / "tiles", ec);
+  if (ec) return fail(dir.string() + ": cannot create: " + ec.message());
+  detail::Manifest m;
+  const int footprint = 1 << desc.metric.maxExp;
+  m.tilesX = detail::tilesAlong(desc.georef.width, footprint);
+  m.tilesY = detail::tilesAlong(desc.georef.height, footprint);
+  m.rangeLo.assign(desc.fields.size(), gis::kNoData);
+  m.rangeHi.assign(desc.fields.size(), gis::kNoData);
+  m.tiles.assign(size_t(m.tilesX) * size_t(m.tilesY), TileRecord{});
+  m.desc = std::move(desc);
+  TileStore s(std::make_unique<Impl>(dir, std::move(m), cache));
+  STRATA_TRY_STATUS(s.commit());
+  return s;
+}
+
+Result<TileStore> TileStore::open(const fs::path& dir, CacheOptions cache) {
+  const fs::path path = dir / detail::kManifestName;
+  std::ifstream in(path);
+  if (!in) return fail(path.string() + ": cannot read (not a Strata tile store?)");
+  std::stringstream text;
+  text << in.rdbuf();
+  STRATA_TRY(auto m, detail::parseManifest(text.str(), path.string()));
+  return TileStore(std::make_unique<Impl>(dir, std::move(m), cache));
+}
+
+const StoreDesc& TileStore::desc() const { return impl_->man.desc; }
+const fs::path& TileStore::dir() const { return impl_->dir; }
+int TileStore::width() const { return impl_->man.desc.georef.width; }
+int TileStore::height() const { return impl_->man.desc.georef.height; }
+int TileStore::footprint() const { return impl_->footprint; }
+int TileStore::tilesX() const { return impl_->man.tilesX; }
+int TileStore::tilesY() const { return impl_->man.tilesY; }
+int TileStore::maxLod() const { return impl_->maxExp(); }
+int TileStore::levelWidth(int lod) const { return (width() + (1 << lod) - 1) >> lod; }
+int TileStore::levelHeight(int lod) const { return (height() + (1 << lod) - 1) >> lod; }
+
+int TileStore::fieldIndex(const std::string& name) const {
+  for (size_t i = 0; i < impl_->fieldNames.size(); ++i) {
+    if (impl_->fieldNames[i] == name) return int(i);
+  }
+  return -1;
+}
+
+const TileRecord& TileStore::tile(int tx, int ty) const {
+  STRATA_CHECK(tx >= 0 && ty >= 0 && tx < tilesX() && ty < tilesY()) << "tile " << tx << "," << ty;
+  return impl_->rec(tx, ty);
+}
+
+std::pair<float, float> TileStore::globalRange(int field) const {
+  STRATA_CHECK(field >= 0 && size_t(field) < impl_->nf()) << "field " << field;
+  return {impl_->man.rangeLo[size_t(field)], impl_->man.rangeHi[size_t(field)]};
+}
+
+Result<Grid<float>> TileStore::readWindow(int field, Window w, int lod) {
+  auto& I = *impl_;
+  if (field < 0 || size_t(field) >= I.nf()) return fail(I.dir.string() + ": no field " + std::to_string(field));
+  if (lod < 0 || lod > maxLod()) {
+    return fail(I.dir.string() + ": level " + std::to_string(lod) + " outside 0.." + std::to_string(maxLod()));
+  }
+  if (w.width < 0 || w.height < 0) return fail(I.dir.string() + ": window with a negative size");
+  Grid<float> out(w.width, w.height, gis::kNoData);
+  const int lw = levelWidth(lod), lh = levelHeight(lod);
+  if (desc().layout == TileLayout::Planar) {
+    const int x0 = std::max(0, w.x), y0 = std::max(0, w.y);
+    const int x1 = std::min(lw, w.x + w.width), y1 = std::min(lh, w.y + w.height);
+    if (x0 < x1 && y0 < y1)
+      STRATA_TRY_STATUS(I.readRect(field, lod, x0, y0, x1 - x0, y1 - y0, out, x0 - w.x, y0 - w.y));
+    return out;
+  }
+  // Global: three bands of rows. Rows above the north pole (y < 0) continue down the meridian
+  // half a turn away (row -1-y, longitude + 180); likewise below the south pole. Columns wrap.
+  struct Band {
+    int outY0, outY1;  // output rows
+    bool folded;
+  };
+  const Band bands[3] = {{std::max(0, -lh - w.y), std::min(w.height, -w.y), true},
+                         {std::max(0, -w.y), std::min(w.height, lh - w.y), false},
+                         {std::max(0, lh - w.y), std::min(w.height, 2 * lh - w.y), true}};
+  for (const auto& b : bands) {
+    if (b.outY0 >= b.outY1) continue;
+    auto srcRow = [&](int j) {
+      const int y = w.y + j;
+      return y < 0 ? -1 - y : y >= lh ? 2 * lh - 1 - y : y;
+    };
+    const int s0 = std::min(srcRow(b.outY0), srcRow(b.outY1 - 1));
+    const int rows = b.outY1 - b.outY0;
+    const int shift = b.folded ? lw / 2 : 0;
+    Grid<float> tmp(w.width, rows, gis::kNoData);
+    for (int i = 0; i < w.width;) {
+      const int sx = (((w.x + i + shift) % lw) + lw) % lw;
+      const int len = std::min(w.width - i, lw - sx);
+      STRATA_TRY_STATUS(I.readRect(field, lod, sx, s0, len, rows, tmp, i, 0));
+      i += len;
+    }
+    for (int j = b.outY0; j < b.outY1; ++j) {
+      const int tj = srcRow(j) - s0;
+      std::copy_n(&tmp.data[tmp.index(0, tj)], w.width, &out.data[out.index(0, j)]);
+    }
+  }
+  return out;
+}
+
+Status TileStore::writeWindow(int field, int x, int y, const Grid<float>& values) {
+  auto& I = *impl_;
+  if (field < 0 || size_t(field) >= I.nf()) return fail(I.dir.string() + ": no field " + std::to_string(field));
+  if (x < 0 || y < 0 || x + values.width > width() || y + values.height > height()) {
+    return fail(I.dir.string() + ": window " + std::to_string(values.width) + "x" + std::to_string(values.height) +
+                " at " + std::to_string(x) + "," + std::to_string(y) + " is not inside the " + std::to_string(width()) +
+                "x" + std::to_string(height()) + " grid");
+  }
+  if (values.size() == 0) return {};
+  const int F = I.footprint;
+  // 1. The affected tiles at full resolution with the new cells pasted in, and their new ranges.
+  std::vector<std::pair<int, int>> tiles;
+  std::vector<std::vector<Grid<float>>> merged;
+  std::vector<std::vector<float>> los, his;
+  std::set<size_t> touched;
+  for (int ty = y / F; ty <= (y + values.height - 1) / F; ++ty) {
+    for (int tx = x / F; tx <= (x + values.width - 1) / F; ++tx) {
+      STRATA_TRY(auto full, I.loadFull(tx, ty));
+      auto& g = full[size_t(field)];
+      const int x0 = std::max(x, tx * F), x1 = std::min(x + values.width, (tx + 1) * F);
+      const int y0 = std::max(y, ty * F), y1 = std::min(y + values.height, (ty + 1) * F);
+      for (int yy = y0; yy < y1; ++yy) {
+        for (int xx = x0; xx < x1; ++xx) g.at(xx - tx * F, yy - ty * F) = values.at(xx - x, yy - y);
+      }
+      std::vector<float> lo, hi;
+      Impl::stats(full, lo, hi);
+      tiles.emplace_back(tx, ty);
+      merged.push_back(std::move(full));
+      los.push_back(std::move(lo));
+      his.push_back(std::move(hi));
+      touched.insert(size_t(ty) * size_t(tilesX()) + size_t(tx));
+    }
+  }
+  // 2. A moved global range re-evaluates every other tile; 3. the affected tiles are stored.
+  std::vector<float> lo, hi;
+  I.unionRange(touched, los, his, lo, hi);
+  STRATA_TRY_STATUS(I.applyRange(lo, hi, touched));
+  for (size_t k = 0; k < tiles.size(); ++k) STRATA_TRY_STATUS(I.put(tiles[k].first, tiles[k].second, merged[k]));
+  return {};
+}
+
+Status TileStore::putTile(int tx, int ty, const std::vector<Grid<float>>& fields) {
+  auto& I = *impl_;
+  STRATA_CHECK(tx >= 0 && ty >= 0 && tx < tilesX() && ty < tilesY()) << "tile " << tx << "," << ty;
+  STRATA_CHECK(fields.size() == I.nf()) << fields.size() << " fields given, the store has " << I.nf();
+  for (const auto& g : fields) {
+    STRATA_CHECK(g.width == I.footprint && g.height == I.footprint) << "tile field " << g.width << "x" << g.height;
+  }
+  return I.put(tx, ty, fields);
+}
+
+void TileStore::setEvaluationRange(int field, float lo, float hi) {
+  STRATA_CHECK(field >= 0 && size_t(field) < impl_->nf()) << "field " << field;
+  impl_->man.rangeLo[size_t(field)] = lo;
+  impl_->man.rangeHi[size_t(field)] = hi;
+}
+
+Status TileStore::reevaluate() {
+  std::vector<float> lo, hi;
+  impl_->unionRange({}, {}, {}, lo, hi);
+  return impl_->applyRange(lo, hi, {});
+}
+
+Status TileStore::commit() {
+  auto& I = *impl_;
+  const fs::path tiles = I.dir / "tiles";
+  // The tile files' data and names reach the disk before the manifest that names them.
+  syncDir(tiles, true);
+  const std::string text = detail::manifestToToml(I.man);
+  STRATA_TRY_STATUS(writeFileAtomic(I.dir / detail::kManifestName, text));
+  syncDir(I.dir, false);
+  // Superseded tiles, and leftovers of writers that died before their commit.
+  std::set<std::string> live;
+  for (const auto& r : I.man.tiles) {
+    if (r.present) live.insert(fs::path(r.file).filename().string());
+  }
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(tiles, ec)) {
+    if (!live.count(e.path().filename().string())) fs::remove(e.path(), ec);
+  }
+  for (const auto& e : fs::directory_iterator(I.dir, ec)) {
+    if (e.path().filename().string().rfind(std::string(detail::kManifestName) + ".tmp", 0) == 0)
+      fs::remove(e.path(), ec);
+  }
+  return {};
+}
+
+std::vector<TileProblem> TileStore::verify() const {
+  auto& I = *impl_;
+  std::vector<TileProblem> problems;
+  for (int ty = 0; ty < tilesY(); ++ty) {
+    for (int tx = 0; tx < tilesX(); ++tx) {
+      const auto& r = I.rec(tx, ty);
+      if (!r.present) continue;
+      const TileRef ref = I.ref(tx, ty);
+      auto bytes = readTileBytes(I.dir, ref);
+      if (!bytes) {
+        problems.push_back({r.file, bytes.message()});
+        continue;
+      }
+      auto finest = detail::decodeTileExrLevel(r.file, *bytes, I.fieldNames, 0);
+      auto coarsest = detail::decodeTileExrLevel(r.file, *bytes, I.fieldNames, r.exp);
+      if (!finest || !coarsest) {
+        problems.push_back({r.file, !finest ? finest.message() : coarsest.message()});
+      } else if ((*finest)[0].width != 1 << r.exp || (*coarsest)[0].width != 1) {
+        problems.push_back({r.file, r.file + ": " + std::to_string((*finest)[0].width) +
+                                        " samples a side, the manifest says 2^" + std::to_string(r.exp)});
+      }
+    }
+  }
+  return problems;
+}
+
+Grid<float> TileStore::resolutionMap() const {
+  Grid<float> m(tilesX(), tilesY(), gis::kNoData);
+  for (int ty = 0; ty < tilesY(); ++ty) {
+    for (int tx = 0; tx < tilesX(); ++tx) {
+      if (impl_->rec(tx, ty).present) m.at(tx, ty) = float(impl_->rec(tx, ty).exp);
+    }
+  }
+  return m;
+}
+
+StorageFootprint TileStore::footprintStats() const {
+  StorageFootprint s;
+  const uint64_t nf = impl_->nf();
+  s.denseSamples = uint64_t(width()) * uint64_t(height()) * nf;
+  for (const auto& r : impl_->man.tiles) {
+    if (!r.present) continue;
+    const uint64_t n = uint64_t(1) << (2 * r.exp);
+    s.storedSamples += n * nf;
+    for (uint64_t side = uint64_t(1) << r.exp; side >= 1; side /= 2) s.storedWithMips += side * side * nf;
+    s.fileBytes += r.bytes;
+  }
+  return s;
+}
+
+gis::Georef TileStore::windowGeoref(Window window, int lod) const {
+  gis::Georef g = desc().georef;
+  const double s = double(1 << lod);
+  const auto& c = desc().georef.transform.c;
+  g.transform.c[0] = c[0] + window.x * s * c[1] + window.y * s * c[2];
+  g.transform.c[3] = c[3] + window.x * s * c[4] + window.y * s * c[5];
+  g.transform.c[1] = c[1] * s;
+  g.transform.c[2] = c[2] * s;
+  g.transform.c[4] = c[4] * s;
+  g.transform.c[5] = c[5] * s;
+  g.width = window.width;
+  g.height = window.height;
+  return g;
+}
+
+Result<LayeredTerrain> TileStore::readTerrain(Window window) {
+  LayeredTerrain t;
+  t.georef = windowGeoref(window, 0);
+  t.materials = desc().materials;
+  t.bedrockM = Grid<float>(window.width, window.height, 0.0f);
+  t.waterM = Grid<float>(window.width, window.height, 0.0f);
+  for (size_t f = 0; f < impl_->nf(); ++f) {
+    const auto& sf = desc().fields[f];
+    STRATA_TRY(auto g, readWindow(int(f), window, 0));
+    switch (sf.kind) {
+      case LayerKind::Bedrock: t.bedrockM = std::move(g); break;
+      case LayerKind::Water: t.waterM = std::move(g); break;
+      case LayerKind::Material:
+        t.layers.push_back({sf.name, findMaterial(t.materials, sf.material), std::move(g)});
+        break;
+    }
+  }
+  return t;
+}
+
+CacheStats TileStore::cacheStats() const { return impl_->cache.stats(); }
+void TileStore::resetCacheStats() { impl_->cache.resetStats(); }
+void TileStore::clearCache() { impl_->cache.clear(); }
+
+}  // namespace strata::terrain
