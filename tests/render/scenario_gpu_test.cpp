@@ -130,7 +130,8 @@ TEST_F(GlTest, FloodScenarioWritesMapsSeriesAndReport) {
   EXPECT_NEAR(rows.back()[4], wet / 1e6, 1e-6 * wet / 1e6);
 
   // Plots and the report.
-  for (const char* f : {"plots/water.png", "plots/area.png", "plots/max_depth.png", "report.md"}) {
+  for (const char* f : {"plots/water.png", "plots/area.png", "plots/max_depth.png", "pictures/before.png",
+                        "pictures/peak.png", "pictures/after.png", "report.md"}) {
     EXPECT_TRUE(std::filesystem::exists(opt.outDir / f)) << f;
   }
   std::ifstream report(opt.outDir / "report.md");

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <optional>
 #include <sstream>
 
 #include <strata/core/files.hpp>
@@ -15,8 +16,10 @@
 #include <strata/gis/dem_io.hpp>
 #include <strata/gis/geodesy.hpp>
 #include <strata/render/gl/context.hpp>
+#include <strata/render/image_io.hpp>
 #include <strata/render/scenario/report.hpp>
 #include <strata/render/sim/simulation.hpp>
+#include <strata/render/terrain/terrain_renderer.hpp>
 #include <strata/terrain/scenario_domain.hpp>
 
 #ifndef STRATA_TOOLS_DIR
@@ -156,6 +159,50 @@ gis::Grid<float> materialThickness(const std::vector<gis::Grid<float>>& layers) 
   return t;
 }
 
+// Oblique pictures of the region with its water, drawn by the concentric-ring renderer: from
+// inside the region's southern edge, looking north across it, about a third of the region's
+// north-south extent above its highest point.
+class Pictures {
+ public:
+  static Result<Pictures> create(const gis::Raster& bed, double extentNorthSouthM) {
+    Pictures p;
+    STRATA_TRY(p.scene_, terrain::TerrainScene::create(bed));
+    STRATA_TRY(p.ring_, terrain::RingRenderer::create({.circles = 160}));
+    STRATA_TRY(p.target_, terrain::OffscreenTarget::create(kWidth, kHeight));
+    const auto& g = bed.georef;
+    const double span = std::abs(g.height * g.transform.c[5]);
+    p.camera_.lon = g.transform.c[0] + 0.5 * g.width * g.transform.c[1];
+    p.camera_.lat = g.transform.c[3] + g.height * g.transform.c[5] + 0.02 * span;
+    const double up = 0.35 * extentNorthSouthM, ahead = 0.5 * extentNorthSouthM;
+    p.camera_.heightM = p.scene_.maxElevationM() + up;
+    p.camera_.headingDeg = 0;
+    p.camera_.pitchDeg =
+        -std::atan2(up + p.scene_.maxElevationM() - 0.5 * (p.scene_.minElevationM() + p.scene_.maxElevationM()),
+                    ahead) *
+        180 / M_PI;
+    p.camera_.fovYDeg = 50;
+    p.shading_.waterDepthScaleM = 15;
+    return p;
+  }
+
+  /// Draws the terrain with `depthM` of water and writes `file` (PNG).
+  Status draw(const gis::Grid<float>& depthM, const fs::path& file) {
+    STRATA_TRY_STATUS(scene_.setWaterDepth(depthM));
+    STRATA_TRY_STATUS(ring_->draw(scene_, camera_, shading_, target_));
+    const auto tmp = temporaryPathFor(file).string() + ".png";
+    STRATA_TRY_STATUS(writeImage8(tmp, kWidth, kHeight, 4, target_.colour()));
+    return commitTemporary(tmp, file);
+  }
+
+ private:
+  static constexpr int kWidth = 960, kHeight = 540;
+  terrain::TerrainScene scene_;
+  std::unique_ptr<terrain::RingRenderer> ring_;
+  terrain::OffscreenTarget target_;
+  terrain::CameraPose camera_;
+  terrain::Shading shading_;
+};
+
 }  // namespace
 
 std::string seriesCsv(const std::vector<SeriesRow>& rows) {
@@ -191,6 +238,14 @@ Result<RunSummary> runScenario(const strata::terrain::Scenario& s, const RunOpti
   STRATA_TRY(auto sim, sim::Simulation::create(domain.input, domain.params));
   for (const auto& src : domain.sources) STRATA_TRY_STATUS(sim.addSource(src));
   sim.enableFloodStats(float(s.outputs.wetThresholdM));
+
+  std::optional<Pictures> pictures;
+  if (opt.pictures) {
+    fs::create_directories(opt.outDir / "pictures", ec);
+    STRATA_TRY(auto p, Pictures::create(domain.bed, domain.input.dyM * h));
+    pictures.emplace(std::move(p));
+    if (!opt.resume) STRATA_TRY_STATUS(pictures->draw(sim.readWaterDepth(), opt.outDir / "pictures" / "before.png"));
+  }
 
   const auto initialLayers = sim.readLayers();
   const gis::Grid<float> initialMaterial = materialThickness(initialLayers);
@@ -282,6 +337,15 @@ Result<RunSummary> runScenario(const strata::terrain::Scenario& s, const RunOpti
     }
     summary.series.push_back(row);
     ++interval;
+    if (pictures) {
+      // The peak picture is redrawn whenever the stored water reaches a new high at an interval.
+      const bool peak = std::all_of(summary.series.begin(), summary.series.end(),
+                                    [&](const SeriesRow& r) { return r.waterM3 <= row.waterM3; });
+      if (peak) {
+        STRATA_TRY_STATUS(pictures->draw(depth, opt.outDir / "pictures" / "peak.png"));
+      }
+      if (interval == intervals) STRATA_TRY_STATUS(pictures->draw(depth, opt.outDir / "pictures" / "after.png"));
+    }
 
     STRATA_TRY_STATUS(writeFileAtomic(opt.outDir / "series.csv", seriesCsv(summary.series)));
     const auto flood = sim.readFloodStats();
@@ -321,6 +385,11 @@ Result<RunSummary> runScenario(const strata::terrain::Scenario& s, const RunOpti
   }
   summary.files = {"scenario.toml", "series.csv", "checkpoint.bin"};
   summary.files.insert(summary.files.end(), mapFiles.begin(), mapFiles.end());
+  std::vector<std::string> pictureFiles;
+  for (const char* p : {"pictures/before.png", "pictures/peak.png", "pictures/after.png"}) {
+    if (fs::exists(opt.outDir / p)) pictureFiles.push_back(p);
+  }
+  summary.files.insert(summary.files.end(), pictureFiles.begin(), pictureFiles.end());
 
   if (opt.plots) {
     STRATA_TRY(auto plots, writePlots(opt.outDir, domain.bed, summary.completed));
