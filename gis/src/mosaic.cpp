@@ -104,9 +104,12 @@ Result<Raster> warpToGrid(const MosaicInput& input, const Georef& target) {
   wo->panDstBands = static_cast<int*>(CPLMalloc(sizeof(int)));
   wo->panDstBands[0] = 1;
   wo->eWorkingDataType = GDT_Float32;
-  wo->eResampleAlg = input.resampling == Resampling::Nearest    ? GRA_NearestNeighbour
-                     : input.resampling == Resampling::Bilinear ? GRA_Bilinear
-                                                                : GRA_Cubic;
+  switch (input.resampling) {
+    case Resampling::Nearest: wo->eResampleAlg = GRA_NearestNeighbour; break;
+    case Resampling::Bilinear: wo->eResampleAlg = GRA_Bilinear; break;
+    case Resampling::Cubic: wo->eResampleAlg = GRA_Cubic; break;
+    case Resampling::Minimum: wo->eResampleAlg = GRA_Min; break;
+  }
   if (srcNoData) {
     wo->padfSrcNoDataReal = static_cast<double*>(CPLMalloc(sizeof(double)));
     wo->padfSrcNoDataReal[0] = *srcNoData;

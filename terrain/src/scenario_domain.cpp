@@ -159,7 +159,11 @@ Result<ScenarioDomain> buildDomain(const Scenario& s) {
     target.transform.c[1] = g0.transform.c[1] * g0.width / target.width;
     target.transform.c[5] = g0.transform.c[5] * g0.height / target.height;
     scale = double(target.width) / g0.width;
-    STRATA_TRY(d.bed, gis::warpToGrid({demPath, std::nullopt}, target));
+    // Coarser cells take the lowest of the cells they cover: averaging (bilinear) raises a
+    // canyon's narrow floor towards its rim and dams the river (docs/scenario.md).
+    gis::MosaicInput in{demPath, std::nullopt};
+    in.resampling = scale < 1 ? gis::Resampling::Minimum : gis::Resampling::Bilinear;
+    STRATA_TRY(d.bed, gis::warpToGrid(in, target));
   }
   auto toRegion = [&](std::vector<std::array<double, 2>> px) {
     for (auto& p : px) p = {(p[0] - window.x) * scale, (p[1] - window.y) * scale};

@@ -159,27 +159,34 @@ gis::Grid<float> materialThickness(const std::vector<gis::Grid<float>>& layers) 
   return t;
 }
 
-// Oblique pictures of the region with its water, drawn by the concentric-ring renderer: from
-// inside the region's southern edge, looking north across it, about a third of the region's
-// north-south extent above its highest point.
+// Oblique pictures of the region with its water, drawn by the concentric-ring renderer: from a
+// little behind the first inflow (or the region's centre), looking across the region towards its
+// centre, about a quarter of the region's north-south extent above its highest point.
 class Pictures {
  public:
-  static Result<Pictures> create(const gis::Raster& bed, double extentNorthSouthM) {
+  static Result<Pictures> create(const strata::terrain::ScenarioDomain& d) {
     Pictures p;
-    STRATA_TRY(p.scene_, terrain::TerrainScene::create(bed));
+    const auto& g = d.bed.georef;
+    STRATA_TRY(p.scene_, terrain::TerrainScene::create(d.bed));
     STRATA_TRY(p.ring_, terrain::RingRenderer::create({.circles = 160}));
     STRATA_TRY(p.target_, terrain::OffscreenTarget::create(kWidth, kHeight));
-    const auto& g = bed.georef;
-    const double span = std::abs(g.height * g.transform.c[5]);
-    p.camera_.lon = g.transform.c[0] + 0.5 * g.width * g.transform.c[1];
-    p.camera_.lat = g.transform.c[3] + g.height * g.transform.c[5] + 0.02 * span;
-    const double up = 0.35 * extentNorthSouthM, ahead = 0.5 * extentNorthSouthM;
-    p.camera_.heightM = p.scene_.maxElevationM() + up;
-    p.camera_.headingDeg = 0;
-    p.camera_.pitchDeg =
-        -std::atan2(up + p.scene_.maxElevationM() - 0.5 * (p.scene_.minElevationM() + p.scene_.maxElevationM()),
-                    ahead) *
-        180 / M_PI;
+    const double cx = 0.5 * g.width, cy = 0.5 * g.height;
+    double tx = cx, ty = cy;
+    if (!d.sources.empty()) {
+      tx = d.sources.front().cells.front().first + 0.5;
+      ty = d.sources.front().cells.front().second + 0.5;
+    }
+    // Cell (column, row) offsets in metres: east, north.
+    const double dxM = d.input.rowDxM[d.input.rowDxM.size() / 2], dyM = d.input.dyM;
+    double east = (cx - tx) * dxM, north = (ty - cy) * dyM;
+    if (std::hypot(east, north) < 1) north = 1;  // no inflow: look north from the centre
+    const double camX = std::clamp(tx - 0.15 * (cx - tx), 0.5, g.width - 0.5);
+    const double camY = std::clamp(ty - 0.15 * (cy - ty), 0.5, g.height - 0.5);
+    p.camera_.lon = g.transform.x(camX, camY);
+    p.camera_.lat = g.transform.y(camX, camY);
+    p.camera_.heightM = p.scene_.maxElevationM() + 0.25 * dyM * g.height;
+    p.camera_.headingDeg = std::atan2(east, north) * 180 / M_PI;
+    p.camera_.pitchDeg = -40;
     p.camera_.fovYDeg = 50;
     p.shading_.waterDepthScaleM = 15;
     return p;
@@ -242,7 +249,7 @@ Result<RunSummary> runScenario(const strata::terrain::Scenario& s, const RunOpti
   std::optional<Pictures> pictures;
   if (opt.pictures) {
     fs::create_directories(opt.outDir / "pictures", ec);
-    STRATA_TRY(auto p, Pictures::create(domain.bed, domain.input.dyM * h));
+    STRATA_TRY(auto p, Pictures::create(domain));
     pictures.emplace(std::move(p));
     if (!opt.resume) STRATA_TRY_STATUS(pictures->draw(sim.readWaterDepth(), opt.outDir / "pictures" / "before.png"));
   }

@@ -173,6 +173,28 @@ Status writeReport(const fs::path& runDir, const ReportInput& in) {
     md += "| area flooded at some time | " + fmt("%.1f", everWet / 1e6) + " km² |\n";
     md += "| deepest water | " + fmt("%.1f", deep.value) + " m at " + where(g, deep.x, deep.y) + " |\n";
     md += "| fastest water | " + fmt("%.1f", fast.value) + " m/s at " + where(g, fast.x, fast.y) + " |\n";
+    if (!d.sources.empty()) {
+      // How far the water got: the wet cell farthest (geodesic) from the first inflow.
+      const auto& c0 = d.sources.front().cells.front();
+      auto from = gis::pixelToLonLat(g, c0.first + 0.5, c0.second + 0.5);
+      double farM = 0;
+      int fx = c0.first, fy = c0.second;
+      for (int y = 0; from && y < g.height; ++y) {
+        for (int x = 0; x < g.width; ++x) {
+          if (!(in.flood.maxDepthM.at(x, y) > s.outputs.wetThresholdM)) continue;
+          auto to = gis::pixelToLonLat(g, x + 0.5, y + 0.5);
+          const double m = to ? gis::geodesicDistanceM(*from, *to, g.body) : 0;
+          if (m > farM) {
+            farM = m;
+            fx = x;
+            fy = y;
+          }
+        }
+      }
+      const double arrival = in.flood.arrivalS.at(fx, fy);
+      md += "| farthest reach | " + fmt("%.1f", farM / 1e3) + " km (straight line) from \"" + d.sourceNames.front() +
+            "\", at " + where(g, fx, fy) + (arrival >= 0 ? ", reached at " + hours(arrival) : "") + " |\n";
+    }
     md += "| water that left through the edges | " + millions(last.outflowM3) +
           (supplied > 0 ? " (" + fmt("%.0f", 100 * last.outflowM3 / supplied) + "% of what entered)" : "") + " |\n";
     md += "| water in the region at the end | " + millions(last.waterM3) + ", " + fmt("%.1f", last.floodedAreaKm2) +

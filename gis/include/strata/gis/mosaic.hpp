@@ -17,7 +17,9 @@ namespace strata::gis {
 enum class BlendMode { Replace, Add, Subtract, Multiply, Max, Min };
 
 /// Resampling kernel used when warping an input onto the target grid.
-enum class Resampling { Nearest, Bilinear, Cubic };
+/// Minimum: each target cell takes the lowest source cell it covers (GDAL's "min"); coarsening a
+/// DEM this way keeps narrow channels connected, which flow routing needs.
+enum class Resampling { Nearest, Bilinear, Cubic, Minimum };
 
 /// "replace", "add", "subtract", "multiply", "max", "min".
 std::string_view toString(BlendMode mode);
