@@ -21,21 +21,8 @@ using strata::terrain::sim::CpuSimulation;
 using strata::terrain::sim::WaterModel;
 using test::GlTest;
 
-SimParams pipeParams() {
-  SimParams p;
-  p.waterModel = int32_t(WaterModel::kVirtualPipes);
-  p.maxDtS = 0.1f;
-  p.pipeAreaM2 = 25.0f;
-  return p;
-}
-
-SimParams floodParams() {
-  SimParams p;
-  p.waterModel = int32_t(WaterModel::kFiniteVolume);
-  p.maxDtS = 10.0f;
-  p.cflAlpha = 0.45f;
-  return p;
-}
+using test::floodParams;
+using test::pipeParams;
 
 double maxAbsDiff(const gis::Grid<float>& a, const gis::Grid<float>& b) {
   double m = 0;

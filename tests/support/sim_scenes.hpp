@@ -99,6 +99,24 @@ inline terrain::sim::SimInput erodingValley(int n) {
 }
 
 /// Erosion parameters for erodingValley (pipes, erosion and thermal weathering on).
+/// Virtual pipes with a fixed 0.1 s step and 25 m^2 pipes (the water tests' default).
+inline terrain::sim::SimParams pipeParams() {
+  terrain::sim::SimParams p;
+  p.waterModel = int32_t(terrain::sim::WaterModel::kVirtualPipes);
+  p.maxDtS = 0.1f;
+  p.pipeAreaM2 = 25.0f;
+  return p;
+}
+
+/// Flood mode with the CFL step (alpha 0.45) capped at 10 s.
+inline terrain::sim::SimParams floodParams() {
+  terrain::sim::SimParams p;
+  p.waterModel = int32_t(terrain::sim::WaterModel::kFiniteVolume);
+  p.maxDtS = 10.0f;
+  p.cflAlpha = 0.45f;
+  return p;
+}
+
 inline terrain::sim::SimParams erosionParams() {
   terrain::sim::SimParams p;
   p.waterModel = int32_t(terrain::sim::WaterModel::kVirtualPipes);

@@ -14,21 +14,8 @@ namespace {
 
 using test::fourLayers;
 
-SimParams pipeParams() {
-  SimParams p;
-  p.waterModel = int32_t(WaterModel::kVirtualPipes);
-  p.maxDtS = 0.1f;
-  p.pipeAreaM2 = 25.0f;
-  return p;
-}
-
-SimParams floodParams() {
-  SimParams p;
-  p.waterModel = int32_t(WaterModel::kFiniteVolume);
-  p.maxDtS = 10.0f;
-  p.cflAlpha = 0.45f;
-  return p;
-}
+using test::floodParams;
+using test::pipeParams;
 
 void expectLakeAtRest(const SimParams& params, int steps) {
   const auto in = test::lakeAtRest(48, 2000.0);
