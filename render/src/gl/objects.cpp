@@ -176,6 +176,16 @@ VertexArray VertexArray::create() {
 
 void VertexArray::bind() const { glBindVertexArray(id()); }
 
+VertexArray VertexArray::forMesh(const Buffer& vertices, int floatsPerVertex, const Buffer& indices) {
+  VertexArray v = create();
+  glVertexArrayVertexBuffer(v.id(), 0, vertices.id(), 0, GLsizei(floatsPerVertex * sizeof(float)));
+  glVertexArrayAttribFormat(v.id(), 0, floatsPerVertex, GL_FLOAT, GL_FALSE, 0);
+  glVertexArrayAttribBinding(v.id(), 0, 0);
+  glEnableVertexArrayAttrib(v.id(), 0);
+  glVertexArrayElementBuffer(v.id(), indices.id());
+  return v;
+}
+
 // ---- Program ---------------------------------------------------------------------------------
 
 namespace {

@@ -80,13 +80,7 @@ Result<std::unique_ptr<SlidingGridRenderer>> SlidingGridRenderer::create(const S
   r->vertices_ = gl::Buffer::from(std::span<const glm::vec3>(mesh.vertices), 0);
   r->indices_ = gl::Buffer::from(std::span<const uint32_t>(mesh.triangles), 0);
   r->indexCount_ = GLsizei(mesh.triangles.size());
-  r->vao_ = gl::VertexArray::create();
-  const GLuint vao = r->vao_.id();
-  glVertexArrayVertexBuffer(vao, 0, r->vertices_.id(), 0, sizeof(glm::vec3));
-  glVertexArrayAttribFormat(vao, 0, 3, GL_FLOAT, GL_FALSE, 0);
-  glVertexArrayAttribBinding(vao, 0, 0);
-  glEnableVertexArrayAttrib(vao, 0);
-  glVertexArrayElementBuffer(vao, r->indices_.id());
+  r->vao_ = gl::VertexArray::forMesh(r->vertices_, 3, r->indices_);
   return r;
 }
 

@@ -323,13 +323,7 @@ Result<std::unique_ptr<RingRenderer>> RingRenderer::create(const RingParams& par
   r->vertices_ = gl::Buffer::from(std::span<const glm::vec2>(mesh.vertices), 0);
   r->indices_ = gl::Buffer::from(std::span<const uint32_t>(mesh.strip), 0);
   r->indexCount_ = GLsizei(mesh.strip.size());
-  r->vao_ = gl::VertexArray::create();
-  const GLuint vao = r->vao_.id();
-  glVertexArrayVertexBuffer(vao, 0, r->vertices_.id(), 0, sizeof(glm::vec2));
-  glVertexArrayAttribFormat(vao, 0, 2, GL_FLOAT, GL_FALSE, 0);
-  glVertexArrayAttribBinding(vao, 0, 0);
-  glEnableVertexArrayAttrib(vao, 0);
-  glVertexArrayElementBuffer(vao, r->indices_.id());
+  r->vao_ = gl::VertexArray::forMesh(r->vertices_, 2, r->indices_);
   return r;
 }
 

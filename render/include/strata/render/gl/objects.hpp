@@ -157,6 +157,9 @@ class Framebuffer : public Object<detail::deleteFramebuffer> {
 class VertexArray : public Object<detail::deleteVertexArray> {
  public:
   static VertexArray create();
+  /// A mesh: attribute 0 = `floatsPerVertex` tightly packed floats from `vertices`, indexed by
+  /// the uint32 `indices`. The buffers must outlive the vertex array.
+  static VertexArray forMesh(const Buffer& vertices, int floatsPerVertex, const Buffer& indices);
   void bind() const;
 };
 
