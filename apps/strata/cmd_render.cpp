@@ -141,12 +141,13 @@ void run(const RenderArgs& a) {
       STRATA_TRY(auto dem, loadDem(a.dem));
       return TerrainScene::create(dem, {.planetary = a.planetary});
     }
-    if (a.planetary) return fail("--planetary: tile stores are streamed in planar mode only");
     STRATA_TRY(auto opened, strata::terrain::TileStore::open(a.dem));
-    return TerrainScene::createStreamed(std::move(opened), {.clipSize = a.clipSize,
-                                                            .pageSize = a.pageSize,
-                                                            .uploadPagesPerFrame = a.uploadPages,
-                                                            .gpuBudgetBytes = size_t(a.gpuBudgetMiB * 1048576.0)});
+    return TerrainScene::createStreamed(std::move(opened),
+                                        {.clipSize = a.clipSize,
+                                         .pageSize = a.pageSize,
+                                         .uploadPagesPerFrame = a.uploadPages,
+                                         .gpuBudgetBytes = size_t(a.gpuBudgetMiB * 1048576.0)},
+                                        {.planetary = a.planetary});
   }();
   if (!scene) die(a.dem + ": " + scene.message());
   auto renderer = makeRenderer(a);

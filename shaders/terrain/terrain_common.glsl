@@ -33,10 +33,13 @@ uniform int uPageShift;          // log2(P)
 uniform ivec2 uClipOrigin[16];   // window corner of level l (level texels, a multiple of P)
 uniform vec2 uCoarseUvScale;     // uv -> uHeight's texture coordinates (1 unless streamed)
 
-// Level-l texel coordinates of `uv`, clamped to the level's extent as GL_CLAMP_TO_EDGE would.
+// Level-l texel coordinates of `uv`, clamped to the level's extent as GL_CLAMP_TO_EDGE would
+// (not in x when the DEM wraps in longitude: the windows continue across the seam).
 vec2 levelTexel(vec2 uv, int l) {
   vec2 size = ceil(uTexSize / exp2(float(l)));
-  return clamp(uv * uTexSize / exp2(float(l)), vec2(0.5), size - 0.5);
+  vec2 p = uv * uTexSize / exp2(float(l));
+  vec2 q = clamp(p, vec2(0.5), size - 0.5);
+  return vec2(uWrapU != 0 ? p.x : q.x, q.y);
 }
 
 // Whether bilinear sampling of level l at level texel p only touches resident pages.
@@ -46,7 +49,10 @@ bool clipResident(int l, vec2 p) {
   int n = int(uClipSize);
   if (any(lessThan(i0, o)) || any(greaterThanEqual(i1, o + n))) return false;
   int k = n >> uPageShift;
-  ivec2 a = (i0 >> uPageShift) % k, b = (i1 >> uPageShift) % k;  // i0 >= 0: no negative remainders
+  // Slots: page index modulo k, floored (columns can be negative across the seam; GLSL's % is
+  // undefined for negative operands, and >> on ints is arithmetic: a floored division).
+  ivec2 pa = i0 >> uPageShift, pb = i1 >> uPageShift;
+  ivec2 a = pa - k * ivec2(floor(vec2(pa) / float(k))), b = pb - k * ivec2(floor(vec2(pb) / float(k)));
   return texelFetch(uClipPages, ivec3(a, l), 0).r != 0u && texelFetch(uClipPages, ivec3(b.x, a.y, l), 0).r != 0u &&
          texelFetch(uClipPages, ivec3(a.x, b.y, l), 0).r != 0u && texelFetch(uClipPages, ivec3(b, l), 0).r != 0u;
 }

@@ -16,10 +16,10 @@ int wrap(int a, int n) { return ((a % n) + n) % n; }
 StreamedElevation::~StreamedElevation() = default;
 
 Result<std::unique_ptr<StreamedElevation>> StreamedElevation::create(strata::terrain::TileStore store,
-                                                                     const StreamParams& params) {
+                                                                     const StreamParams& params, bool wrapLongitude) {
   const std::string where = "render: streaming " + store.dir().string() + ": ";
-  if (store.desc().layout != strata::terrain::TileLayout::Planar) {
-    return fail(where + "only planar stores are streamed (this one is global)");
+  if (wrapLongitude && store.desc().layout != strata::terrain::TileLayout::Global) {
+    return fail(where + "wrapping in longitude needs a global store (this one is planar)");
   }
   const int p = params.pageSize, n = params.clipSize;
   if (p < 8 || p > 1024 || (p & (p - 1)) != 0) {
@@ -36,6 +36,7 @@ Result<std::unique_ptr<StreamedElevation>> StreamedElevation::create(strata::ter
   std::unique_ptr<StreamedElevation> s(new StreamedElevation());
   s->params_ = params;
   s->field_ = field;
+  s->wrapX_ = wrapLongitude;
   s->store_ = std::make_unique<strata::terrain::TileStore>(std::move(store));
   auto& st = *s->store_;
   const auto [lo, hi] = st.globalRange(field);
@@ -61,6 +62,7 @@ Result<std::unique_ptr<StreamedElevation>> StreamedElevation::create(strata::ter
   s->coarseTex_ = gl::Texture::create2D(gl::kR32F, cw, ch, 0);
   s->coarseTex_.upload(s->coarseCpu_.data.data());
   s->coarseTex_.generateMipmap();
+  if (wrapLongitude) glTextureParameteri(s->coarseTex_.id(), GL_TEXTURE_WRAP_S, GL_REPEAT);
 
   // The stack: one toroidal layer per level 0..C-1 (one unused layer when C = 0, so that the
   // sampler always has a texture), bilinear with wrap-around addressing.
@@ -121,9 +123,10 @@ void StreamedElevation::moveWindow(int level, glm::ivec2 origin) {
   for (int py = o.y; py < o.y + k; ++py) {
     for (int px = o.x; px < o.x + k; ++px) {
       if (had && inWindow(level, px, py)) continue;  // stays resident in its slot
-      const bool outside = px < 0 || py < 0 || px * p >= ext.x || py * p >= ext.y;
       // Pages wholly outside the level's cells are never sampled (the shader clamps to the
-      // level's extent): ready at once, nothing to copy.
+      // level's extent): ready at once, nothing to copy. Wrapping in longitude, columns past
+      // the seam are real pages (the store's global reads take them modulo the grid).
+      const bool outside = (!wrapX_ && (px < 0 || px * p >= ext.x)) || py < 0 || py * p >= ext.y;
       flagsCpu_[flagIndex(level, px, py)] = outside ? 1u : 0u;
       if (!outside) pending_.push_back({level, px, py});
     }

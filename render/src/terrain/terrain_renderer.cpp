@@ -156,17 +156,21 @@ Result<TerrainScene> TerrainScene::create(const gis::Raster& dem, const SceneOpt
   return s;
 }
 
-Result<TerrainScene> TerrainScene::createStreamed(strata::terrain::TileStore store, const StreamParams& params) {
+Result<TerrainScene> TerrainScene::createStreamed(strata::terrain::TileStore store, const StreamParams& params,
+                                                  const SceneOptions& options) {
   const gis::Georef g = store.desc().georef;
+  if (options.planetary && !g.geographic) return fail("render: planetary mode needs a geographic (lon/lat) store");
   if (!g.transform.isNorthUp() || g.transform.c[1] <= 0 || g.transform.c[5] >= 0) {
     return fail("render: store " + store.dir().string() +
                 ": geotransform is not north-up (rotation terms or axis signs)");
   }
   if (g.body.semiMajorM <= 0) return fail("render: store body '" + g.body.name + "' has no radius");
   if (g.width < 2 || g.height < 2) return fail("render: store " + store.dir().string() + " has fewer than 2x2 cells");
-  STRATA_TRY(auto streamed, StreamedElevation::create(std::move(store), params));
+  STRATA_TRY(auto streamed,
+             StreamedElevation::create(std::move(store), params, options.planetary && isGlobalInLongitude(g)));
   TerrainScene s;
   s.georef_ = g;
+  s.planetary_ = options.planetary;
   s.minM_ = streamed->minElevationM();
   s.maxM_ = streamed->maxElevationM();
   s.streamed_ = std::move(streamed);

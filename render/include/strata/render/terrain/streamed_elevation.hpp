@@ -50,10 +50,12 @@ struct StreamStats {
 
 class StreamedElevation {
  public:
-  /// Takes the store; reads its coarse level C (whole terrain) and uploads it. Planar stores only.
+  /// Takes the store; reads its coarse level C (whole terrain) and uploads it. `wrapLongitude`:
+  /// the grid spans 360 degrees and is drawn on the body (planetary mode), so windows continue
+  /// across the seam (page columns are taken modulo the grid by the store's global reads).
   /// Fails on bad parameters, a missing field, or a budget too small for the stack plus one page.
   static Result<std::unique_ptr<StreamedElevation>> create(strata::terrain::TileStore store,
-                                                           const StreamParams& params = {});
+                                                           const StreamParams& params = {}, bool wrapLongitude = false);
   ~StreamedElevation();
 
   /// Centres the windows on the viewer at base-grid position `cell` (cells from the grid's
@@ -105,7 +107,7 @@ class StreamedElevation {
   StreamParams params_;
   int field_ = 0, coarse_ = 0;
   float minM_ = 0, maxM_ = 0;
-  bool placed_ = false;
+  bool placed_ = false, wrapX_ = false;
   std::vector<glm::ivec2> origins_;
   std::vector<uint32_t> flagsCpu_;  // slots^2 per stack level, 1: the slot holds its window's page
   bool flagsDirty_ = true;

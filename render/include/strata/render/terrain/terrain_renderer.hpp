@@ -64,11 +64,13 @@ struct SceneOptions {
 class TerrainScene {
  public:
   static Result<TerrainScene> create(const gis::Raster& dem, const SceneOptions& options = {});
-  /// Streams the elevation of a planar tile store (taken over): the renderers that support it
-  /// (ring, sliding grid) move the stack to each frame's viewer and refill it within the
-  /// per-frame budget before drawing. Water, material layers, heights() and gridSurfaceAt()
-  /// are for whole-DEM scenes only.
-  static Result<TerrainScene> createStreamed(strata::terrain::TileStore store, const StreamParams& params = {});
+  /// Streams the elevation of a tile store (taken over): the renderers that support it (ring,
+  /// sliding grid) move the stack to each frame's viewer and refill it within the per-frame
+  /// budget before drawing. Planetary mode needs a geographic store; a global one then wraps
+  /// across the seam. Water, material layers, heights() and gridSurfaceAt() are for whole-DEM
+  /// scenes only.
+  static Result<TerrainScene> createStreamed(strata::terrain::TileStore store, const StreamParams& params = {},
+                                             const SceneOptions& options = {});
 
   /// Water depth (m) over the terrain, same grid as the DEM.
   Status setWaterDepth(const gis::Grid<float>& depthM);
