@@ -51,7 +51,11 @@ Result<std::unique_ptr<StreamedElevation>> StreamedElevation::create(strata::ter
     return fail(where + "clip size " + std::to_string(n) + " is too small: level " + std::to_string(st.maxLod()) +
                 " (the store's coarsest) is " + std::to_string(st.levelWidth(st.maxLod())) + " cells wide");
   }
-  if (c > 30) return fail(where + "too many levels");
+  // terrain_common.glsl holds 16 window origins.
+  if (c > 16) {
+    return fail(where + "clip size " + std::to_string(n) + " needs " + std::to_string(c) +
+                " streamed levels for this grid, more than 16: use a larger one");
+  }
   s->coarse_ = c;
   const int cw = st.levelWidth(c), ch = st.levelHeight(c);
   STRATA_TRY(auto coarse, st.readWindow(field, {0, 0, cw, ch}, c));
