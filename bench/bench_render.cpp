@@ -8,12 +8,17 @@
 // with the DEM; the grid's does). The Grand Canyon errors are in the gpu test's report
 // (build/test-output/render/ring_error.txt).
 //   build/bench/strata_bench_render [--benchmark_filter=...]
+// Streaming (BM_StreamedVsWhole, BM_StreamRefill): the same synthetic DEM drawn from a whole-
+// DEM texture and streamed from a tile store (ingested once into $TMPDIR/strata_bench_stream_N),
+// with the viewer gliding east; and the cost of refilling the stack when the viewer moves by
+// one page.
 // Figures: docs/benchmarks.md ("Render").
 #include <benchmark/benchmark.h>
 
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <map>
 #include <memory>
 #include <optional>
@@ -24,6 +29,8 @@
 #include <strata/render/terrain/sliding_grid.hpp>
 #include <strata/render/terrain/synthetic_dem.hpp>
 #include <strata/render/terrain/terrain_renderer.hpp>
+#include <strata/terrain/ingest.hpp>
+#include <strata/terrain/tile_store.hpp>
 
 namespace {
 using namespace strata::render;
@@ -160,6 +167,135 @@ void BM_RingCpuPerFrame(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_RingCpuPerFrame)->ArgName("dem")->Arg(512)->Arg(2048)->Unit(benchmark::kMicrosecond);
+
+// The synthetic DEM of size^2 cells as a tile store (tiles of 256 cells, 2^5..2^8), streamed
+// with windows of 512 texels in pages of 64 and a 64 MiB GPU budget.
+std::unique_ptr<TerrainScene> streamedSynthetic(int size, int uploadPages, size_t gpuBudget = size_t(64) << 20) {
+  const auto dir = std::filesystem::temp_directory_path() / ("strata_bench_stream_" + std::to_string(size));
+  if (!std::filesystem::exists(dir / "manifest.toml")) {
+    std::filesystem::remove_all(dir);
+    const auto dem = syntheticDem(size, 30.0, 400.0, 1);
+    strata::terrain::WindowReader read = [&dem](int x, int y, int w,
+                                                int h) -> strata::Result<strata::gis::Grid<float>> {
+      strata::gis::Grid<float> g(w, h, strata::gis::kNoData);
+      for (int j = 0; j < h; ++j) {
+        for (int i = 0; i < w; ++i) {
+          if (dem.values.contains(x + i, y + j)) g.at(i, j) = dem.values.at(x + i, y + j);
+        }
+      }
+      return g;
+    };
+    strata::terrain::IngestOptions o;
+    o.metric = {.minExp = 5, .maxExp = 8};
+    auto rep =
+        strata::terrain::ingest(dir, dem.georef, {{{"bedrock", strata::terrain::LayerKind::Bedrock, ""}, read}}, o);
+    if (!rep) {
+      std::fprintf(stderr, "%s\n", rep.message().c_str());
+      std::exit(1);
+    }
+  }
+  auto store = strata::terrain::TileStore::open(dir, {.budgetBytes = size_t(256) << 20, .prefetch = false});
+  if (!store) {
+    std::fprintf(stderr, "%s\n", store.message().c_str());
+    std::exit(1);
+  }
+  auto scene = TerrainScene::createStreamed(
+      std::move(store).value(),
+      {.clipSize = 512, .pageSize = 64, .uploadPagesPerFrame = uploadPages, .gpuBudgetBytes = gpuBudget});
+  if (!scene) {
+    std::fprintf(stderr, "%s\n", scene.message().c_str());
+    std::exit(1);
+  }
+  return std::make_unique<TerrainScene>(std::move(scene).value());
+}
+
+// Ring renderer (128 circles, 640x360) on a synthetic DEM of range(1)^2 cells, whole-DEM
+// texture (range(0) = 0) or streamed from a store (range(0) = 1), the viewer gliding east 15 m
+// (half a cell) a frame: the draw's CPU time (submit_ms, including the stack's refill), the GPU
+// timer and the wall time to glFinish.
+void BM_StreamedVsWhole(benchmark::State& state) {
+  const bool streamed = state.range(0) != 0;
+  const int size = int(state.range(1));
+  Setup& s = synthetic(size);
+  std::unique_ptr<TerrainScene> owned = streamed ? streamedSynthetic(size, 64) : nullptr;
+  const TerrainScene& scene = streamed ? *owned : *s.scene;
+  auto ring = RingRenderer::create({.circles = 128});
+  if (!ring) return state.SkipWithError(ring.message().c_str());
+  auto target = OffscreenTarget::create(640, 360);
+  if (!target) return state.SkipWithError(target.message().c_str());
+  const Shading shading;
+  CameraPose cam = s.camera;
+  // Warm-up: compiles, and (streamed) fills the windows.
+  for (int i = 0; i < 100; ++i) {
+    if (auto r = (*ring)->draw(scene, cam, shading, *target); !r) return state.SkipWithError(r.message().c_str());
+    if (!streamed || scene.streamed()->stats().pending == 0) break;
+  }
+  glFinish();
+  double submitMs = 0, timerMs = 0;
+  uint64_t copied0 = streamed ? scene.streamed()->stats().pagesCopied : 0;
+  for (auto _ : state) {
+    cam.lon += 15.0;
+    gl::GpuTimer t;
+    const auto c0 = std::chrono::steady_clock::now();
+    t.begin();
+    (void)(*ring)->draw(scene, cam, shading, *target);
+    t.end();
+    const auto c1 = std::chrono::steady_clock::now();
+    glFinish();
+    const auto c2 = std::chrono::steady_clock::now();
+    submitMs += std::chrono::duration<double, std::milli>(c1 - c0).count();
+    timerMs += t.milliseconds();
+    state.SetIterationTime(std::chrono::duration<double>(c2 - c0).count());
+  }
+  state.SetLabel(streamed ? "streamed" : "whole");
+  state.counters["submit_ms"] = submitMs / double(state.iterations());
+  state.counters["gpu_timer_ms"] = timerMs / double(state.iterations());
+  if (streamed) {
+    const auto st = scene.streamed()->stats();
+    state.counters["pages/frame"] = double(st.pagesCopied - copied0) / double(state.iterations());
+    state.counters["gpu_MiB"] = double(st.gpuBytes) / 1048576.0;
+  }
+}
+BENCHMARK(BM_StreamedVsWhole)
+    ->ArgNames({"streamed", "dem"})
+    ->Args({0, 2048})
+    ->Args({1, 2048})
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(6);
+
+// Refill when the viewer moves by one page (64 cells) east or west along a 16-page stretch:
+// update() alone (CPU, page uploads from the store's RAM cache into the GPU tile cache, GPU
+// copies into the stack) to glFinish. Pages per move and how many came from RAM (GPU cache
+// misses): with a 64 MiB budget (range(0) = 64) the stretch stays in the GPU cache; with 4 MiB
+// (the stack takes 3.4 of it) nearly every page is uploaded again.
+void BM_StreamRefill(benchmark::State& state) {
+  auto scene = streamedSynthetic(2048, 1000, size_t(state.range(0)) << 20);
+  auto* st = scene->streamed();
+  glm::dvec2 cell(512, 1024);
+  if (auto r = st->update(cell); !r) return state.SkipWithError(r.message().c_str());
+  glFinish();
+  const auto before = st->stats();
+  int step = 0;
+  for (auto _ : state) {
+    cell.x += ((step++ / 16) % 2 ? -64.0 : 64.0);
+    const auto c0 = std::chrono::steady_clock::now();
+    (void)st->update(cell);
+    glFinish();
+    state.SetIterationTime(std::chrono::duration<double>(std::chrono::steady_clock::now() - c0).count());
+  }
+  const auto after = st->stats();
+  const double n = double(state.iterations());
+  state.counters["pages/move"] = double(after.pagesCopied - before.pagesCopied) / n;
+  state.counters["ram_uploads/move"] = double(after.cache.uploads - before.cache.uploads) / n;
+}
+BENCHMARK(BM_StreamRefill)
+    ->ArgName("budget_MiB")
+    ->Arg(64)
+    ->Arg(4)
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(0.3);
 
 }  // namespace
 BENCHMARK_MAIN();

@@ -2,6 +2,7 @@
 // elevation), from one camera or along a keyframed flight path.
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -15,6 +16,7 @@
 #include <strata/render/terrain/sliding_grid.hpp>
 #include <strata/render/terrain/synthetic_dem.hpp>
 #include <strata/render/terrain/terrain_renderer.hpp>
+#include <strata/terrain/tile_store.hpp>
 
 #include "commands.hpp"
 
@@ -39,6 +41,8 @@ struct RenderArgs {
   float fogM = 0;
   std::string path;
   int frames = 0;
+  int clipSize = 512, pageSize = 64, uploadPages = 64;
+  double gpuBudgetMiB = 256;
 };
 
 [[noreturn]] void die(const std::string& message) {
@@ -101,6 +105,15 @@ Status writeOutputs(const OffscreenTarget& target, const FrameGeometry& frame, c
   return {};
 }
 
+void reportStream(const TerrainScene& scene) {
+  if (auto* st = scene.streamed()) {
+    const auto s = st->stats();
+    std::printf("streamed: %llu frames, %llu pages copied, %d pending, %zu of %zu GPU bytes\n",
+                static_cast<unsigned long long>(s.frames), static_cast<unsigned long long>(s.pagesCopied), s.pending,
+                s.gpuBytes, s.gpuBudgetBytes);
+  }
+}
+
 void run(const RenderArgs& a) {
   int w = 0, h = 0;
   if (std::sscanf(a.size.c_str(), "%dx%d", &w, &h) != 2 || w < 1 || h < 1 || w > 16384 || h > 16384) {
@@ -122,9 +135,20 @@ void run(const RenderArgs& a) {
 
   auto ctx = render::gl::HeadlessContext::create({.debugOutput = false});
   if (!ctx) die(ctx.message());
-  auto dem = loadDem(a.dem);
-  if (!dem) die(dem.message());
-  auto scene = TerrainScene::create(*dem, {.planetary = a.planetary});
+  // A folder with a manifest is a tile store: its elevation is streamed around the viewer.
+  auto scene = [&]() -> Result<TerrainScene> {
+    if (!std::filesystem::is_regular_file(std::filesystem::path(a.dem) / "manifest.toml")) {
+      STRATA_TRY(auto dem, loadDem(a.dem));
+      return TerrainScene::create(dem, {.planetary = a.planetary});
+    }
+    STRATA_TRY(auto opened, strata::terrain::TileStore::open(a.dem));
+    return TerrainScene::createStreamed(std::move(opened),
+                                        {.clipSize = a.clipSize,
+                                         .pageSize = a.pageSize,
+                                         .uploadPagesPerFrame = a.uploadPages,
+                                         .gpuBudgetBytes = size_t(a.gpuBudgetMiB * 1048576.0)},
+                                        {.planetary = a.planetary});
+  }();
   if (!scene) die(a.dem + ": " + scene.message());
   auto renderer = makeRenderer(a);
   if (!renderer) die(renderer.message());
@@ -143,11 +167,21 @@ void run(const RenderArgs& a) {
   cam.fovYDeg = a.fov;
 
   if (a.path.empty()) {
-    if (auto s = (*renderer)->draw(*scene, cam, shading, *target); !s) die(s.message());
+    if (auto* st = scene->streamed()) {
+      // One picture: draw until every page of the windows is resident (each draw copies at
+      // most --upload-pages of them), so the image is the full-resolution one.
+      for (int i = 0; i < 10000; ++i) {
+        if (auto s = (*renderer)->draw(*scene, cam, shading, *target); !s) die(s.message());
+        if (st->stats().pending == 0) break;
+      }
+    } else if (auto s = (*renderer)->draw(*scene, cam, shading, *target); !s) {
+      die(s.message());
+    }
     const auto frame = frameGeometry(*scene, cam, shading, w, h);
     if (auto s = writeOutputs(*target, frame, a.output, a.depthOut, a.elevationOut); !s) die(s.message());
     std::printf("%s: %dx%d, %zu triangles (%s)\n", a.output.c_str(), w, h, (*renderer)->trianglesPerFrame(*scene),
                 (*renderer)->name().c_str());
+    reportStream(*scene);
     return;
   }
   auto path = FlightPath::load(a.path);
@@ -166,6 +200,7 @@ void run(const RenderArgs& a) {
     if (auto s = writeOutputs(*target, frame, *name, *depthName, *elevName); !s) die(s.message());
   }
   std::printf("%d frames %dx%d along %s\n", a.frames, w, h, a.path.c_str());
+  reportStream(*scene);
 }
 
 }  // namespace
@@ -173,7 +208,9 @@ void run(const RenderArgs& a) {
 void addRenderCommand(CLI::App& app) {
   auto a = std::make_shared<RenderArgs>();
   auto* cmd = app.add_subcommand("render", "Render a DEM offscreen to PNG (and EXR depth/elevation)");
-  cmd->add_option("dem", a->dem, "DEM file, or synthetic:SIZE[:SEED] for a generated terrain")->required();
+  cmd->add_option("dem", a->dem,
+                  "DEM file, synthetic:SIZE[:SEED] for a generated terrain, or a tile store folder (streamed)")
+      ->required();
   cmd->add_option("-o,--output", a->output, "Colour PNG (with --path: a pattern such as frame_%04d.png)");
   cmd->add_option("--depth", a->depthOut, "Also write the distance along the view axis (m) to this EXR");
   cmd->add_option("--elevation", a->elevationOut, "Also write the rendered elevation (m) to this EXR");
@@ -196,6 +233,10 @@ void addRenderCommand(CLI::App& app) {
   cmd->add_option("--fog", a->fogM, "Haze distance (m); 0: none");
   cmd->add_option("--path", a->path, "Keyframe file (lon lat height heading pitch [fov] per line)");
   cmd->add_option("--frames", a->frames, "Frames to render along --path");
+  cmd->add_option("--clip-size", a->clipSize, "Store: texels a side of each streamed level's window");
+  cmd->add_option("--page-size", a->pageSize, "Store: texels a side of a streamed page");
+  cmd->add_option("--upload-pages", a->uploadPages, "Store: pages copied into the stack per frame at most");
+  cmd->add_option("--gpu-budget", a->gpuBudgetMiB, "Store: GPU memory for the streamed elevation (MiB)");
   cmd->callback([a] { run(*a); });
 }
 

@@ -64,12 +64,12 @@ void main() {
     // The centre vertex averages a small ring of samples (it has no radial direction).
     for (int k = 0; k < samples; ++k) {
       float a = 6.2831853 * (float(k) + 0.5) / float(samples);
-      elev += textureLod(uHeight, uvAt(0.25 * spacing * float(samples > 1), vec2(cos(a), sin(a))), lod).r;
+      elev += terrainHeight(uvAt(0.25 * spacing * float(samples > 1), vec2(cos(a), sin(a))), lod);
     }
   } else {
     for (int k = 0; k < samples; ++k) {
       float d = r + spacing * ((float(k) + 0.5) / float(samples) - 0.5);
-      elev += textureLod(uHeight, uvAt(d, dir), lod).r;
+      elev += terrainHeight(uvAt(d, dir), lod);
     }
   }
   elev /= float(samples);

@@ -20,7 +20,7 @@ vs;
 
 void main() {
   vec2 uv = (uGridOrigin + aLattice.xy + 0.5) / uTexSize;
-  float elev = textureLod(uHeight, uv, aLattice.z).r;
+  float elev = terrainHeight(uv, aLattice.z);
   // Metres from the viewer, from small numbers only (texels from the viewer / texels per metre).
   vec2 offset = (uOriginFromViewer + aLattice.xy) / (uUvPerMetre * uTexSize);
   vs.uv = uv;

@@ -49,8 +49,8 @@ void main() {
   // MIP level apart.
   float lod = fs.lod;
   vec2 d = exp2(lod) / uTexSize;
-  float hx = textureLod(uHeight, uv + vec2(d.x, 0.0), lod).r - textureLod(uHeight, uv - vec2(d.x, 0.0), lod).r;
-  float hy = textureLod(uHeight, uv + vec2(0.0, d.y), lod).r - textureLod(uHeight, uv - vec2(0.0, d.y), lod).r;
+  float hx = terrainHeight(uv + vec2(d.x, 0.0), lod) - terrainHeight(uv - vec2(d.x, 0.0), lod);
+  float hy = terrainHeight(uv + vec2(0.0, d.y), lod) - terrainHeight(uv - vec2(0.0, d.y), lod);
   vec2 metresPerUv;
   vec3 east = vec3(1.0, 0.0, 0.0), north = vec3(0.0, 1.0, 0.0), up = vec3(0.0, 0.0, 1.0);
   if (uPlanetary == 0) {

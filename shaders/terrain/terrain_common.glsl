@@ -3,7 +3,7 @@
 // under the viewer (x east, y north, z up, metres), so float precision is spent where the
 // viewer is (docs/render-rings.md, "Precision"). Set by strata::render::terrain (C++).
 
-layout(binding = 0) uniform sampler2D uHeight;  // elevation (m), r32f, full mip chain
+layout(binding = 0) uniform sampler2D uHeight;  // elevation (m), r32f, full mip chain; streamed: level C of it
 
 uniform mat4 uViewProj;       // viewer-relative metres -> clip (reversed-Z)
 uniform int uPlanetary;       // 0: planar (a local tangent plane), 1: on the body's ellipsoid
@@ -20,6 +20,68 @@ uniform vec3 uPoleAux;        // planetary: unit polar axis in the nadir frame o
 uniform vec3 uNadirNormal;    // planetary: ellipsoid normal at the nadir, same frame
 uniform mat3 uFrameRot;       // planetary: nadir frame of the auxiliary sphere -> the viewer's ENU frame
 uniform vec4 uGeoToUv;        // planetary: u = (lon - x) * y, v = (lat - z) * w (radians); x, z only for shading
+
+// Streamed elevation (StreamedElevation, docs/render-rings.md "Streaming"): levels 0..C-1 are
+// N x N windows of a texture array addressed toroidally (level texel g at g mod N), each cut
+// into P x P pages whose residency uClipPages records; level C and coarser are uHeight's mips.
+layout(binding = 3) uniform sampler2DArray uClip;         // r32f, N x N, layer l = level l
+layout(binding = 4) uniform usampler2DArray uClipPages;  // 1 where the page slot holds its window's page
+uniform int uStreamed;           // 1: sample the stack (uClip, uClipPages) and uHeight from level C
+uniform int uClipCoarse;         // C
+uniform float uClipSize;         // N (texels)
+uniform int uPageShift;          // log2(P)
+uniform ivec2 uClipOrigin[16];   // window corner of level l (level texels, a multiple of P)
+uniform vec2 uCoarseUvScale;     // uv -> uHeight's texture coordinates (1 unless streamed)
+
+// Level-l texel coordinates of `uv`, clamped to the level's extent as GL_CLAMP_TO_EDGE would
+// (not in x when the DEM wraps in longitude: the windows continue across the seam).
+vec2 levelTexel(vec2 uv, int l) {
+  vec2 size = ceil(uTexSize / exp2(float(l)));
+  vec2 p = uv * uTexSize / exp2(float(l));
+  vec2 q = clamp(p, vec2(0.5), size - 0.5);
+  return vec2(uWrapU != 0 ? p.x : q.x, q.y);
+}
+
+// Whether bilinear sampling of level l at level texel p only touches resident pages.
+bool clipResident(int l, vec2 p) {
+  ivec2 i0 = ivec2(floor(p - 0.5)), i1 = i0 + 1;
+  ivec2 o = uClipOrigin[l];
+  int n = int(uClipSize);
+  if (any(lessThan(i0, o)) || any(greaterThanEqual(i1, o + n))) return false;
+  int k = n >> uPageShift;
+  // Slots: page index modulo k, floored (columns can be negative across the seam; GLSL's % is
+  // undefined for negative operands, and >> on ints is arithmetic: a floored division).
+  ivec2 pa = i0 >> uPageShift, pb = i1 >> uPageShift;
+  ivec2 a = pa - k * ivec2(floor(vec2(pa) / float(k))), b = pb - k * ivec2(floor(vec2(pb) / float(k)));
+  return texelFetch(uClipPages, ivec3(a, l), 0).r != 0u && texelFetch(uClipPages, ivec3(b.x, a.y, l), 0).r != 0u &&
+         texelFetch(uClipPages, ivec3(a.x, b.y, l), 0).r != 0u && texelFetch(uClipPages, ivec3(b, l), 0).r != 0u;
+}
+
+float clipSample(int l, vec2 uv) {
+  if (l >= uClipCoarse) return textureLod(uHeight, uv * uCoarseUvScale, 0.0).r;
+  return textureLod(uClip, vec3(levelTexel(uv, l) / uClipSize, float(l)), 0.0).r;
+}
+
+// Elevation at `uv`, MIP level `lod`, from the stack: the finest resident level at or above
+// floor(lod) (a late page shows a coarser stand-in, never a hole), blended towards the next
+// level as trilinear filtering would when the wanted level itself is resident.
+float streamedHeight(vec2 uv, float lod) {
+  if (lod >= float(uClipCoarse)) return textureLod(uHeight, uv * uCoarseUvScale, lod - float(uClipCoarse)).r;
+  int lo = int(floor(lod));
+  int l = lo;
+  while (l < uClipCoarse && !clipResident(l, levelTexel(uv, l))) ++l;
+  float h = clipSample(l, uv);
+  float t = lod - float(lo);
+  if (l > lo || t <= 0.0) return h;
+  if (l + 1 < uClipCoarse && !clipResident(l + 1, levelTexel(uv, l + 1))) return h;
+  return mix(h, clipSample(l + 1, uv), t);
+}
+
+// Elevation (m) at texture coordinates `uv`, MIP level `lod`: the whole-DEM texture, or the stack.
+float terrainHeight(vec2 uv, float lod) {
+  if (uStreamed != 0) return streamedHeight(uv, max(lod, 0.0));
+  return textureLod(uHeight, uv, lod).r;
+}
 
 // Longitude and latitude (radians) of the point at great-circle angle `gamma` from the viewer's
 // nadir in direction `dir` (unit east, north), RELATIVE to the nadir's: written so that no

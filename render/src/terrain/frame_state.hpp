@@ -19,8 +19,9 @@ class FrameState {
   GLint previous_ = 0;
 };
 
-/// Sets terrain_common.glsl's and terrain.frag's uniforms and binds the scene's textures.
-void setCommonUniforms(const gl::Program& p, const TerrainScene& scene, const FrameGeometry& frame,
-                       const Shading& shading, const glm::dmat4& viewProj);
+/// Sets terrain_common.glsl's and terrain.frag's uniforms and binds the scene's textures; a
+/// streamed scene is first moved to the frame's viewer and refilled within its budget.
+Status setCommonUniforms(const gl::Program& p, const TerrainScene& scene, const FrameGeometry& frame,
+                         const Shading& shading, const glm::dmat4& viewProj);
 
 }  // namespace strata::render::terrain::detail

@@ -95,7 +95,8 @@ Status SlidingGridRenderer::draw(const TerrainScene& scene, const CameraPose& ca
   const double step = double(1 << (params_.levels - 1));
   const glm::dvec2 origin = glm::round(tCam / step) * step;
   detail::FrameState state(target, shading.sky);
-  detail::setCommonUniforms(program_, scene, frame, shading, observer ? *observer : frame.viewProj());
+  STRATA_TRY_STATUS(
+      detail::setCommonUniforms(program_, scene, frame, shading, observer ? *observer : frame.viewProj()));
   program_.set("uGridOrigin", glm::vec2(origin));
   program_.set("uOriginFromViewer", glm::vec2(origin - tCam));
   program_.use();

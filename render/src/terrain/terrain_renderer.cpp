@@ -1,11 +1,14 @@
 #include <strata/render/terrain/terrain_renderer.hpp>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <numbers>
 
 #include <glm/gtc/matrix_transform.hpp>
+
+#include <strata/terrain/tile_store.hpp>
 
 #include "terrain/frame_state.hpp"
 
@@ -45,8 +48,8 @@ FrameState::~FrameState() {
   glBindFramebuffer(GL_FRAMEBUFFER, GLuint(previous_));
 }
 
-void setCommonUniforms(const gl::Program& p, const TerrainScene& scene, const FrameGeometry& frame,
-                       const Shading& shading, const glm::dmat4& viewProj) {
+Status setCommonUniforms(const gl::Program& p, const TerrainScene& scene, const FrameGeometry& frame,
+                         const Shading& shading, const glm::dmat4& viewProj) {
   const auto& c = scene.georef().transform.c;
   const double w = scene.width(), h = scene.height();
   p.set("uViewProj", toFloat(viewProj));
@@ -83,9 +86,31 @@ void setCommonUniforms(const gl::Program& p, const TerrainScene& scene, const Fr
   p.set("uPole", glm::vec3(frame.frameRot * frame.poleAux));
   p.set("uSky", shading.sky);
   p.set("uFogM", shading.fogM);
-  scene.heightTexture().bind(0);
   if (scene.waterTexture()) scene.waterTexture()->bind(1);
   if (scene.layerTexture()) scene.layerTexture()->bind(2);
+  StreamedElevation* s = scene.streamed();
+  p.set("uStreamed", s ? 1 : 0);
+  if (!s) {
+    p.set("uCoarseUvScale", glm::vec2(1.0f));
+    scene.heightTexture().bind(0);
+    return {};
+  }
+  STRATA_TRY_STATUS(s->update(frame.uvCam * glm::dvec2(w, h)));
+  // The coarse texture covers whole level-C cells: ceil(w / 2^C) of them, a little more than
+  // the grid when 2^C does not divide it.
+  const int lc = s->coarseLevel();
+  const glm::ivec2 coarse = s->levelSize(lc);
+  p.set("uCoarseUvScale", glm::vec2(float(w / std::ldexp(coarse.x, lc)), float(h / std::ldexp(coarse.y, lc))));
+  p.set("uClipCoarse", lc);
+  p.set("uClipSize", float(s->params().clipSize));
+  p.set("uPageShift", int(std::countr_zero(unsigned(s->params().pageSize))));
+  for (int l = 0; l < lc; ++l) {
+    p.set(("uClipOrigin[" + std::to_string(l) + "]").c_str(), s->windowOrigin(l));
+  }
+  s->coarseTexture().bind(0);
+  s->clipTexture().bind(3);
+  s->pageFlags().bind(4);
+  return {};
 }
 
 }  // namespace detail
@@ -131,7 +156,29 @@ Result<TerrainScene> TerrainScene::create(const gis::Raster& dem, const SceneOpt
   return s;
 }
 
+Result<TerrainScene> TerrainScene::createStreamed(strata::terrain::TileStore store, const StreamParams& params,
+                                                  const SceneOptions& options) {
+  const gis::Georef g = store.desc().georef;
+  if (options.planetary && !g.geographic) return fail("render: planetary mode needs a geographic (lon/lat) store");
+  if (!g.transform.isNorthUp() || g.transform.c[1] <= 0 || g.transform.c[5] >= 0) {
+    return fail("render: store " + store.dir().string() +
+                ": geotransform is not north-up (rotation terms or axis signs)");
+  }
+  if (g.body.semiMajorM <= 0) return fail("render: store body '" + g.body.name + "' has no radius");
+  if (g.width < 2 || g.height < 2) return fail("render: store " + store.dir().string() + " has fewer than 2x2 cells");
+  STRATA_TRY(auto streamed,
+             StreamedElevation::create(std::move(store), params, options.planetary && isGlobalInLongitude(g)));
+  TerrainScene s;
+  s.georef_ = g;
+  s.planetary_ = options.planetary;
+  s.minM_ = streamed->minElevationM();
+  s.maxM_ = streamed->maxElevationM();
+  s.streamed_ = std::move(streamed);
+  return s;
+}
+
 Status TerrainScene::setWaterDepth(const gis::Grid<float>& depthM) {
+  if (streamed_) return fail("render: water depth is drawn on whole-DEM scenes only (this one is streamed)");
   if (depthM.width != width() || depthM.height != height()) {
     return fail("render: water depth grid " + std::to_string(depthM.width) + "x" + std::to_string(depthM.height) +
                 " differs from the DEM's " + std::to_string(width()) + "x" + std::to_string(height()));
@@ -143,6 +190,7 @@ Status TerrainScene::setWaterDepth(const gis::Grid<float>& depthM) {
 }
 
 Status TerrainScene::setMaterialLayers(const std::vector<gis::Grid<float>>& thicknessM) {
+  if (streamed_) return fail("render: material layers are drawn on whole-DEM scenes only (this one is streamed)");
   if (thicknessM.empty() || thicknessM.size() > 4) {
     return fail("render: " + std::to_string(thicknessM.size()) + " material layers given, need 1 to 4");
   }
@@ -168,12 +216,17 @@ double TerrainScene::heightAt(double lon, double lat) const {
   const double y = std::clamp((lat - c[3]) / c[5] - 0.5, 0.0, double(height() - 1));
   const int i = std::min(int(x), width() - 2), j = std::min(int(y), height() - 2);
   const double fx = x - i, fy = y - j;
-  const auto& h = heights_;
-  return (1 - fy) * ((1 - fx) * h.at(i, j) + fx * h.at(i + 1, j)) +
-         fy * ((1 - fx) * h.at(i, j + 1) + fx * h.at(i + 1, j + 1));
+  std::array<float, 4> q;
+  if (streamed_) {
+    q = streamed_->cellQuad(i, j);
+  } else {
+    q = {heights_.at(i, j), heights_.at(i + 1, j), heights_.at(i, j + 1), heights_.at(i + 1, j + 1)};
+  }
+  return (1 - fy) * ((1 - fx) * q[0] + fx * q[1]) + fy * ((1 - fx) * q[2] + fx * q[3]);
 }
 
 double TerrainScene::gridSurfaceAt(double u, double v) const {
+  STRATA_CHECK(!streamed_) << "gridSurfaceAt on a streamed scene";
   const double x = std::clamp(u * width() - 0.5, 0.0, double(width() - 1));
   const double y = std::clamp(v * height() - 0.5, 0.0, double(height() - 1));
   const int i = std::min(int(x), width() - 2), j = std::min(int(y), height() - 2);
@@ -352,7 +405,7 @@ Status RingRenderer::draw(const TerrainScene& scene, const CameraPose& camera, c
   const RingLayout l = layout(scene, frame);
   detail::FrameState state(target, shading.sky);
   const auto& p = program_;
-  detail::setCommonUniforms(p, scene, frame, shading, observer ? *observer : frame.viewProj());
+  STRATA_TRY_STATUS(detail::setCommonUniforms(p, scene, frame, shading, observer ? *observer : frame.viewProj()));
   p.set("uCircles", float(params_.circles));
   p.set("uAlphaMax", float(l.alphaMax));
   p.set("uSoftH", float(l.softHeightM));
@@ -381,6 +434,7 @@ Result<std::unique_ptr<GridRenderer>> GridRenderer::create() {
 Status GridRenderer::draw(const TerrainScene& scene, const CameraPose& camera, const Shading& shading,
                           const OffscreenTarget& target, const glm::dmat4* observer) {
   if (scene.planetary()) return fail("render: the brute-force grid renderer draws planar scenes only");
+  if (scene.streamed()) return fail("render: the brute-force grid renderer draws whole-DEM scenes only (not streamed)");
   if (gridW_ != scene.width() || gridH_ != scene.height()) {
     gridW_ = scene.width();
     gridH_ = scene.height();
@@ -399,7 +453,8 @@ Status GridRenderer::draw(const TerrainScene& scene, const CameraPose& camera, c
   }
   const FrameGeometry frame = frameGeometry(scene, camera, shading, target.width(), target.height());
   detail::FrameState state(target, shading.sky);
-  detail::setCommonUniforms(program_, scene, frame, shading, observer ? *observer : frame.viewProj());
+  STRATA_TRY_STATUS(
+      detail::setCommonUniforms(program_, scene, frame, shading, observer ? *observer : frame.viewProj()));
   program_.use();
   vao_.bind();
   glDrawElements(GL_TRIANGLES, indexCount_, GL_UNSIGNED_INT, nullptr);

@@ -18,6 +18,7 @@
 #include <strata/gis/raster.hpp>
 #include <strata/render/gl/objects.hpp>
 #include <strata/render/terrain/ring_mesh.hpp>
+#include <strata/render/terrain/streamed_elevation.hpp>
 
 namespace strata::render::terrain {
 
@@ -57,11 +58,19 @@ struct SceneOptions {
   bool planetary = false;
 };
 
-/// A DEM on the GPU (r32f, full mip chain) plus the CPU copy for height queries. No data is
-/// filled with the lowest valid elevation.
+/// A DEM on the GPU (r32f, full mip chain) plus the CPU copy for height queries, or (streamed)
+/// a tile store's elevation around the viewer (StreamedElevation). No data is filled with the
+/// lowest valid elevation.
 class TerrainScene {
  public:
   static Result<TerrainScene> create(const gis::Raster& dem, const SceneOptions& options = {});
+  /// Streams the elevation of a tile store (taken over): the renderers that support it (ring,
+  /// sliding grid) move the stack to each frame's viewer and refill it within the per-frame
+  /// budget before drawing. Planetary mode needs a geographic store; a global one then wraps
+  /// across the seam. Water, material layers, heights() and gridSurfaceAt() are for whole-DEM
+  /// scenes only.
+  static Result<TerrainScene> createStreamed(strata::terrain::TileStore store, const StreamParams& params = {},
+                                             const SceneOptions& options = {});
 
   /// Water depth (m) over the terrain, same grid as the DEM.
   Status setWaterDepth(const gis::Grid<float>& depthM);
@@ -77,12 +86,14 @@ class TerrainScene {
   double gridSurfaceAt(double u, double v) const;
 
   const gis::Georef& georef() const { return georef_; }
-  const gis::Grid<float>& heights() const { return heights_; }
+  const gis::Grid<float>& heights() const { return heights_; }  ///< empty when streamed
   bool planetary() const { return planetary_; }
   float minElevationM() const { return minM_; }
   float maxElevationM() const { return maxM_; }
-  int width() const { return heights_.width; }
-  int height() const { return heights_.height; }
+  int width() const { return georef_.width; }
+  int height() const { return georef_.height; }
+  /// The streamed elevation, or null for a whole-DEM scene.
+  StreamedElevation* streamed() const { return streamed_.get(); }
   /// Radius of the body (m) used for the local frame and planetary mode.
   double radiusM() const { return georef_.body.semiMajorM; }
 
@@ -96,6 +107,7 @@ class TerrainScene {
   bool planetary_ = false;
   float minM_ = 0, maxM_ = 0;
   gl::Texture height_, water_, layers_;
+  std::shared_ptr<StreamedElevation> streamed_;
 };
 
 /// Everything the shaders need about one frame's view, computed in double on the CPU.
