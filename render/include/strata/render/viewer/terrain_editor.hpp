@@ -1,0 +1,91 @@
+#pragma once
+// Height brushes applied on the GPU to the elevations a TerrainScene draws, with undo/redo that
+// restore the exact earlier values. The CPU copy of the scene's heights is the mirror: a stroke
+// remembers the pre-edit values of the cells it touched (their bounding box only), and undo and
+// redo upload those patches. Tools and their equations: docs/viewer.md, "Tools".
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include <strata/core/result.hpp>
+#include <strata/render/gl/objects.hpp>
+#include <strata/render/terrain/terrain_renderer.hpp>
+
+namespace strata::render::viewer {
+
+/// The editing and simulation tools. Raise .. paste edit the terrain (TerrainEditor); water,
+/// spring and region act on the viewer's simulation region (Viewer).
+enum class Tool { kRaise, kLower, kSmooth, kFlatten, kCopy, kPaste, kWater, kSpring, kRegion };
+/// "raise", "lower", ... ; nullopt for an unknown name.
+std::optional<Tool> toolFromName(const std::string& name);
+const char* toolName(Tool tool);
+
+/// The active brush.
+struct Brush {
+  Tool tool = Tool::kRaise;
+  double radiusM = 300;  ///< radius (m) on the ground
+  double strength = 5;   ///< raise/lower: m at the centre per dab; smooth/flatten: blend fraction per dab
+};
+
+/// A rectangle of grid cells.
+struct CellRect {
+  int x = 0, y = 0, w = 0, h = 0;
+  bool empty() const { return w <= 0 || h <= 0; }
+  CellRect united(const CellRect& o) const;
+};
+
+class TerrainEditor {
+ public:
+  /// Compiles the brush kernel. `scene` must outlive the editor.
+  static Result<TerrainEditor> create(render::terrain::TerrainScene& scene);
+
+  /// Grid position (cells, continuous) of a map position (lon/lat or easting/northing).
+  glm::dvec2 cellOf(double lon, double lat) const;
+  /// The brush's radius in cells along x and y at grid row `y`.
+  glm::dvec2 radiusCells(double radiusM, double y) const;
+
+  /// Starts a stroke: the dabs until endStroke() are one undo step.
+  void beginStroke();
+  /// Applies one dab of a height tool (raise, lower, smooth, flatten) or of copy/paste centred
+  /// at `cell`. Cells outside the grid are ignored. Needs an open stroke.
+  Status dab(const Brush& brush, glm::dvec2 cell);
+  /// Closes the stroke and records it for undo (nothing if it changed nothing).
+  void endStroke();
+  bool inStroke() const { return inStroke_; }
+
+  /// Restores the cells of the last stroke to their pre-stroke values; false if none.
+  bool undo();
+  /// Re-applies the last undone stroke; false if none.
+  bool redo();
+  size_t undoDepth() const { return undo_.size(); }
+  size_t redoDepth() const { return redo_.size(); }
+  /// Bytes the history holds (two floats per cell of each recorded stroke).
+  size_t historyBytes() const;
+  /// The union of every cell changed since the start or the last clearDirty() (for saving).
+  const CellRect& dirty() const { return dirty_; }
+  void clearDirty() { dirty_ = {}; }
+  /// The cells the last dab wrote.
+  const CellRect& lastDab() const { return lastDab_; }
+
+ private:
+  struct Edit {
+    CellRect rect;
+    std::vector<float> before, after;
+  };
+  CellRect clip(CellRect r) const;
+  void apply(const Edit& edit, bool forward);
+
+  render::terrain::TerrainScene* scene_ = nullptr;
+  gl::Program brush_;
+  gl::Texture clipboard_;
+  std::vector<float> strokeBefore_;
+  CellRect strokeRect_, dirty_, lastDab_;
+  bool inStroke_ = false;
+  std::optional<float> flattenTarget_;
+  std::vector<Edit> undo_, redo_;
+};
+
+}  // namespace strata::render::viewer
