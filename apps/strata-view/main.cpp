@@ -16,6 +16,7 @@
 #include <strata/core/log.hpp>
 #include <strata/gis/dem_io.hpp>
 #include <strata/render/gl/context.hpp>
+#include <strata/render/terrain/lon_lat_dem.hpp>
 #include <strata/render/viewer/store_io.hpp>
 #include <strata/render/viewer/viewer.hpp>
 #include <strata/terrain/tile_store.hpp>
@@ -122,6 +123,7 @@ int run(const Args& a) {
     dem = loaded->surface;
   } else {
     auto d = gis::readDem(a.input);
+    if (d && a.planetary) d = render::terrain::toLonLat(std::move(*d), a.input);
     if (!d) {
       std::fprintf(stderr, "strata-view: %s\n", d.message().c_str());
       return 1;
@@ -143,11 +145,17 @@ int run(const Args& a) {
     return 1;
   }
   Viewer& v = **viewer;
+  if (loaded && !loaded->layers.empty()) {
+    if (auto s = v.editor().setLayers(loaded->layers); !s) {
+      std::fprintf(stderr, "strata-view: %s\n", s.message().c_str());
+      return 1;
+    }
+  }
   // Saving: back into the store (tiles re-evaluated, committed), or a whole-grid GeoTIFF.
   v.savePath = !a.savePath.empty() ? a.savePath : store ? a.input : "edited.tif";
   v.saver = [&](const std::string& path) -> Status {
     if (store && std::filesystem::equivalent(path, a.input)) {
-      return saveStoreEdits(*store, *loaded, v.scene().heights(), v.editor().dirty());
+      return saveStoreEdits(*store, *loaded, v.scene().heights(), v.editor().layers(), v.editor().dirty());
     }
     gis::Raster out{dem.georef, v.scene().heights()};
     return gis::writeGeoTiff(path, out);
@@ -166,6 +174,9 @@ int run(const Args& a) {
   size_t next = 0;
   int failures = 0;
   auto last = std::chrono::steady_clock::now();
+  // Mean timings over the run (printed at the end of scripted runs; docs/benchmarks.md).
+  double sumWallMs = 0, sumCpuMs = 0, sumGpuMs = 0;
+  int timedFrames = 0;
   for (int frame = 0; !ctx->shouldClose() && !v.quitRequested(); ++frame) {
     if (a.frames > 0 && frame >= a.frames) break;
     ctx->pollEvents();
@@ -193,10 +204,20 @@ int run(const Args& a) {
       ++failures;
     }
     ctx->swapBuffers();
+    if (frame > 0) {  // the first frame compiles and uploads
+      sumWallMs += 1000.0 * std::chrono::duration<double>(std::chrono::steady_clock::now() - now).count();
+      sumCpuMs += v.times().cpuMs;
+      sumGpuMs += v.times().gpuMs;
+      ++timedFrames;
+    }
     if (scripted && next == script.size() && frame >= script.back().frame) break;
   }
   if (scripted) {
     for (const auto& l : v.hudLines()) std::printf("%s\n", l.c_str());
+    if (timedFrames > 0) {
+      std::printf("{\"frames\": %d, \"wall_ms\": %.2f, \"cpu_ms\": %.2f, \"gpu_ms\": %.2f, \"size\": \"%dx%d\"}\n",
+                  timedFrames, sumWallMs / timedFrames, sumCpuMs / timedFrames, sumGpuMs / timedFrames, fbW, fbH);
+    }
   }
   // A script whose commands fail is a failed run (the test relies on it).
   return scripted && failures > 0 ? 2 : 0;

@@ -12,7 +12,11 @@ uniform ivec2 uSize;       // cells written
 uniform ivec2 uSrcOrigin;  // grid cell of uSrc's texel (0, 0)
 uniform vec2 uCentre;      // brush centre (grid cells, continuous: cell (i, j) spans i..i+1)
 uniform vec2 uRadius;      // brush radius in cells along x and y
-uniform int uMode;         // 0 raise, 1 lower, 2 smooth, 3 flatten
+layout(rgba32f, binding = 3) uniform image2D uLayers;  // layer thicknesses (m), modes 8-9
+layout(binding = 2) uniform sampler2D uStamp;  // stamp image t (bilinear, clamped), modes 4-7
+uniform int uMode;         // 0 raise, 1 lower, 2 smooth, 3 flatten, 4-7 stamp: add, subtract, multiply,
+                           // replace, 8 add material, 9 remove material
+uniform int uLayer;        // modes 8-9: the layer (0 = bottom)
 uniform float uStrength;   // raise/lower: m at the centre; smooth/flatten: blend fraction at the centre
 uniform float uTarget;     // flatten: the level (m)
 
@@ -43,6 +47,25 @@ void main() {
   } else if (uMode == 3) {
     result = mix(h, uTarget, clamp(uStrength * w, 0.0, 1.0));
   }
-  // Cells outside the disc are written with their own value: bit for bit unchanged.
-  imageStore(uDst, cell, vec4(w > 0.0 ? result : h));
+  bool inside = w > 0.0;
+  if (uMode >= 4) {
+    // The stamp covers the brush's square (centre +- radius) with weight 1; f = strength * t.
+    const vec2 uv = (vec2(cell) + 0.5 - (uCentre - uRadius)) / (2.0 * uRadius);
+    inside = all(greaterThanEqual(uv, vec2(0.0))) && all(lessThanEqual(uv, vec2(1.0)));
+    const float f = uStrength * textureLod(uStamp, uv, 0.0).r;
+    if (uMode == 4) result = h + f;
+    if (uMode == 5) result = h - f;
+    if (uMode == 6) result = h * f;
+    if (uMode == 7) result = f;
+  }
+  if (uMode >= 8 && inside) {
+    // The layer's thickness changes by s w (removal stops at zero); the surface moves with it.
+    vec4 t = imageLoad(uLayers, cell);
+    const float delta = uMode == 8 ? uStrength * w : -min(uStrength * w, t[uLayer]);
+    t[uLayer] += delta;
+    imageStore(uLayers, cell, t);
+    result = h + delta;
+  }
+  // Cells outside the brush are written with their own value: bit for bit unchanged.
+  imageStore(uDst, cell, vec4(inside ? result : h));
 }

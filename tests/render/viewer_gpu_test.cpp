@@ -5,6 +5,8 @@
 #include <cstring>
 #include <numbers>
 
+#include <glm/glm.hpp>
+
 #include <gtest/gtest.h>
 
 #include <strata/gis/dem_io.hpp>
@@ -160,6 +162,98 @@ TEST_F(ViewerGpu, PasteWritesTheCopiedCellsExactly) {
   EXPECT_TRUE(bitEqual(scene->heights().data, original.data));
 }
 
+TEST_F(ViewerGpu, StampBlendsOverTheBrushSquareInAllFourModes) {
+  auto scene = TerrainScene::create(planarDem(64, 64, gentle));
+  ASSERT_TRUE(scene);
+  auto editor = TerrainEditor::create(*scene);
+  ASSERT_TRUE(editor);
+  const auto original = scene->heights();
+  // A uniform stamp t = 0.5: f = strength / 2 on every cell whose centre is in the square
+  // centre +- radius (radius 4 cells: 8 x 8 cells), nothing elsewhere.
+  const gis::Grid<float> half(4, 4, 0.5f);
+  struct Case {
+    Blend blend;
+    double strength;
+    glm::dvec2 centre;
+    float (*expect)(float);
+  };
+  const Case cases[] = {{Blend::kAdd, 10.0, {12, 12}, [](float h) { return h + 5.0f; }},
+                        {Blend::kSubtract, 10.0, {40, 12}, [](float h) { return h - 5.0f; }},
+                        {Blend::kMultiply, 4.0, {12, 40}, [](float h) { return h * 2.0f; }},
+                        {Blend::kReplace, 100.0, {40, 40}, [](float) { return 50.0f; }}};
+  editor->beginStroke();
+  for (const auto& c : cases) {
+    editor->setStamp(half, c.blend);
+    ASSERT_TRUE(editor->dab({Tool::kStamp, 120.0, c.strength}, c.centre));
+  }
+  editor->endStroke();
+  int inside = 0;
+  for (int y = 0; y < 64; ++y) {
+    for (int x = 0; x < 64; ++x) {
+      const float h0 = original.at(x, y), h = scene->heights().at(x, y);
+      const Case* hit = nullptr;
+      for (const auto& c : cases) {
+        if (std::abs(x + 0.5 - c.centre.x) <= 4 && std::abs(y + 0.5 - c.centre.y) <= 4) hit = &c;
+      }
+      if (hit) {
+        ++inside;
+        EXPECT_EQ(h, hit->expect(h0)) << x << " " << y;  // one float operation: exact
+      } else {
+        EXPECT_EQ(h, h0) << x << " " << y;
+      }
+    }
+  }
+  EXPECT_EQ(inside, 4 * 64);
+  ASSERT_TRUE(editor->undo());
+  EXPECT_TRUE(bitEqual(scene->heights().data, original.data));
+}
+
+TEST_F(ViewerGpu, MaterialBrushesMoveTheSurfaceWithTheLayerAndUndoBoth) {
+  auto scene = TerrainScene::create(planarDem(64, 64, gentle));
+  ASSERT_TRUE(scene);
+  auto editor = TerrainEditor::create(*scene);
+  ASSERT_TRUE(editor);
+  const auto original = scene->heights();
+  // Add 2 m of layer 1 at the centre (radius 10 cells); the surface rises by what was added.
+  editor->beginStroke();
+  ASSERT_TRUE(editor->dab({Tool::kAddMaterial, 300.0, 2.0, 1}, {32.0, 32.0}));
+  editor->endStroke();
+  ASSERT_EQ(editor->layers().size(), size_t(64 * 64 * 4));
+  const auto layersAfterAdd = editor->layers();
+  const auto heightsAfterAdd = scene->heights().data;
+  double added = 0;
+  for (int i = 0; i < 64 * 64; ++i) {
+    const float t = editor->layers()[size_t(i) * 4 + 1];
+    EXPECT_EQ(editor->layers()[size_t(i) * 4 + 0], 0.0f);
+    EXPECT_NEAR(scene->heights().data[size_t(i)] - original.data[size_t(i)], t, 1e-3);  // float sums at 1000 m
+    added += t;
+  }
+  EXPECT_NEAR(added, std::numbers::pi * 100.0 / 3.0 * 2.0, 0.01 * std::numbers::pi * 100.0 / 3.0 * 2.0);
+  // The layer texture the renderer draws holds the same thicknesses.
+  EXPECT_TRUE(bitEqual(scene->layerTexture()->read<float>(), editor->layers()));
+  // Removing 5 m takes away only what is there: layer 1 ends empty, the surface back to where it was.
+  editor->beginStroke();
+  ASSERT_TRUE(editor->dab({Tool::kRemoveMaterial, 300.0, 5.0, 1}, {32.0, 32.0}));
+  editor->endStroke();
+  for (int i = 0; i < 64 * 64; ++i) {
+    EXPECT_EQ(editor->layers()[size_t(i) * 4 + 1], 0.0f);
+    EXPECT_NEAR(scene->heights().data[size_t(i)], original.data[size_t(i)], 1e-3);
+  }
+  // Removing from an empty layer changes nothing and records nothing.
+  editor->beginStroke();
+  ASSERT_TRUE(editor->dab({Tool::kRemoveMaterial, 300.0, 5.0, 2}, {32.0, 32.0}));
+  editor->endStroke();
+  EXPECT_EQ(editor->undoDepth(), 2u);
+  // Undo restores layers and elevations bit for bit, one stroke at a time.
+  ASSERT_TRUE(editor->undo());
+  EXPECT_TRUE(bitEqual(editor->layers(), layersAfterAdd));
+  EXPECT_TRUE(bitEqual(scene->heights().data, heightsAfterAdd));
+  EXPECT_TRUE(bitEqual(scene->layerTexture()->read<float>(), layersAfterAdd));
+  ASSERT_TRUE(editor->undo());
+  EXPECT_TRUE(bitEqual(scene->heights().data, original.data));
+  for (float t : editor->layers()) ASSERT_EQ(t, 0.0f);
+}
+
 TEST_F(ViewerGpu, FlightSpeedFollowsHeightAboveGround) {
   auto scene = TerrainScene::create(planarDem(64, 64, [](int, int) { return 500.0f; }));
   ASSERT_TRUE(scene);
@@ -229,7 +323,7 @@ TEST_F(ViewerGpu, BrushOnATileBoundaryChangesBothTilesAndTheirResolutions) {
     EXPECT_GT(west, 0.0f) << d;
     EXPECT_NEAR(west, east, 1e-3) << d;
   }
-  ASSERT_TRUE(saveStoreEdits(*store, *loaded, edited, editor->dirty()));
+  ASSERT_TRUE(saveStoreEdits(*store, *loaded, edited, editor->layers(), editor->dirty()));
 
   auto reopened = terrain::TileStore::open(dir);
   ASSERT_TRUE(reopened) << reopened.message();

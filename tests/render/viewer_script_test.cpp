@@ -19,7 +19,7 @@ TEST(ViewerScript, ParsesEveryCommand) {
 6 button left down
 7 button right up
 8 tool raise
-8 brush 300 4.5
+8 brush 300 4.5 2
 9 stroke -112.08 36.06
 10 undo
 10 redo
@@ -31,11 +31,12 @@ TEST(ViewerScript, ParsesEveryCommand) {
 15 exaggeration 2
 16 screenshot out.png
 17 save edited.tif
+18 stamp crater.png multiply
 18 quit
 )",
                              "t.txt");
   ASSERT_TRUE(s) << s.message();
-  ASSERT_EQ(s->size(), 21u);
+  ASSERT_EQ(s->size(), 22u);
   const auto& v = *s;
   EXPECT_EQ(v[0].frame, 0);
   const auto& g = std::get<GoToCommand>(v[0].command);
@@ -49,6 +50,7 @@ TEST(ViewerScript, ParsesEveryCommand) {
   EXPECT_EQ(std::get<MouseButtonCommand>(v[6].command).button, MouseButtonCommand::kRight);
   EXPECT_EQ(std::get<ToolCommand>(v[7].command).name, "raise");
   EXPECT_DOUBLE_EQ(std::get<BrushCommand>(v[8].command).strength, 4.5);
+  EXPECT_EQ(std::get<BrushCommand>(v[8].command).layer, 2);
   EXPECT_DOUBLE_EQ(std::get<StrokeCommand>(v[9].command).lat, 36.06);
   EXPECT_TRUE(std::holds_alternative<UndoCommand>(v[10].command));
   EXPECT_DOUBLE_EQ(std::get<RegionCommand>(v[12].command).lat1, 36.1);
@@ -56,7 +58,8 @@ TEST(ViewerScript, ParsesEveryCommand) {
   EXPECT_EQ(std::get<SimCommand>(v[14].command).count, 8);
   EXPECT_EQ(std::get<SimCommand>(v[15].command).count, 4);
   EXPECT_EQ(std::get<ScreenshotCommand>(v[18].command).path, "out.png");
-  EXPECT_TRUE(std::holds_alternative<QuitCommand>(v[20].command));
+  EXPECT_EQ(std::get<StampCommand>(v[20].command).blend, "multiply");
+  EXPECT_TRUE(std::holds_alternative<QuitCommand>(v[21].command));
 }
 
 TEST(ViewerScript, RefusesBadLinesNamingThem) {
@@ -69,9 +72,10 @@ TEST(ViewerScript, RefusesBadLinesNamingThem) {
         Case{"\n3 goto 1", "t.txt:2: goto: expected goto LON LAT [AGL_M]"}, Case{"x key W down", "t.txt:1: frame 'x'"},
         Case{"5 undo\n4 redo", "t.txt:2: frame 4 is before the previous line's"},
         Case{"0 key W sideways", "t.txt:1: key: expected key NAME down|up"},
-        Case{"0 brush -1 2", "t.txt:1: brush: expected brush RADIUS_M STRENGTH (radius > 0)"},
-        Case{"0 step 2.5", "t.txt:1: step: expected step [N]"}, Case{"0 undo now", "t.txt:1: undo: unexpected 'now'"},
-        Case{"0 look 0 95", "t.txt:1: look: expected"}, Case{"0", "t.txt:1: a command is missing"}}) {
+        Case{"0 brush -1 2", "t.txt:1: brush: expected brush RADIUS_M STRENGTH [LAYER] (radius > 0, layer 0..3)"},
+        Case{"0 brush 10 2 4", "t.txt:1: brush: expected"}, Case{"0 step 2.5", "t.txt:1: step: expected step [N]"},
+        Case{"0 undo now", "t.txt:1: undo: unexpected 'now'"}, Case{"0 look 0 95", "t.txt:1: look: expected"},
+        Case{"0", "t.txt:1: a command is missing"}}) {
     const auto s = parseScript(c.text, "t.txt");
     ASSERT_FALSE(s) << c.text;
     EXPECT_NE(s.message().find(c.message), std::string::npos) << s.message();

@@ -162,6 +162,24 @@ void TerrainScene::heightsEditedOnGpu(int x, int y, int w, int h) {
   for (int j = 0; j < h; ++j) std::copy_n(&window[size_t(j) * size_t(w)], w, &heights_.at(x, y + j));
 }
 
+void TerrainScene::writeLayers(int x, int y, int w, int h, const std::vector<float>& thicknessM) {
+  STRATA_CHECK(layers_ && x >= 0 && y >= 0 && x + w <= width() && y + h <= height() &&
+               thicknessM.size() == size_t(w) * size_t(h) * 4)
+      << "writeLayers: no layers, or the window is outside the grid";
+  layers_.upload(thicknessM.data(), 0, x, y, w, h);
+  layers_.generateMipmap();
+}
+
+std::vector<float> TerrainScene::layersEditedOnGpu(int x, int y, int w, int h) {
+  STRATA_CHECK(layers_ && x >= 0 && y >= 0 && w > 0 && h > 0 && x + w <= width() && y + h <= height())
+      << "layersEditedOnGpu: no layers, or the window is outside the grid";
+  layers_.generateMipmap();
+  std::vector<float> window(size_t(w) * size_t(h) * 4);
+  glGetTextureSubImage(layers_.id(), 0, x, y, 0, w, h, 1, GL_RGBA, GL_FLOAT, GLsizei(window.size() * sizeof(float)),
+                       window.data());
+  return window;
+}
+
 Status TerrainScene::setMaterialLayers(const std::vector<gis::Grid<float>>& thicknessM) {
   if (thicknessM.empty() || thicknessM.size() > 4) {
     return fail("render: " + std::to_string(thicknessM.size()) + " material layers given, need 1 to 4");

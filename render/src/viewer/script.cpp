@@ -69,8 +69,10 @@ Result<std::vector<TimedCommand>> parseScript(const std::string& text, const std
       if (!(in >> name)) return bad("tool NAME");
       c = ToolCommand{name};
     } else if (verb == "brush") {
-      if (!numbers(in, v, 2) || v[0] <= 0) return bad("brush RADIUS_M STRENGTH (radius > 0)");
-      c = BrushCommand{v[0], v[1]};
+      if (!numbers(in, v, 2, 1) || v[0] <= 0 || (v.size() > 2 && (v[2] < 0 || v[2] > 3 || v[2] != std::floor(v[2])))) {
+        return bad("brush RADIUS_M STRENGTH [LAYER] (radius > 0, layer 0..3)");
+      }
+      c = BrushCommand{v[0], v[1], v.size() > 2 ? int(v[2]) : -1};
     } else if (verb == "stroke") {
       if (!numbers(in, v, 2)) return bad("stroke LON LAT");
       c = StrokeCommand{v[0], v[1]};
@@ -105,6 +107,13 @@ Result<std::vector<TimedCommand>> parseScript(const std::string& text, const std
       } else {
         c = SaveCommand{path};
       }
+    } else if (verb == "stamp") {
+      std::string path, blend;
+      if (!(in >> path >> blend) ||
+          (blend != "add" && blend != "subtract" && blend != "multiply" && blend != "replace")) {
+        return bad("stamp PATH add|subtract|multiply|replace");
+      }
+      c = StampCommand{path, blend};
     } else if (verb == "quit") {
       c = QuitCommand{};
     } else {

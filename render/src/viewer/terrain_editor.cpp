@@ -9,8 +9,9 @@ namespace strata::render::viewer {
 
 namespace {
 constexpr double kDeg = std::numbers::pi / 180.0;
-constexpr const char* kToolNames[] = {"raise", "lower", "smooth", "flatten", "copy",
-                                      "paste", "water", "spring", "region"};
+constexpr const char* kToolNames[] = {"raise",  "lower",  "smooth", "flatten", "copy",      "paste",    "water",
+                                      "spring", "region", "stamp",  "rain",    "material+", "material-"};
+constexpr const char* kBlendNames[] = {"add", "subtract", "multiply", "replace"};
 }  // namespace
 
 std::optional<Tool> toolFromName(const std::string& name) {
@@ -21,6 +22,22 @@ std::optional<Tool> toolFromName(const std::string& name) {
 }
 
 const char* toolName(Tool tool) { return kToolNames[int(tool)]; }
+
+std::optional<Blend> blendFromName(const std::string& name) {
+  for (int i = 0; i < int(std::size(kBlendNames)); ++i) {
+    if (name == kBlendNames[i]) return Blend(i);
+  }
+  return std::nullopt;
+}
+
+void TerrainEditor::setStamp(const gis::Grid<float>& image, Blend blend) {
+  STRATA_CHECK(image.width > 0 && image.height > 0) << "setStamp: empty image";
+  stamp_ = gl::Texture::create2D(gl::kR32F, image.width, image.height, 1);
+  stamp_.upload(image.data.data());
+  stamp_.setFilter(GL_LINEAR, GL_LINEAR);
+  stamp_.setWrap(GL_CLAMP_TO_EDGE);
+  blend_ = blend;
+}
 
 CellRect CellRect::united(const CellRect& o) const {
   if (empty()) return o;
@@ -57,10 +74,24 @@ CellRect TerrainEditor::clip(CellRect r) const {
   return {x0, y0, std::max(x1 - x0, 0), std::max(y1 - y0, 0)};
 }
 
+Status TerrainEditor::setLayers(const std::vector<gis::Grid<float>>& thicknessM) {
+  STRATA_CHECK(!inStroke_) << "setLayers during a stroke";
+  STRATA_TRY_STATUS(scene_->setMaterialLayers(thicknessM));
+  layers_.assign(size_t(scene_->width()) * size_t(scene_->height()) * 4, 0.0f);
+  for (size_t k = 0; k < thicknessM.size(); ++k) {
+    for (size_t i = 0; i < thicknessM[k].data.size(); ++i) layers_[i * 4 + k] = thicknessM[k].data[i];
+  }
+  // History entries without layers cannot be mixed with ones that have them.
+  undo_.clear();
+  redo_.clear();
+  return {};
+}
+
 void TerrainEditor::beginStroke() {
   STRATA_CHECK(!inStroke_) << "beginStroke: a stroke is already open";
   inStroke_ = true;
   strokeBefore_ = scene_->heights().data;
+  strokeLayersBefore_ = layers_;
   strokeRect_ = {};
   flattenTarget_.reset();
 }
@@ -93,6 +124,7 @@ Status TerrainEditor::dab(const Brush& brush, glm::dvec2 cell) {
     case Tool::kWater:
     case Tool::kSpring:
     case Tool::kRegion:
+    case Tool::kRain:
       return fail(std::string(toolName(brush.tool)) + ": not a terrain brush (it acts on the simulation region)");
     default: {
       // The kernel reads a copy of the box plus a one-cell margin (smooth's neighbours).
@@ -105,7 +137,24 @@ Status TerrainEditor::dab(const Brush& brush, glm::dvec2 cell) {
         const int cy = std::clamp(int(std::floor(cell.y)), 0, scene_->height() - 1);
         flattenTarget_ = scene_->heights().at(cx, cy);
       }
+      if (brush.tool == Tool::kStamp && !stamp_) return fail("stamp: no stamp image set");
+      const bool material = brush.tool == Tool::kAddMaterial || brush.tool == Tool::kRemoveMaterial;
+      if (material) {
+        if (brush.layer < 0 || brush.layer > 3)
+          return fail("material: layer " + std::to_string(brush.layer) + " is not 0..3");
+        if (layers_.empty()) {  // four empty layers; the open stroke started from them
+          const auto& h = scene_->heights();
+          STRATA_TRY_STATUS(
+              scene_->setMaterialLayers(std::vector<gis::Grid<float>>(4, gis::Grid<float>(h.width, h.height, 0.0f))));
+          layers_.assign(h.data.size() * 4, 0.0f);
+          strokeLayersBefore_ = layers_;
+        }
+        scene_->layerTexture()->bindImage(3, GL_READ_WRITE);
+      }
       int mode = 0;
+      if (brush.tool == Tool::kAddMaterial) mode = 8;
+      if (brush.tool == Tool::kRemoveMaterial) mode = 9;
+      if (brush.tool == Tool::kStamp) mode = 4 + int(blend_);
       if (brush.tool == Tool::kLower) mode = 1;
       if (brush.tool == Tool::kSmooth) mode = 2;
       if (brush.tool == Tool::kFlatten) mode = 3;
@@ -118,12 +167,21 @@ Status TerrainEditor::dab(const Brush& brush, glm::dvec2 cell) {
       brush_.set("uMode", mode);
       brush_.set("uStrength", float(brush.strength));
       brush_.set("uTarget", flattenTarget_.value_or(0.0f));
+      brush_.set("uLayer", brush.layer);
+      if (stamp_) stamp_.bind(2);
       scratch.bindImage(0, GL_READ_ONLY);
       scene_->heightTexture().bindImage(1, GL_WRITE_ONLY);
       brush_.dispatchCovering(box.w, box.h);
       glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |
                       GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
       lastDab_ = box;
+      if (material) {
+        const auto window = scene_->layersEditedOnGpu(box.x, box.y, box.w, box.h);
+        for (int y = 0; y < box.h; ++y) {
+          std::copy_n(&window[size_t(y) * size_t(box.w) * 4], size_t(box.w) * 4,
+                      &layers_[(size_t(box.y + y) * size_t(scene_->width()) + size_t(box.x)) * 4]);
+        }
+      }
     }
   }
   scene_->heightsEditedOnGpu(lastDab_.x, lastDab_.y, lastDab_.w, lastDab_.h);
@@ -143,16 +201,24 @@ void TerrainEditor::endStroke() {
   e.before.reserve(cells);
   e.after.reserve(cells);
   bool changed = false;
+  const bool withLayers = !layers_.empty() && strokeLayersBefore_.size() == layers_.size();
   for (int y = e.rect.y; y < e.rect.y + e.rect.h; ++y) {
     for (int x = e.rect.x; x < e.rect.x + e.rect.w; ++x) {
       const size_t i = size_t(y) * size_t(now.width) + size_t(x);
       e.before.push_back(strokeBefore_[i]);
       e.after.push_back(now.data[i]);
       changed |= std::memcmp(&e.before.back(), &e.after.back(), sizeof(float)) != 0;
+      if (withLayers) {
+        e.layersBefore.insert(e.layersBefore.end(), &strokeLayersBefore_[i * 4], &strokeLayersBefore_[i * 4] + 4);
+        e.layersAfter.insert(e.layersAfter.end(), &layers_[i * 4], &layers_[i * 4] + 4);
+        changed |= std::memcmp(&strokeLayersBefore_[i * 4], &layers_[i * 4], 4 * sizeof(float)) != 0;
+      }
     }
   }
   strokeBefore_.clear();
   strokeBefore_.shrink_to_fit();
+  strokeLayersBefore_.clear();
+  strokeLayersBefore_.shrink_to_fit();
   if (!changed) return;
   undo_.push_back(std::move(e));
   redo_.clear();
@@ -162,6 +228,14 @@ void TerrainEditor::apply(const Edit& edit, bool forward) {
   gis::Grid<float> patch(edit.rect.w, edit.rect.h);
   patch.data = forward ? edit.after : edit.before;
   scene_->writeHeights(edit.rect.x, edit.rect.y, patch);
+  if (!edit.layersBefore.empty() && !layers_.empty()) {
+    const auto& l = forward ? edit.layersAfter : edit.layersBefore;
+    scene_->writeLayers(edit.rect.x, edit.rect.y, edit.rect.w, edit.rect.h, l);
+    for (int y = 0; y < edit.rect.h; ++y) {
+      std::copy_n(&l[size_t(y) * size_t(edit.rect.w) * 4], size_t(edit.rect.w) * 4,
+                  &layers_[(size_t(edit.rect.y + y) * size_t(scene_->width()) + size_t(edit.rect.x)) * 4]);
+    }
+  }
   dirty_ = dirty_.united(edit.rect);
 }
 
@@ -184,7 +258,9 @@ bool TerrainEditor::redo() {
 size_t TerrainEditor::historyBytes() const {
   size_t n = 0;
   for (const auto* stack : {&undo_, &redo_}) {
-    for (const auto& e : *stack) n += (e.before.size() + e.after.size()) * sizeof(float);
+    for (const auto& e : *stack) {
+      n += (e.before.size() + e.after.size() + e.layersBefore.size() + e.layersAfter.size()) * sizeof(float);
+    }
   }
   return n;
 }

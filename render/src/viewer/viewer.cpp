@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <numbers>
 
+#include <strata/gis/dem_io.hpp>
 #include <strata/render/image_io.hpp>
 #include <strata/render/viewer/viewer.hpp>
 
@@ -20,8 +21,10 @@ std::string fmt(const char* format, auto... args) {
   return buf;
 }
 
+// Tools that change the elevation (the held mouse button keeps applying them).
 bool isHeightTool(Tool t) {
-  return t == Tool::kRaise || t == Tool::kLower || t == Tool::kSmooth || t == Tool::kFlatten;
+  return t == Tool::kRaise || t == Tool::kLower || t == Tool::kSmooth || t == Tool::kFlatten ||
+         t == Tool::kAddMaterial || t == Tool::kRemoveMaterial;
 }
 
 constexpr const char* kToolKeys[] = {"1", "2", "3", "4", "5", "6", "7", "8", "9"};
@@ -125,6 +128,7 @@ Status Viewer::handle(const Command& command) {
         } else if constexpr (std::is_same_v<T, BrushCommand>) {
           brush_.radiusM = c.radiusM;
           brush_.strength = c.strength;
+          if (c.layer >= 0) brush_.layer = c.layer;
           return {};
         } else if constexpr (std::is_same_v<T, StrokeCommand>) {
           if (brush_.tool == Tool::kRegion) return fail("stroke: the region tool takes 'region LON0 LAT0 LON1 LAT1'");
@@ -158,6 +162,22 @@ Status Viewer::handle(const Command& command) {
             case SimCommand::kStep: return stepSimulation(c.count);
             case SimCommand::kSpeed: region_->stepsPerFrame = c.count; break;
           }
+          return {};
+        } else if constexpr (std::is_same_v<T, StampCommand>) {
+          const auto blend = blendFromName(c.blend);
+          if (!blend) return fail("stamp: blend '" + c.blend + "': expected add, subtract, multiply or replace");
+          gis::Grid<float> t;
+          if (auto image = readImage8(c.path)) {
+            t = gis::Grid<float>(image->width, image->height);
+            for (size_t i = 0; i < t.data.size(); ++i)
+              t.data[i] = float(image->pixels[i * size_t(image->channels)]) / 255.0f;
+          } else {
+            auto raster = gis::readDem(c.path);
+            if (!raster) return fail("stamp " + c.path + ": " + image.message() + "; " + raster.message());
+            t = std::move(raster->values);
+          }
+          editor_->setStamp(t, *blend);
+          brush_.tool = Tool::kStamp;
           return {};
         } else if constexpr (std::is_same_v<T, ScreenshotCommand>) {
           pendingScreenshots_.push_back(c.path);
@@ -210,6 +230,14 @@ Status Viewer::key(const KeyCommand& k) {
   for (int i = 0; i < int(std::size(kToolKeys)); ++i) {
     if (n == kToolKeys[i]) brush_.tool = Tool(i);
   }
+  if (n == "0") {
+    if (!editor_->hasStamp()) return fail("stamp: load an image first ('stamp PATH BLEND' in a script)");
+    brush_.tool = Tool::kStamp;
+  }
+  if (n == "R") brush_.tool = Tool::kRain;
+  if (n == "M") brush_.tool = Tool::kAddMaterial;
+  if (n == "B") brush_.tool = Tool::kRemoveMaterial;
+  if (n == "L") brush_.layer = (brush_.layer + 1) % 4;
   return {};
 }
 
@@ -240,6 +268,20 @@ Status Viewer::applyToolAt(double lon, double lat, bool newStroke) {
       STRATA_TRY_STATUS(rebuildSimulation(water));
       return showWater();
     }
+    case Tool::kRain: {
+      if (!region_) return fail("rain: choose a simulation region first");
+      const glm::dvec2 rc = editor_->radiusCells(brush_.radiusM, cell.y);
+      const auto& r = region_->rect;
+      if (region_->rainMmPerHour.data.empty()) region_->rainMmPerHour = gis::Grid<float>(r.w, r.h, 0.0f);
+      for (int y = 0; y < r.h; ++y) {
+        for (int x = 0; x < r.w; ++x) {
+          const glm::dvec2 d = (glm::dvec2(r.x + x + 0.5, r.y + y + 0.5) - cell) / rc;
+          const double r2 = glm::dot(d, d);
+          if (r2 < 1) region_->rainMmPerHour.at(x, y) += float(std::max(brush_.strength, 0.0) * (1 - r2) * (1 - r2));
+        }
+      }
+      return rebuildSimulation(region_->sim->readWaterDepth());
+    }
     case Tool::kRegion: return fail("region: drag with the left button");
     default: break;
   }
@@ -249,7 +291,7 @@ Status Viewer::applyToolAt(double lon, double lat, bool newStroke) {
   }
   STRATA_TRY_STATUS(editor_->dab(brush_, cell));
   // The simulation reads the edited bed: rebuild it from the new terrain and the current water.
-  if (region_ && (isHeightTool(brush_.tool) || brush_.tool == Tool::kPaste)) {
+  if (region_ && (isHeightTool(brush_.tool) || brush_.tool == Tool::kPaste || brush_.tool == Tool::kStamp)) {
     const auto& d = editor_->lastDab();
     const auto& r = region_->rect;
     if (!d.empty() && d.x < r.x + r.w && r.x < d.x + d.w && d.y < r.y + r.h && r.y < d.y + d.h) {
@@ -284,6 +326,7 @@ Status Viewer::rebuildSimulation(const gis::Grid<float>& waterM) {
   in.layersM = {gis::Grid<float>(r.w, r.h, 0.0f)};
   in.materials = {strata::terrain::Material{}};
   in.waterDepthM = waterM;
+  in.rainMmPerHour = reg.rainMmPerHour;
   // Cell sizes: projected grids from the geotransform; geographic ones on the body's sphere.
   const auto& g = scene_.georef();
   const auto& c = g.transform.c;
@@ -381,6 +424,10 @@ Status Viewer::present(unsigned fbo, int width, int height) {
   return {};
 }
 
+Viewer::FrameTimes Viewer::times() const {
+  return {cpuFrameMs_, gpuFrameMs_, region_ && region_->playing ? region_->lastStepMs : 0.0};
+}
+
 std::vector<std::string> Viewer::hudLines() const {
   const double ex = options_.shading.exaggeration;
   const auto& pose = camera_->pose();
@@ -401,8 +448,8 @@ std::vector<std::string> Viewer::hudLines() const {
   } else {
     lines.push_back("cursor: -");
   }
-  lines.push_back(fmt("tool %s  radius %.0f m  strength %.3g  undo %zu redo %zu", toolName(brush_.tool), brush_.radiusM,
-                      brush_.strength, editor_->undoDepth(), editor_->redoDepth()));
+  lines.push_back(fmt("tool %s  radius %.0f m  strength %.3g  layer %d  undo %zu redo %zu", toolName(brush_.tool),
+                      brush_.radiusM, brush_.strength, brush_.layer, editor_->undoDepth(), editor_->redoDepth()));
   lines.push_back(message_.empty() ? "H: help" : message_);
   return lines;
 }
@@ -412,6 +459,8 @@ std::vector<std::string> Viewer::helpLines() {
           "right mouse drag: look   left mouse: use the tool",
           "1 raise 2 lower 3 smooth 4 flatten 5 copy 6 paste",
           "7 water 8 spring 9 region (drag a rectangle)",
+          "0 stamp (image from a script)   R rain",
+          "M add, B remove material   L next layer",
           "[ ]: brush radius   - =: strength",
           "Z: undo   Y: redo   PAGE UP/DOWN: exaggeration",
           "SPACE: play/pause   N: step   , .: sim speed",

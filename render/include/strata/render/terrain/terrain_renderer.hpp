@@ -74,6 +74,12 @@ class TerrainScene {
   /// After GPU code wrote level 0 of heightTexture() in the window (x, y, w, h) (cells): rebuilds
   /// the mip chain and reads the window back into the CPU copy, so heightAt() sees the edit.
   void heightsEditedOnGpu(int x, int y, int w, int h);
+  /// Replaces the layer thicknesses (4 per cell, bottom first) of `w` x `h` cells at (x, y) in
+  /// the layer texture (setMaterialLayers first); the mip chain is rebuilt.
+  void writeLayers(int x, int y, int w, int h, const std::vector<float>& thicknessM);
+  /// After GPU code wrote level 0 of the layer texture in (x, y, w, h): rebuilds its mip chain and
+  /// returns the window's thicknesses (4 per cell).
+  std::vector<float> layersEditedOnGpu(int x, int y, int w, int h);
 
   /// Elevation (m) at a camera position (lon/lat or easting/northing as in CameraPose),
   /// bilinear between texel centres, clamped at the edges.

@@ -25,14 +25,16 @@ struct MouseButtonCommand {
   enum Button { kLeft, kRight } button = kLeft;
   bool down = true;
 };
-/// Selects the active tool by name (raise, lower, smooth, flatten, water, spring, copy, paste).
+/// Selects the active tool by name (raise, lower, smooth, flatten, copy, paste, water, spring,
+/// region, stamp, rain, material+, material-).
 struct ToolCommand {
   std::string name;
 };
-/// Brush radius (m) and strength (tool units per dab: m for raise/lower/water, fraction for
-/// smooth/flatten, m^3/s for a spring).
+/// Brush radius (m) and strength (tool units per dab: m for raise/lower/water/stamp, fraction
+/// for smooth/flatten, m^3/s for a spring, mm/h for rain).
 struct BrushCommand {
   double radiusM = 0, strength = 0;
+  int layer = -1;  ///< add/remove material: the layer 0..3 (-1: keep the current one)
 };
 /// One stroke of the active tool at a map position (lon/lat deg, or easting/northing m).
 struct StrokeCommand {
@@ -70,12 +72,18 @@ struct ScreenshotCommand {
 struct SaveCommand {
   std::string path;
 };
+/// Loads the stamp image (an 8-bit image: t = first channel / 255; or a raster GDAL reads:
+/// t = its values) and sets how the stamp tool blends it: add, subtract, multiply or replace.
+struct StampCommand {
+  std::string path;
+  std::string blend = "add";
+};
 /// Ends the session.
 struct QuitCommand {};
 
 using Command = std::variant<KeyCommand, MouseMoveCommand, MouseButtonCommand, ToolCommand, BrushCommand, StrokeCommand,
                              GoToCommand, LookCommand, ExaggerationCommand, UndoCommand, RedoCommand, RegionCommand,
-                             SimCommand, ScreenshotCommand, SaveCommand, QuitCommand>;
+                             SimCommand, ScreenshotCommand, SaveCommand, StampCommand, QuitCommand>;
 
 /// A command due at frame `frame` (0-based; commands of one frame run in file order).
 struct TimedCommand {

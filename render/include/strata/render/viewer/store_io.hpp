@@ -16,13 +16,17 @@ struct StoreSurface {
   strata::terrain::Window window;  ///< base-grid cells
   gis::Raster surface;             ///< bedrock + material layers (m), georeferenced
   gis::Grid<float> bedrock;
+  std::vector<gis::Grid<float>> layers;  ///< the first four material layers (m), bottom first
+  std::vector<int> layerFields;          ///< their store fields
 };
 
 /// Reads `window` (level 0) of `store`: the bedrock field plus every material layer.
 Result<StoreSurface> loadStoreSurface(strata::terrain::TileStore& store, strata::terrain::Window window);
-/// Writes the cells `rect` (window cells) of `edited` (the surface, as drawn) back to the store's
-/// bedrock field as bedrock + (edited - loaded surface), updates `loaded` to match, and commits.
+/// Writes the cells `rect` (window cells) of an edit back to the store and commits: `edited` is
+/// the surface as drawn, `editedLayers` the thicknesses (4 per cell, TerrainEditor::layers(); empty
+/// if never edited). Each material layer is written as edited; bedrock as bedrock + (surface
+/// change) - (sum of the layer changes), so unchanged cells stay bit for bit. `loaded` is updated.
 Status saveStoreEdits(strata::terrain::TileStore& store, StoreSurface& loaded, const gis::Grid<float>& edited,
-                      const CellRect& rect);
+                      const std::vector<float>& editedLayers, const CellRect& rect);
 
 }  // namespace strata::render::viewer

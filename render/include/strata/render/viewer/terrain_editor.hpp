@@ -18,16 +18,36 @@ namespace strata::render::viewer {
 
 /// The editing and simulation tools. Raise .. paste edit the terrain (TerrainEditor); water,
 /// spring and region act on the viewer's simulation region (Viewer).
-enum class Tool { kRaise, kLower, kSmooth, kFlatten, kCopy, kPaste, kWater, kSpring, kRegion };
+enum class Tool {
+  kRaise,
+  kLower,
+  kSmooth,
+  kFlatten,
+  kCopy,
+  kPaste,
+  kWater,
+  kSpring,
+  kRegion,
+  kStamp,
+  kRain,
+  kAddMaterial,
+  kRemoveMaterial
+};
 /// "raise", "lower", ... ; nullopt for an unknown name.
 std::optional<Tool> toolFromName(const std::string& name);
 const char* toolName(Tool tool);
+
+/// How a stamp combines with the elevation h, with f = strength * t (t: the image's value).
+enum class Blend { kAdd, kSubtract, kMultiply, kReplace };
+/// "add", "subtract", "multiply", "replace"; nullopt otherwise.
+std::optional<Blend> blendFromName(const std::string& name);
 
 /// The active brush.
 struct Brush {
   Tool tool = Tool::kRaise;
   double radiusM = 300;  ///< radius (m) on the ground
   double strength = 5;   ///< raise/lower: m at the centre per dab; smooth/flatten: blend fraction per dab
+  int layer = 0;         ///< add/remove material: the layer (0 = bottom, < 4)
 };
 
 /// A rectangle of grid cells.
@@ -52,6 +72,16 @@ class TerrainEditor {
   /// Applies one dab of a height tool (raise, lower, smooth, flatten) or of copy/paste centred
   /// at `cell`. Cells outside the grid are ignored. Needs an open stroke.
   Status dab(const Brush& brush, glm::dvec2 cell);
+  /// Sets the stamp image (t per pixel, top row first; drawn over the brush's square, bilinear)
+  /// and its blend mode, for Tool::kStamp.
+  void setStamp(const gis::Grid<float>& image, Blend blend);
+  bool hasStamp() const { return bool(stamp_); }
+  /// Material layers (up to 4, bottom first, thickness in m) the add/remove material tools edit:
+  /// shown by the scene (setMaterialLayers) and mirrored here for undo. The elevations must
+  /// already include them. Without a call, the first material dab starts from four empty layers.
+  Status setLayers(const std::vector<gis::Grid<float>>& thicknessM);
+  /// The current thicknesses, 4 per cell (empty before any layers exist).
+  const std::vector<float>& layers() const { return layers_; }
   /// Closes the stroke and records it for undo (nothing if it changed nothing).
   void endStroke();
   bool inStroke() const { return inStroke_; }
@@ -73,15 +103,17 @@ class TerrainEditor {
  private:
   struct Edit {
     CellRect rect;
-    std::vector<float> before, after;
+    std::vector<float> before, after;              ///< elevations
+    std::vector<float> layersBefore, layersAfter;  ///< 4 per cell; empty when no layers exist
   };
   CellRect clip(CellRect r) const;
   void apply(const Edit& edit, bool forward);
 
   render::terrain::TerrainScene* scene_ = nullptr;
   gl::Program brush_;
-  gl::Texture clipboard_;
-  std::vector<float> strokeBefore_;
+  gl::Texture clipboard_, stamp_;
+  Blend blend_ = Blend::kAdd;
+  std::vector<float> strokeBefore_, strokeLayersBefore_, layers_;
   CellRect strokeRect_, dirty_, lastDab_;
   bool inStroke_ = false;
   std::optional<float> flattenTarget_;

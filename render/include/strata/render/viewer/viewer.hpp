@@ -36,7 +36,8 @@ struct SimRegionState {
   std::unique_ptr<render::sim::Simulation> sim;
   std::vector<std::pair<int, int>> springCells;  ///< region cells of placed springs
   std::vector<double> springRatesM3S;
-  double timeOffsetS = 0;  ///< simulated time before the last rebuild
+  gis::Grid<float> rainMmPerHour;  ///< painted rain (rain tool), region cells; empty until painted
+  double timeOffsetS = 0;          ///< simulated time before the last rebuild
   bool playing = false;
   int stepsPerFrame = 1;
   double lastStepMs = 0;  ///< wall time of the last frame's steps and water upload (ms)
@@ -63,6 +64,13 @@ class Viewer {
   /// nullopt for sky (or, in planetary mode, always: picking is planar only).
   std::optional<glm::dvec2> pick(double x, double y) const;
   std::vector<std::string> hudLines() const;
+  /// The last frame's timings (ms): CPU work of frame() (camera, brush, simulation, draw
+  /// submission), GPU time of the terrain draw (GL_TIME_ELAPSED, read a frame late so nothing
+  /// stalls), and wall time of the simulation steps with the water upload (0 without a region).
+  struct FrameTimes {
+    double cpuMs = 0, gpuMs = 0, simMs = 0;
+  };
+  FrameTimes times() const;
   static std::vector<std::string> helpLines();
 
   bool quitRequested() const { return quit_; }
