@@ -32,11 +32,12 @@ TEST(ViewerScript, ParsesEveryCommand) {
 16 screenshot out.png
 17 save edited.tif
 18 stamp crater.png multiply
+18 save
 18 quit
 )",
                              "t.txt");
   ASSERT_TRUE(s) << s.message();
-  ASSERT_EQ(s->size(), 22u);
+  ASSERT_EQ(s->size(), 23u);
   const auto& v = *s;
   EXPECT_EQ(v[0].frame, 0);
   const auto& g = std::get<GoToCommand>(v[0].command);
@@ -59,7 +60,8 @@ TEST(ViewerScript, ParsesEveryCommand) {
   EXPECT_EQ(std::get<SimCommand>(v[15].command).count, 4);
   EXPECT_EQ(std::get<ScreenshotCommand>(v[18].command).path, "out.png");
   EXPECT_EQ(std::get<StampCommand>(v[20].command).blend, "multiply");
-  EXPECT_TRUE(std::holds_alternative<QuitCommand>(v[21].command));
+  EXPECT_EQ(std::get<SaveCommand>(v[21].command).path, "");
+  EXPECT_TRUE(std::holds_alternative<QuitCommand>(v[22].command));
 }
 
 TEST(ViewerScript, RefusesBadLinesNamingThem) {
@@ -74,8 +76,9 @@ TEST(ViewerScript, RefusesBadLinesNamingThem) {
         Case{"0 key W sideways", "t.txt:1: key: expected key NAME down|up"},
         Case{"0 brush -1 2", "t.txt:1: brush: expected brush RADIUS_M STRENGTH [LAYER] (radius > 0, layer 0..3)"},
         Case{"0 brush 10 2 4", "t.txt:1: brush: expected"}, Case{"0 step 2.5", "t.txt:1: step: expected step [N]"},
-        Case{"0 undo now", "t.txt:1: undo: unexpected 'now'"}, Case{"0 look 0 95", "t.txt:1: look: expected"},
-        Case{"0", "t.txt:1: a command is missing"}}) {
+        Case{"0 undo now", "t.txt:1: undo: unexpected 'now'"},
+        Case{"0 screenshot", "t.txt:1: screenshot: expected screenshot PATH"},
+        Case{"0 look 0 95", "t.txt:1: look: expected"}, Case{"0", "t.txt:1: a command is missing"}}) {
     const auto s = parseScript(c.text, "t.txt");
     ASSERT_FALSE(s) << c.text;
     EXPECT_NE(s.message().find(c.message), std::string::npos) << s.message();

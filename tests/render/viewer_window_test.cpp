@@ -27,48 +27,42 @@ TEST(ViewerWindow, ScriptedSessionMatchesGoldensAndUndoIsExact) {
   for (const char* f : {"fly.png", "sim.png", "raised.png", "undone.png", "before.tif", "raised.tif", "undone.tif"}) {
     std::filesystem::remove(out / f);
   }
-  // Grand Canyon, 512 x 512 cells of 1/512 degree. Frames advance 1/30 s each (--dt).
-  std::ofstream(out / "session.txt") << "0 goto -112.09 36.01 2500\n"
-                                        "0 look 0 -25\n"
-                                        "0 key W down\n"
-                                        "20 key W up\n"
-                                        "21 screenshot " +
-                                            o +
-                                            "fly.png\n"
-                                            "22 region -112.15 36.04 -112.03 36.16\n"
-                                            "22 tool spring\n"
-                                            "22 brush 500 5000\n"
-                                            "23 stroke -112.09 36.10\n"
-                                            "24 speed 8\n"
-                                            "24 play\n"
-                                            "54 pause\n"
-                                            "55 screenshot " +
-                                            o +
-                                            "sim.png\n"
-                                            "56 save " +
-                                            o +
-                                            "before.tif\n"
-                                            "56 tool raise\n"
-                                            "56 brush 1500 150\n"
-                                            "57 mouse 240 180\n"
-                                            "57 button left down\n"
-                                            "58 button left up\n"
-                                            "58 save " +
-                                            o +
-                                            "raised.tif\n"
-                                            "59 screenshot " +
-                                            o +
-                                            "raised.png\n"
-                                            "60 undo\n"
-                                            "60 save " +
-                                            o +
-                                            "undone.tif\n"
-                                            "61 screenshot " +
-                                            o + "undone.png\n";
+  // Grand Canyon, 512 x 512 cells of 1/512 degree. Frames advance 1/30 s each (--dt). "@" stands
+  // for the output folder.
+  const char* lines[] = {"0 goto -112.09 36.01 2500",
+                         "0 look 0 -25",
+                         "0 key W down",
+                         "20 key W up",
+                         "21 screenshot @fly.png",
+                         "22 region -112.15 36.04 -112.03 36.16",
+                         "22 tool spring",
+                         "22 brush 500 5000",
+                         "23 stroke -112.09 36.10",
+                         "24 speed 8",
+                         "24 play",
+                         "54 pause",
+                         "55 screenshot @sim.png",
+                         "56 save @before.tif",
+                         "56 tool raise",
+                         "56 brush 1500 150",
+                         "57 mouse 240 180",
+                         "57 button left down",
+                         "58 button left up",
+                         "58 save @raised.tif",
+                         "59 screenshot @raised.png",
+                         "60 undo",
+                         "60 save @undone.tif",
+                         "61 screenshot @undone.png"};
+  {
+    std::ofstream script(out / "session.txt");
+    for (std::string line : lines) {
+      if (const auto at = line.find('@'); at != std::string::npos) line.replace(at, 1, o);
+      script << line << "\n";
+    }
+  }
   const std::string cmd = std::string("xvfb-run -a -s '-screen 0 1280x800x24' ") + STRATA_VIEW_EXE + " " +
-                          STRATA_DATA_DIR +
-                          "/grand_canyon/grand_canyon_512.tif --size 480x320 --circles 128 --script " + o +
-                          "session.txt > " + o + "session.log 2>&1";
+                          test::dataPath("grand_canyon/grand_canyon_512.tif") +
+                          " --size 480x320 --circles 128 --script " + o + "session.txt > " + o + "session.log 2>&1";
   const int rc = std::system(cmd.c_str());
   std::ifstream logFile(out / "session.log");
   const std::string log((std::istreambuf_iterator<char>(logFile)), std::istreambuf_iterator<char>());

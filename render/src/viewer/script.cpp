@@ -99,14 +99,14 @@ Result<std::vector<TimedCommand>> parseScript(const std::string& text, const std
         return bad(verb + " [N] (a whole number >= 1)");
       }
       c = SimCommand{verb == "step" ? SimCommand::kStep : SimCommand::kSpeed, v.empty() ? 1 : int(v[0])};
-    } else if (verb == "screenshot" || verb == "save") {
+    } else if (verb == "screenshot") {
       std::string path;
-      if (!(in >> path)) return bad(verb + " PATH");
-      if (verb == "screenshot") {
-        c = ScreenshotCommand{path};
-      } else {
-        c = SaveCommand{path};
-      }
+      if (!(in >> path)) return bad("screenshot PATH");
+      c = ScreenshotCommand{path};
+    } else if (verb == "save") {
+      std::string path;
+      in >> path;  // optional: empty saves where the viewer was told to (the store itself)
+      c = SaveCommand{path};
     } else if (verb == "stamp") {
       std::string path, blend;
       if (!(in >> path >> blend) ||

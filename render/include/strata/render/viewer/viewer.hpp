@@ -111,7 +111,7 @@ class Viewer {
   std::string message_;
   // Timings for the HUD (ms): CPU work of the last frame, GPU time of the terrain draw.
   double cpuFrameMs_ = 0, gpuFrameMs_ = 0;
-  gl::GpuTimer gpuTimers_[2];
+  gl::GpuTimer gpuTimers_[3];  // a ring: frame N reads the timer of frame N - 2
   int frameIndex_ = 0;
 };
 
