@@ -13,6 +13,7 @@
 #include <strata/render/viewer/camera_controller.hpp>
 #include <strata/render/viewer/store_io.hpp>
 #include <strata/render/viewer/terrain_editor.hpp>
+#include <strata/render/viewer/viewer.hpp>
 #include <strata/terrain/ingest.hpp>
 
 #include "gl_fixture.hpp"
@@ -252,6 +253,33 @@ TEST_F(ViewerGpu, MaterialBrushesMoveTheSurfaceWithTheLayerAndUndoBoth) {
   ASSERT_TRUE(editor->undo());
   EXPECT_TRUE(bitEqual(scene->heights().data, original.data));
   for (float t : editor->layers()) ASSERT_EQ(t, 0.0f);
+}
+
+TEST_F(ViewerGpu, PickFindsTheGroundPointUnderThePixel) {
+  // Flat ground at 500 m, 6 km square; the camera 1000 m above its centre looking north. The
+  // centre pixel of an odd-sized image is the view axis: it meets the ground 1000 / tan(-pitch)
+  // metres north. Tolerance 2 m: the depth buffer is float, the ring mesh is exact on flat ground.
+  ViewerOptions options;
+  options.width = 101;
+  options.height = 101;
+  options.circles = 64;
+  auto viewer = Viewer::create(planarDem(200, 200, [](int, int) { return 500.0f; }), options);
+  ASSERT_TRUE(viewer) << viewer.message();
+  auto& v = **viewer;
+  for (const double pitch : {-30.0, -45.0, -90.0}) {
+    ASSERT_TRUE(v.handle(GoToCommand{503000.0, 3997000.0, 1000.0}));
+    ASSERT_TRUE(v.handle(LookCommand{0.0, pitch}));
+    ASSERT_TRUE(v.frame(0.0));
+    const auto at = v.pick(50.5, 50.5);
+    ASSERT_TRUE(at) << pitch;
+    const double north = pitch == -90.0 ? 0.0 : 1000.0 / std::tan(-pitch * std::numbers::pi / 180.0);
+    EXPECT_NEAR(at->x, 503000.0, 2.0) << pitch;
+    EXPECT_NEAR(at->y, 3997000.0 + north, 2.0) << pitch;
+  }
+  // Looking up at the sky: nothing to pick.
+  ASSERT_TRUE(v.handle(LookCommand{0.0, 30.0}));
+  ASSERT_TRUE(v.frame(0.0));
+  EXPECT_FALSE(v.pick(50.5, 10.5));
 }
 
 TEST_F(ViewerGpu, FlightSpeedFollowsHeightAboveGround) {

@@ -30,6 +30,7 @@ TEST(ViewerScript, ParsesEveryCommand) {
 14 pause
 15 exaggeration 2
 16 screenshot out.png
+16 screenshot hud.png hud
 17 save edited.tif
 18 stamp crater.png multiply
 18 save
@@ -37,7 +38,7 @@ TEST(ViewerScript, ParsesEveryCommand) {
 )",
                              "t.txt");
   ASSERT_TRUE(s) << s.message();
-  ASSERT_EQ(s->size(), 23u);
+  ASSERT_EQ(s->size(), 24u);
   const auto& v = *s;
   EXPECT_EQ(v[0].frame, 0);
   const auto& g = std::get<GoToCommand>(v[0].command);
@@ -59,9 +60,11 @@ TEST(ViewerScript, ParsesEveryCommand) {
   EXPECT_EQ(std::get<SimCommand>(v[14].command).count, 8);
   EXPECT_EQ(std::get<SimCommand>(v[15].command).count, 4);
   EXPECT_EQ(std::get<ScreenshotCommand>(v[18].command).path, "out.png");
-  EXPECT_EQ(std::get<StampCommand>(v[20].command).blend, "multiply");
-  EXPECT_EQ(std::get<SaveCommand>(v[21].command).path, "");
-  EXPECT_TRUE(std::holds_alternative<QuitCommand>(v[22].command));
+  EXPECT_FALSE(std::get<ScreenshotCommand>(v[18].command).withHud);
+  EXPECT_TRUE(std::get<ScreenshotCommand>(v[19].command).withHud);
+  EXPECT_EQ(std::get<StampCommand>(v[21].command).blend, "multiply");
+  EXPECT_EQ(std::get<SaveCommand>(v[22].command).path, "");
+  EXPECT_TRUE(std::holds_alternative<QuitCommand>(v[23].command));
 }
 
 TEST(ViewerScript, RefusesBadLinesNamingThem) {

@@ -100,9 +100,9 @@ Result<std::vector<TimedCommand>> parseScript(const std::string& text, const std
       }
       c = SimCommand{verb == "step" ? SimCommand::kStep : SimCommand::kSpeed, v.empty() ? 1 : int(v[0])};
     } else if (verb == "screenshot") {
-      std::string path;
-      if (!(in >> path)) return bad("screenshot PATH");
-      c = ScreenshotCommand{path};
+      std::string path, hud;
+      if (!(in >> path) || ((in >> hud) && hud != "hud")) return bad("screenshot PATH [hud]");
+      c = ScreenshotCommand{path, hud == "hud"};
     } else if (verb == "save") {
       std::string path;
       in >> path;  // optional: empty saves where the viewer was told to (the store itself)

@@ -180,7 +180,7 @@ Status Viewer::handle(const Command& command) {
           brush_.tool = Tool::kStamp;
           return {};
         } else if constexpr (std::is_same_v<T, ScreenshotCommand>) {
-          pendingScreenshots_.push_back(c.path);
+          pendingScreenshots_.push_back(c);
           return {};
         } else if constexpr (std::is_same_v<T, SaveCommand>) {
           const std::string path = c.path.empty() ? savePath : c.path;
@@ -404,16 +404,22 @@ Status Viewer::frame(double dtS) {
 Status Viewer::present(unsigned fbo, int width, int height) {
   target_->blitColourTo(fbo, width, height);
   glBindFramebuffer(GL_FRAMEBUFFER, fbo);
-  for (const auto& path : pendingScreenshots_) {
-    std::vector<uint8_t> pixels(size_t(width) * size_t(height) * 4), flipped(pixels.size());
-    glPixelStorei(GL_PACK_ALIGNMENT, 1);
-    glReadPixels(0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, pixels.data());
-    const size_t row = size_t(width) * 4;
-    for (int y = 0; y < height; ++y) std::copy_n(&pixels[size_t(height - 1 - y) * row], row, &flipped[size_t(y) * row]);
-    for (size_t i = 3; i < flipped.size(); i += 4) flipped[i] = 255;
-    STRATA_TRY_STATUS(writeImage8(path, width, height, 4, flipped));
-  }
-  pendingScreenshots_.clear();
+  auto capture = [&](bool withHud) -> Status {
+    for (const auto& shot : pendingScreenshots_) {
+      if (shot.withHud != withHud) continue;
+      std::vector<uint8_t> pixels(size_t(width) * size_t(height) * 4), flipped(pixels.size());
+      glPixelStorei(GL_PACK_ALIGNMENT, 1);
+      glReadPixels(0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, pixels.data());
+      const size_t row = size_t(width) * 4;
+      for (int y = 0; y < height; ++y) {
+        std::copy_n(&pixels[size_t(height - 1 - y) * row], row, &flipped[size_t(y) * row]);
+      }
+      for (size_t i = 3; i < flipped.size(); i += 4) flipped[i] = 255;
+      STRATA_TRY_STATUS(writeImage8(shot.path, width, height, 4, flipped));
+    }
+    return {};
+  };
+  STRATA_TRY_STATUS(capture(false));
   const int scale = height >= 700 ? 2 : 1;
   if (options_.showHud) hud_->draw(hudLines(), 0, 0, width, height, scale);
   if (showHelp_) {
@@ -422,6 +428,8 @@ Status Viewer::present(unsigned fbo, int width, int height) {
     HudRenderer::measure(help, scale, w, h);
     hud_->draw(help, std::max(0, width - w), 0, width, height, scale);
   }
+  STRATA_TRY_STATUS(capture(true));
+  pendingScreenshots_.clear();
   return {};
 }
 

@@ -64,9 +64,10 @@ struct SimCommand {
   enum Action { kPlay, kPause, kStep, kSpeed } action = kPlay;
   int count = 1;
 };
-/// Writes the window's image (before the HUD) to `path` (PNG).
+/// Writes the window's image to `path` (PNG): the terrain only, or with the HUD and help on top.
 struct ScreenshotCommand {
   std::string path;
+  bool withHud = false;
 };
 /// Writes the edited terrain: to the input store, or to a new GeoTIFF.
 struct SaveCommand {

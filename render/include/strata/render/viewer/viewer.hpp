@@ -107,7 +107,7 @@ class Viewer {
   Brush brush_;
   glm::dvec2 cursor_{-1, -1}, regionStart_{0, 0};
   bool leftDown_ = false, rightDown_ = false, showHelp_ = false, quit_ = false;
-  std::vector<std::string> pendingScreenshots_;
+  std::vector<ScreenshotCommand> pendingScreenshots_;
   std::string message_;
   // Timings for the HUD (ms): CPU work of the last frame, GPU time of the terrain draw.
   double cpuFrameMs_ = 0, gpuFrameMs_ = 0;
