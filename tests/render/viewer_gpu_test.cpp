@@ -276,6 +276,13 @@ TEST_F(ViewerGpu, PickFindsTheGroundPointUnderThePixel) {
     EXPECT_NEAR(at->x, 503000.0, 2.0) << pitch;
     EXPECT_NEAR(at->y, 3997000.0 + north, 2.0) << pitch;
   }
+  // G goes to the point under the cursor: 1000 m ahead at pitch -45.
+  ASSERT_TRUE(v.handle(LookCommand{0.0, -45.0}));
+  ASSERT_TRUE(v.frame(0.0));
+  ASSERT_TRUE(v.handle(MouseMoveCommand{50.5, 50.5}));
+  ASSERT_TRUE(v.handle(KeyCommand{"G", true}));
+  EXPECT_NEAR(v.camera().pose().lat, 3997000.0 + 1000.0, 2.0);
+  EXPECT_NEAR(v.camera().heightAboveGroundM(1.0), 1000.0, 1e-6);
   // Looking up at the sky: nothing to pick.
   ASSERT_TRUE(v.handle(LookCommand{0.0, 30.0}));
   ASSERT_TRUE(v.frame(0.0));

@@ -234,6 +234,11 @@ Status Viewer::key(const KeyCommand& k) {
     if (!editor_->hasStamp()) return fail("stamp: load an image first ('stamp PATH BLEND' in a script)");
     brush_.tool = Tool::kStamp;
   }
+  if (n == "G") {  // go to the point under the cursor, keeping the height above ground
+    const auto at = pick(cursor_.x, cursor_.y);
+    if (!at) return fail("goto: the cursor is not over the terrain");
+    return camera_->goTo(at->x, at->y, -1, ex);
+  }
   if (n == "R") brush_.tool = Tool::kRain;
   if (n == "M") brush_.tool = Tool::kAddMaterial;
   if (n == "B") brush_.tool = Tool::kRemoveMaterial;
@@ -473,6 +478,7 @@ std::vector<std::string> Viewer::helpLines() {
           "[ ]: brush radius   - =: strength",
           "Z: undo   Y: redo   PAGE UP/DOWN: exaggeration",
           "SPACE: play/pause   N: step   , .: sim speed",
+          "G: go to the point under the cursor",
           "F2: HUD   H or F1: this help   ESC: quit"};
 }
 
