@@ -289,6 +289,51 @@ TEST_F(ViewerGpu, PickFindsTheGroundPointUnderThePixel) {
   EXPECT_FALSE(v.pick(50.5, 10.5));
 }
 
+TEST_F(ViewerGpu, ErosionInTheRegionMovesTheSurfaceWithTheLayers) {
+  // A 30 m-cell slope falling 3 m a cell to the south; a 40 x 40 region fed by a spring at its top.
+  ViewerOptions options;
+  options.width = 64;
+  options.height = 48;
+  options.circles = 32;
+  auto viewer = Viewer::create(
+      planarDem(64, 64, [](int x, int y) { return 400.0f - 3.0f * float(y) + 0.1f * float(x % 3); }), options);
+  ASSERT_TRUE(viewer) << viewer.message();
+  auto& v = **viewer;
+  const auto before = v.scene().heights();
+  // Region cells 12..51 (easting 500360..501560, northing 3999640..3998440).
+  ASSERT_TRUE(v.handle(RegionCommand{500360.0, 3999640.0, 501560.0, 3998440.0}));
+  ASSERT_TRUE(v.handle(ToolCommand{"spring"}));
+  ASSERT_TRUE(v.handle(BrushCommand{30.0, 20.0}));
+  ASSERT_TRUE(v.handle(StrokeCommand{500975.0, 3999600.0}));  // cell (32, 13)
+  ASSERT_TRUE(v.handle(SimCommand{SimCommand::kErosionOn}));
+  ASSERT_EQ(v.editor().layers().size(), size_t(64 * 64 * 4));
+  ASSERT_TRUE(v.handle(SimCommand{SimCommand::kStep, 200}));
+  const auto& after = v.scene().heights();
+  const auto& layers = v.editor().layers();
+  double surfaceChange = 0, layerChange = 0, maxCut = 0;
+  for (int y = 0; y < 64; ++y) {
+    for (int x = 0; x < 64; ++x) {
+      const size_t i = size_t(y) * 64 + size_t(x);
+      const bool inRegion = x >= 12 && x < 52 && y >= 12 && y < 52;
+      if (!inRegion) {
+        ASSERT_EQ(after.data[i], before.data[i]) << x << " " << y;
+        continue;
+      }
+      const double dh = double(after.data[i]) - double(before.data[i]);
+      double dl = -2.0;  // the region started with 2 m of soil in layer 1
+      for (int k = 0; k < 4; ++k) dl += layers[i * 4 + size_t(k)];
+      // The base does not move: the surface changes by what the layers gain or lose (float
+      // rounding of elevations near 300 m: 1e-4 m).
+      EXPECT_NEAR(dh, dl, 1e-4) << x << " " << y;
+      surfaceChange += dh;
+      layerChange += dl;
+      maxCut = std::max(maxCut, -dh);
+    }
+  }
+  EXPECT_NEAR(surfaceChange, layerChange, 1e-2);
+  EXPECT_GT(maxCut, 1e-3) << "the spring's water eroded nothing";
+}
+
 TEST_F(ViewerGpu, FlightSpeedFollowsHeightAboveGround) {
   auto scene = TerrainScene::create(planarDem(64, 64, [](int, int) { return 500.0f; }));
   ASSERT_TRUE(scene);

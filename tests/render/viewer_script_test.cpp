@@ -34,11 +34,12 @@ TEST(ViewerScript, ParsesEveryCommand) {
 17 save edited.tif
 18 stamp crater.png multiply
 18 save
+18 erosion on
 18 quit
 )",
                              "t.txt");
   ASSERT_TRUE(s) << s.message();
-  ASSERT_EQ(s->size(), 24u);
+  ASSERT_EQ(s->size(), 25u);
   const auto& v = *s;
   EXPECT_EQ(v[0].frame, 0);
   const auto& g = std::get<GoToCommand>(v[0].command);
@@ -64,7 +65,8 @@ TEST(ViewerScript, ParsesEveryCommand) {
   EXPECT_TRUE(std::get<ScreenshotCommand>(v[19].command).withHud);
   EXPECT_EQ(std::get<StampCommand>(v[21].command).blend, "multiply");
   EXPECT_EQ(std::get<SaveCommand>(v[22].command).path, "");
-  EXPECT_TRUE(std::holds_alternative<QuitCommand>(v[23].command));
+  EXPECT_EQ(std::get<SimCommand>(v[23].command).action, SimCommand::kErosionOn);
+  EXPECT_TRUE(std::holds_alternative<QuitCommand>(v[24].command));
 }
 
 TEST(ViewerScript, RefusesBadLinesNamingThem) {

@@ -107,6 +107,10 @@ Result<std::vector<TimedCommand>> parseScript(const std::string& text, const std
       std::string path;
       in >> path;  // optional: empty saves where the viewer was told to (the store itself)
       c = SaveCommand{path};
+    } else if (verb == "erosion") {
+      std::string state;
+      if (!(in >> state) || (state != "on" && state != "off")) return bad("erosion on|off");
+      c = SimCommand{state == "on" ? SimCommand::kErosionOn : SimCommand::kErosionOff, 1};
     } else if (verb == "stamp") {
       std::string path, blend;
       if (!(in >> path >> blend) ||

@@ -239,6 +239,21 @@ void TerrainEditor::apply(const Edit& edit, bool forward) {
   dirty_ = dirty_.united(edit.rect);
 }
 
+void TerrainEditor::applyExternal(const CellRect& rect, const std::vector<float>& heights,
+                                  const std::vector<float>& layers4) {
+  STRATA_CHECK(!inStroke_) << "applyExternal during a stroke";
+  STRATA_CHECK(heights.size() == size_t(rect.w) * size_t(rect.h)) << "applyExternal: wrong patch size";
+  Edit e;
+  e.rect = rect;
+  e.after = heights;
+  if (!layers_.empty()) {
+    STRATA_CHECK(layers4.size() == heights.size() * 4) << "applyExternal: wrong layer patch size";
+    e.layersBefore = layers4;  // apply() only checks that layers are present
+    e.layersAfter = layers4;
+  }
+  apply(e, true);
+}
+
 bool TerrainEditor::undo() {
   if (inStroke_ || undo_.empty()) return false;
   apply(undo_.back(), false);

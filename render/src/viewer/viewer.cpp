@@ -161,6 +161,8 @@ Status Viewer::handle(const Command& command) {
             case SimCommand::kPause: region_->playing = false; break;
             case SimCommand::kStep: return stepSimulation(c.count);
             case SimCommand::kSpeed: region_->stepsPerFrame = c.count; break;
+            case SimCommand::kErosionOn: return setErosion(true);
+            case SimCommand::kErosionOff: return setErosion(false);
           }
           return {};
         } else if constexpr (std::is_same_v<T, StampCommand>) {
@@ -239,6 +241,7 @@ Status Viewer::key(const KeyCommand& k) {
     if (!at) return fail("goto: the cursor is not over the terrain");
     return camera_->goTo(at->x, at->y, -1, ex);
   }
+  if (n == "X" && region_) return setErosion(!region_->erosion);
   if (n == "R") brush_.tool = Tool::kRain;
   if (n == "M") brush_.tool = Tool::kAddMaterial;
   if (n == "B") brush_.tool = Tool::kRemoveMaterial;
@@ -328,8 +331,25 @@ Status Viewer::rebuildSimulation(const gis::Grid<float>& waterM) {
   for (int y = 0; y < r.h; ++y) {
     for (int x = 0; x < r.w; ++x) in.baseM.at(x, y) = scene_.heights().at(r.x + x, r.y + y);
   }
-  in.layersM = {gis::Grid<float>(r.w, r.h, 0.0f)};
-  in.materials = {strata::terrain::Material{}};
+  if (reg.erosion) {
+    // The editor's four layers are the sim's (sediment settles on the top one); the base is the
+    // surface less their thickness, so the bed is the drawn surface.
+    const auto& l = editor_->layers();
+    in.layersM.assign(4, gis::Grid<float>(r.w, r.h));
+    for (int y = 0; y < r.h; ++y) {
+      for (int x = 0; x < r.w; ++x) {
+        const size_t i = (size_t(r.y + y) * size_t(scene_.width()) + size_t(r.x + x)) * 4;
+        for (int k = 0; k < 4; ++k) {
+          in.layersM[size_t(k)].at(x, y) = l[i + size_t(k)];
+          in.baseM.at(x, y) -= l[i + size_t(k)];
+        }
+      }
+    }
+    in.materials = strata::terrain::defaultMaterials();
+  } else {
+    in.layersM = {gis::Grid<float>(r.w, r.h, 0.0f)};
+    in.materials = {strata::terrain::Material{}};
+  }
   in.waterDepthM = waterM;
   in.rainMmPerHour = reg.rainMmPerHour;
   // Cell sizes: projected grids from the geotransform; geographic ones on the body's sphere.
@@ -355,6 +375,15 @@ Status Viewer::rebuildSimulation(const gis::Grid<float>& waterM) {
   p.cflAlpha = 0.45f;
   p.maxDtS = 10.0f;
   p.manningN = 0.03f;
+  if (reg.erosion) {  // the test suite's erosion constants (tests/support/sim_scenes.hpp)
+    p.erosionEnabled = 1;
+    p.capacityK = 0.05f;
+    p.erosionRate = 0.5f;
+    p.depositionRate = 0.3f;
+    p.deepWaterM = 2.0f;
+    p.slowWaterMS = 0.05f;
+    p.dryDepthM = 1e-3f;
+  }
   p.openEdges = strata::terrain::sim::kEdgeWest | strata::terrain::sim::kEdgeEast | strata::terrain::sim::kEdgeNorth |
                 strata::terrain::sim::kEdgeSouth;
   STRATA_TRY(auto sim, render::sim::Simulation::create(in, p));
@@ -366,9 +395,40 @@ Status Viewer::rebuildSimulation(const gis::Grid<float>& waterM) {
   return {};
 }
 
+Status Viewer::setErosion(bool on) {
+  if (!region_) return fail("erosion: choose a simulation region first");
+  if (on == region_->erosion) return {};
+  if (on && editor_->layers().empty()) {
+    // Four layers (rock, soil, sand, sediment) with 2 m of soil over the region, taken from
+    // the surface (which does not move). Starting layers clears the undo history.
+    std::vector<gis::Grid<float>> layers(4, gis::Grid<float>(scene_.width(), scene_.height(), 0.0f));
+    const auto& r = region_->rect;
+    for (int y = r.y; y < r.y + r.h; ++y) {
+      for (int x = r.x; x < r.x + r.w; ++x) layers[1].at(x, y) = 2.0f;
+    }
+    STRATA_TRY_STATUS(editor_->setLayers(layers));
+    message_ = "erosion on: 2 m of soil over the region (undo history cleared)";
+  }
+  region_->erosion = on;
+  return rebuildSimulation(region_->sim->readWaterDepth());
+}
+
 Status Viewer::stepSimulation(int steps) {
   const auto t0 = Clock::now();
   region_->sim->step(steps);
+  if (region_->erosion) {
+    // The bed and layers moved: bring them into the scene (elevations, layer colours) and the
+    // editor's mirror.
+    const auto bed = region_->sim->readBed();
+    const auto layers = region_->sim->readLayers();
+    const double datum = region_->sim->datumM();
+    std::vector<float> heights(bed.data.size()), packed(bed.data.size() * 4);
+    for (size_t i = 0; i < bed.data.size(); ++i) {
+      heights[i] = float(double(bed.data[i]) + datum);
+      for (size_t k = 0; k < 4; ++k) packed[i * 4 + k] = layers[k].data[i];
+    }
+    editor_->applyExternal(region_->rect, heights, packed);
+  }
   STRATA_TRY_STATUS(showWater());
   region_->lastStepMs = msSince(t0);
   return {};
@@ -448,8 +508,8 @@ std::vector<std::string> Viewer::hudLines() const {
   std::vector<std::string> lines;
   lines.push_back(fmt("frame %.1f ms CPU, %.1f ms GPU", cpuFrameMs_, gpuFrameMs_));
   if (region_) {
-    lines.push_back(fmt("sim %s x%d  %.1f ms/frame  t=%.0f s", region_->playing ? "playing" : "paused",
-                        region_->stepsPerFrame, region_->lastStepMs,
+    lines.push_back(fmt("sim %s x%d%s  %.1f ms/frame  t=%.0f s", region_->playing ? "playing" : "paused",
+                        region_->stepsPerFrame, region_->erosion ? " erosion" : "", region_->lastStepMs,
                         region_->timeOffsetS + region_->sim->stats().timeS));
   } else {
     lines.push_back("sim: no region (tool 9, drag)");
@@ -478,7 +538,7 @@ std::vector<std::string> Viewer::helpLines() {
           "[ ]: brush radius   - =: strength",
           "Z: undo   Y: redo   PAGE UP/DOWN: exaggeration",
           "SPACE: play/pause   N: step   , .: sim speed",
-          "G: go to the point under the cursor",
+          "G: go to the point under the cursor   X: erosion on/off",
           "F2: HUD   H or F1: this help   ESC: quit"};
 }
 

@@ -59,9 +59,10 @@ struct RedoCommand {};
 struct RegionCommand {
   double lon0 = 0, lat0 = 0, lon1 = 0, lat1 = 0;
 };
-/// Simulation control: play, pause, `steps` single steps, or `stepsPerFrame` while playing.
+/// Simulation control: play, pause, `count` single steps, `count` steps per frame while
+/// playing, erosion and deposition on or off.
 struct SimCommand {
-  enum Action { kPlay, kPause, kStep, kSpeed } action = kPlay;
+  enum Action { kPlay, kPause, kStep, kSpeed, kErosionOn, kErosionOff } action = kPlay;
   int count = 1;
 };
 /// Writes the window's image to `path` (PNG): the terrain only, or with the HUD and help on top.

@@ -82,6 +82,10 @@ class TerrainEditor {
   Status setLayers(const std::vector<gis::Grid<float>>& thicknessM);
   /// The current thicknesses, 4 per cell (empty before any layers exist).
   const std::vector<float>& layers() const { return layers_; }
+  /// The simulation changed the terrain in `rect`: elevations (rect cells) and, if layers exist,
+  /// thicknesses (4 per rect cell). Written to the scene and the mirror, outside the undo
+  /// history (an undo of an earlier edit there restores that edit's values).
+  void applyExternal(const CellRect& rect, const std::vector<float>& heights, const std::vector<float>& layers4);
   /// Closes the stroke and records it for undo (nothing if it changed nothing).
   void endStroke();
   bool inStroke() const { return inStroke_; }

@@ -39,6 +39,7 @@ struct SimRegionState {
   gis::Grid<float> rainMmPerHour;  ///< painted rain (rain tool), region cells; empty until painted
   double timeOffsetS = 0;          ///< simulated time before the last rebuild
   bool playing = false;
+  bool erosion = false;  ///< erosion and deposition (docs/sim-erosion.md) on the editor's four layers
   int stepsPerFrame = 1;
   double lastStepMs = 0;  ///< wall time of the last frame's steps and water upload (ms)
 };
@@ -95,6 +96,7 @@ class Viewer {
   Status rebuildSimulation(const gis::Grid<float>& waterM);
   Status stepSimulation(int steps);
   Status showWater();
+  Status setErosion(bool on);
 
   render::terrain::TerrainScene scene_;
   ViewerOptions options_;
