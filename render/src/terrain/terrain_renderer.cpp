@@ -189,6 +189,44 @@ Status TerrainScene::setWaterDepth(const gis::Grid<float>& depthM) {
   return {};
 }
 
+void TerrainScene::writeHeights(int x, int y, const gis::Grid<float>& patch) {
+  STRATA_CHECK(x >= 0 && y >= 0 && x + patch.width <= width() && y + patch.height <= height())
+      << "writeHeights: patch outside the grid";
+  height_.upload(patch.data.data(), 0, x, y, patch.width, patch.height);
+  height_.generateMipmap();
+  for (int j = 0; j < patch.height; ++j) {
+    std::copy_n(&patch.data[size_t(j) * size_t(patch.width)], patch.width, &heights_.at(x, y + j));
+  }
+}
+
+void TerrainScene::heightsEditedOnGpu(int x, int y, int w, int h) {
+  STRATA_CHECK(x >= 0 && y >= 0 && w > 0 && h > 0 && x + w <= width() && y + h <= height())
+      << "heightsEditedOnGpu: window outside the grid";
+  height_.generateMipmap();
+  std::vector<float> window(size_t(w) * size_t(h));
+  glGetTextureSubImage(height_.id(), 0, x, y, 0, w, h, 1, GL_RED, GL_FLOAT, GLsizei(window.size() * sizeof(float)),
+                       window.data());
+  for (int j = 0; j < h; ++j) std::copy_n(&window[size_t(j) * size_t(w)], w, &heights_.at(x, y + j));
+}
+
+void TerrainScene::writeLayers(int x, int y, int w, int h, const std::vector<float>& thicknessM) {
+  STRATA_CHECK(layers_ && x >= 0 && y >= 0 && x + w <= width() && y + h <= height() &&
+               thicknessM.size() == size_t(w) * size_t(h) * 4)
+      << "writeLayers: no layers, or the window is outside the grid";
+  layers_.upload(thicknessM.data(), 0, x, y, w, h);
+  layers_.generateMipmap();
+}
+
+std::vector<float> TerrainScene::layersEditedOnGpu(int x, int y, int w, int h) {
+  STRATA_CHECK(layers_ && x >= 0 && y >= 0 && w > 0 && h > 0 && x + w <= width() && y + h <= height())
+      << "layersEditedOnGpu: no layers, or the window is outside the grid";
+  layers_.generateMipmap();
+  std::vector<float> window(size_t(w) * size_t(h) * 4);
+  glGetTextureSubImage(layers_.id(), 0, x, y, 0, w, h, 1, GL_RGBA, GL_FLOAT, GLsizei(window.size() * sizeof(float)),
+                       window.data());
+  return window;
+}
+
 Status TerrainScene::setMaterialLayers(const std::vector<gis::Grid<float>>& thicknessM) {
   if (streamed_) return fail("render: material layers are drawn on whole-DEM scenes only (this one is streamed)");
   if (thicknessM.empty() || thicknessM.size() > 4) {
@@ -347,6 +385,19 @@ std::vector<T> flipRows(std::vector<T> pixels, int width, int height, int channe
 
 std::vector<uint8_t> OffscreenTarget::colour() const { return flipRows(colour_.read<uint8_t>(), width_, height_, 4); }
 std::vector<float> OffscreenTarget::depth() const { return flipRows(depth_.read<float>(), width_, height_, 1); }
+float OffscreenTarget::depthAt(int x, int y) const {
+  STRATA_CHECK(x >= 0 && y >= 0 && x < width_ && y < height_) << "depthAt(" << x << ", " << y << ") outside the target";
+  float d = 0;
+  glGetTextureSubImage(depth_.id(), 0, x, height_ - 1 - y, 0, 1, 1, 1, GL_DEPTH_COMPONENT, GL_FLOAT, sizeof d, &d);
+  return d;
+}
+
+void OffscreenTarget::blitColourTo(GLuint drawFramebuffer, int width, int height) const {
+  glNamedFramebufferReadBuffer(fbo_.id(), GL_COLOR_ATTACHMENT0);
+  glBlitNamedFramebuffer(fbo_.id(), drawFramebuffer, 0, 0, width_, height_, 0, 0, width, height, GL_COLOR_BUFFER_BIT,
+                         width == width_ && height == height_ ? GL_NEAREST : GL_LINEAR);
+}
+
 std::vector<float> OffscreenTarget::elevation() const { return flipRows(elevation_.read<float>(), width_, height_, 1); }
 
 // ---- RingRenderer ------------------------------------------------------------------------------

@@ -77,6 +77,18 @@ class TerrainScene {
   /// Thicknesses (m) of up to four material layers (bottom first), same grid as the DEM;
   /// drawn with Shading::layerColours.
   Status setMaterialLayers(const std::vector<gis::Grid<float>>& thicknessM);
+  /// Replaces the elevations of the `patch.width` x `patch.height` cells at (x, y) (m), on the
+  /// GPU and in the CPU copy; the mip chain is rebuilt. The patch must lie inside the grid.
+  void writeHeights(int x, int y, const gis::Grid<float>& patch);
+  /// After GPU code wrote level 0 of heightTexture() in the window (x, y, w, h) (cells): rebuilds
+  /// the mip chain and reads the window back into the CPU copy, so heightAt() sees the edit.
+  void heightsEditedOnGpu(int x, int y, int w, int h);
+  /// Replaces the layer thicknesses (4 per cell, bottom first) of `w` x `h` cells at (x, y) in
+  /// the layer texture (setMaterialLayers first); the mip chain is rebuilt.
+  void writeLayers(int x, int y, int w, int h, const std::vector<float>& thicknessM);
+  /// After GPU code wrote level 0 of the layer texture in (x, y, w, h): rebuilds its mip chain and
+  /// returns the window's thicknesses (4 per cell).
+  std::vector<float> layersEditedOnGpu(int x, int y, int w, int h);
 
   /// Elevation (m) at a camera position (lon/lat or easting/northing as in CameraPose),
   /// bilinear between texel centres, clamped at the edges.
@@ -150,6 +162,11 @@ class OffscreenTarget {
   std::vector<uint8_t> colour() const;
   std::vector<float> depth() const;
   std::vector<float> elevation() const;
+  /// The reversed depth at pixel (x, y), y counted from the top row (0: nothing drawn).
+  float depthAt(int x, int y) const;
+  /// Copies the colour attachment to framebuffer `drawFramebuffer` (0: a window's), scaled to
+  /// `width` x `height` pixels.
+  void blitColourTo(GLuint drawFramebuffer, int width, int height) const;
 
  private:
   int width_ = 0, height_ = 0;

@@ -1,0 +1,6 @@
+#version 450
+// Heads-up display: one flat colour per draw.
+uniform vec4 uColour;
+layout(location = 0) out vec4 outColour;
+
+void main() { outColour = uColour; }
