@@ -11,19 +11,15 @@
 #include <strata/terrain/sim/sim_host.hpp>
 #include <strata/terrain/tile_store.hpp>
 
+#include "tile_common.hpp"
+
 namespace strata::render::sim {
 
 namespace ts = strata::terrain::sim;
 
-namespace {
-gis::Grid<float> crop(const gis::Grid<float>& g, int x0, int y0, int x1, int y1) {
-  gis::Grid<float> out(x1 - x0, y1 - y0);
-  for (int y = y0; y < y1; ++y) {
-    for (int x = x0; x < x1; ++x) out.at(x - x0, y - y0) = g.at(x, y);
-  }
-  return out;
-}
+using detail::crop;
 
+namespace {
 // A3: the water level eta at which cells of beds b_i and areas a_i hold `volume`
 // (sum a_i max(0, eta - b_i) = volume); `cells` holds (b_i, a_i) and is sorted here.
 double fillLevel(std::vector<std::pair<double, double>>& cells, double volume) {
@@ -161,23 +157,15 @@ Status AdaptiveSimulation::ensureSim(Tile& t, int L) {
   sub.dyM = input_.dyM * double(1 << L);
   sub.datumM = input_.datumM;
   SimParams sp = p_;
-  // As in TiledSimulation: only the region's own edges keep their open/closed setting.
-  sp.openEdges = 0;
-  if (ex0 == 0) sp.openEdges |= p_.openEdges & ts::kEdgeWest;
-  if (ex1 == m.width) sp.openEdges |= p_.openEdges & ts::kEdgeEast;
-  if (ey0 == 0) sp.openEdges |= p_.openEdges & ts::kEdgeNorth;
-  if (ey1 == m.height) sp.openEdges |= p_.openEdges & ts::kEdgeSouth;
+  sp.openEdges = detail::tileOpenEdges(p_.openEdges, ex0, ey0, ex1, ey1, m.width, m.height);
   auto sim = Simulation::create(sub, sp);
   if (!sim)
     return fail("adaptive tile at (" + std::to_string(t.x0) + ", " + std::to_string(t.y0) + "): " + sim.message());
   // Each base cell of a source feeds its share into the level-L cell holding it.
   for (const auto& s : sources_) {
-    for (auto [x, y] : s.cells) {
-      const int cx = x >> L, cy = y >> L;
+    for (auto one : detail::perCellSources(s)) {
+      const int cx = one.cells[0].first >> L, cy = one.cells[0].second >> L;
       if (cx < ex0 || cx >= ex1 || cy < ey0 || cy >= ey1) continue;
-      Source one;
-      one.hydrographM3S = s.hydrographM3S;
-      for (auto& [tS, q] : one.hydrographM3S) q /= double(s.cells.size());
       one.cells = {{cx - ex0, cy - ey0}};
       STRATA_TRY_STATUS(sim->addSource(one));
     }
