@@ -453,6 +453,8 @@ void AdaptiveSimulation::step(int n) {
     for (auto& t : tiles_) {
       t.sims[size_t(t.level)]->stepWithDt(dt);
       cellUpdates_ += double(o_.tileSize >> t.level) * double(o_.tileSize >> t.level);
+      const size_t L = size_t(t.level);
+      computedUpdates_ += double(t.ex1[L] - t.ex0[L]) * double(t.ey1[L] - t.ey0[L]);
     }
     auto states = readStates();
     if (o_.reflux) reflux(states, dtF);
@@ -482,6 +484,10 @@ std::vector<int> AdaptiveSimulation::levels() const {
 
 double AdaptiveSimulation::cellFraction() const {
   return steps_ > 0 ? cellUpdates_ / (double(steps_) * double(width_) * double(height_)) : 1.0;
+}
+
+double AdaptiveSimulation::computedCellFraction() const {
+  return steps_ > 0 ? computedUpdates_ / (double(steps_) * double(width_) * double(height_)) : 1.0;
 }
 
 SimStats AdaptiveSimulation::stats() const {

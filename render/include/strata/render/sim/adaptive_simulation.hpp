@@ -56,8 +56,11 @@ class AdaptiveSimulation {
   /// Cell updates per step so far, summed over the tiles' interiors, relative to a full-resolution
   /// run of the same steps (1 = no saving).
   double cellFraction() const;
-  /// Water added (+) or removed (-) by keeping depths >= 0 after refluxing (m^3): part of the
-  /// balance error, reported separately.
+  /// The same with the halos counted (what the GPU computes: a tile of n cells a side at its
+  /// level computes (n + 2 halo)^2 cells, so coarse tiles pay relatively more halo).
+  double computedCellFraction() const;
+  /// Water added where a reflux correction would have made a depth negative and the depth was
+  /// set to 0 instead (m^3): part of the balance error, reported separately.
   double clampedWaterM3() const { return clampedM3_; }
 
  private:
@@ -97,7 +100,7 @@ class AdaptiveSimulation {
   std::vector<Source> sources_;
   std::vector<float> prevDepth_;  // base resolution, at the last evaluation
   double timeS_ = 0, lastDt_ = 0, rainM3_ = 0, inflowM3_ = 0, rainRateM3S_ = 0, clampedM3_ = 0;
-  double initialWater_ = 0, initialMaterial_ = 0, cellUpdates_ = 0;
+  double initialWater_ = 0, initialMaterial_ = 0, cellUpdates_ = 0, computedUpdates_ = 0;
   long long steps_ = 0;
   bool started_ = false;
 };
