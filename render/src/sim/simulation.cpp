@@ -484,6 +484,27 @@ double Simulation::maxWaveSpeedMS() {
 
 void Simulation::stepWithDt(double dtS) { impl_->takeStep(dtS); }
 
+std::vector<float> Simulation::readStateRaw() const { return impl_->readState(); }
+
+void Simulation::writeStateRaw(const std::vector<float>& state) {
+  Impl& s = *impl_;
+  STRATA_CHECK(state.size() == 4 * s.n) << "writeStateRaw: " << state.size() / 4 << " cells, grid has " << s.n;
+  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+  (s.aIsCurrent ? s.stateA : s.stateB).upload(0, state.size() * 4, state.data());
+}
+
+std::vector<float> Simulation::readFaceMassFlux() const {
+  const Impl& s = *impl_;
+  STRATA_CHECK(s.p.waterModel == int32_t(ts::WaterModel::kFiniteVolume)) << "face fluxes exist in flood mode only";
+  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+  const auto fx = s.faceX.read<float>(), fy = s.faceY.read<float>();
+  std::vector<float> out;
+  out.reserve(fx.size() / 4 + fy.size() / 4);
+  for (size_t i = 0; i < fx.size(); i += 4) out.push_back(fx[i]);
+  for (size_t i = 0; i < fy.size(); i += 4) out.push_back(fy[i]);
+  return out;
+}
+
 SimStats Simulation::stats() const {
   const Impl& s = *impl_;
   const auto st = s.readState();

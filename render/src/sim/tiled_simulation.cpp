@@ -5,20 +5,13 @@
 
 #include <strata/terrain/sim/sim_host.hpp>
 
+#include "tile_common.hpp"
+
 namespace strata::render::sim {
 
 namespace ts = strata::terrain::sim;
 
-namespace {
-gis::Grid<float> crop(const gis::Grid<float>& g, int x0, int y0, int x1, int y1) {
-  if (g.size() == 0) return {};
-  gis::Grid<float> out(x1 - x0, y1 - y0);
-  for (int y = y0; y < y1; ++y) {
-    for (int x = x0; x < x1; ++x) out.at(x - x0, y - y0) = g.at(x, y);
-  }
-  return out;
-}
-}  // namespace
+using detail::crop;
 
 Result<TiledSimulation> TiledSimulation::create(const SimInput& input, const SimParams& params,
                                                 const TileOptions& options) {
@@ -61,13 +54,7 @@ Result<TiledSimulation> TiledSimulation::create(const SimInput& input, const Sim
       sub.dyM = input.dyM;
       sub.datumM = input.datumM;
       SimParams sp = params;
-      // Only the region's own edges keep their open/closed setting; inner tile edges lie in the
-      // halo, whose outer cells are overwritten every step.
-      sp.openEdges = 0;
-      if (ex0 == 0) sp.openEdges |= params.openEdges & ts::kEdgeWest;
-      if (ex1 == t.width_) sp.openEdges |= params.openEdges & ts::kEdgeEast;
-      if (ey0 == 0) sp.openEdges |= params.openEdges & ts::kEdgeNorth;
-      if (ey1 == t.height_) sp.openEdges |= params.openEdges & ts::kEdgeSouth;
+      sp.openEdges = detail::tileOpenEdges(params.openEdges, ex0, ey0, ex1, ey1, t.width_, t.height_);
       auto sim = Simulation::create(sub, sp);
       if (!sim) return fail("tile (" + std::to_string(tx) + ", " + std::to_string(ty) + "): " + sim.message());
       t.tiles_.push_back(Tile{x0, y0, x1, y1, ex0, ey0, ex1, ey1, std::move(sim).value()});
@@ -92,10 +79,8 @@ Status TiledSimulation::addSource(const Source& source) {
   }
   // Each cell becomes its own source carrying its share, so a tile that sees only some of the
   // cells still feeds each the right amount.
-  for (auto [x, y] : source.cells) {
-    Source one;
-    one.hydrographM3S = source.hydrographM3S;
-    for (auto& [tS, q] : one.hydrographM3S) q /= double(source.cells.size());
+  for (auto one : detail::perCellSources(source)) {
+    const auto [x, y] = one.cells[0];
     for (auto& tile : tiles_) {
       if (x < tile.ex0 || x >= tile.ex1 || y < tile.ey0 || y >= tile.ey1) continue;
       one.cells = {{x - tile.ex0, y - tile.ey0}};

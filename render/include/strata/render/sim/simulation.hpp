@@ -93,6 +93,15 @@ class Simulation {
   /// One step of exactly `dtS` seconds (tiles must all take the same step).
   void stepWithDt(double dtS);
 
+  /// For adaptive runs (AdaptiveSimulation): the state alone, 4 floats per cell (h, s, hu, hv),
+  /// without the round trip of the other buffers that readRaw/writeRaw make.
+  std::vector<float> readStateRaw() const;
+  void writeStateRaw(const std::vector<float>& state);
+  /// Flood mode: the mass flux per unit width (m^2/s, positive east / south) the last step moved
+  /// through each face (the Heun average, W22): x faces ((width + 1) x height, face x is the west
+  /// face of cell x) then y faces (width x (height + 1), face y is the north face of row y).
+  std::vector<float> readFaceMassFlux() const;
+
  private:
   struct Impl;
   explicit Simulation(std::unique_ptr<Impl> impl);
