@@ -186,6 +186,33 @@ TEST(SimWaterCpu, SourcesOutflowAndEvaporationBalance) {
   }
 }
 
+// Flood mode with a long step cap: a strong spring on a steep, dry hillside (the start of the
+// Grand Canyon scenario in miniature). The CFL step of a dry domain is the cap, and the water a
+// step pours in must not make that step too long for itself (W10): the balance holds to 1e-6 of
+// the water moved whatever maxDtS is.
+TEST(SimWaterCpu, FloodLongStepCapKeepsBalanceOnDrySlope) {
+  for (float maxDt : {2.0f, 30.0f, 300.0f}) {
+    auto p = floodParams();
+    p.cflAlpha = 0.5f;
+    p.maxDtS = maxDt;
+    p.openEdges = kEdgeEast;
+    p.manningN = 0.05f;
+    auto sim = CpuSimulation::create(test::steepDrySlope(), p);
+    ASSERT_TRUE(sim) << sim.message();
+    ASSERT_TRUE(sim->addSource(test::steepSlopeSpring()));
+    sim->advance(600.0);
+    const auto st = sim->stats();
+    const double moved = st.initialWaterM3 + st.inflowM3 + st.outflowM3;
+    std::printf(
+        "dry slope, max step %.0f s: %lld steps, last dt %.3f s, inflow %.1f, outflow %.1f, stored %.1f, "
+        "balance %.3g m3 (%.3g of the water moved)\n",
+        double(maxDt), st.steps, st.lastDtS, st.inflowM3, st.outflowM3, st.storedWaterM3, st.waterBalanceM3(),
+        st.waterBalanceM3() / moved);
+    EXPECT_GT(st.outflowM3, 0.2 * st.inflowM3);  // the water reached the open edge
+    EXPECT_LT(std::abs(st.waterBalanceM3()), 1e-6 * moved);
+  }
+}
+
 // Ritter's dry dam break: h0 upstream of x0, dry downstream, frictionless, flat bed. For
 // x0 - c0 t <= x <= x0 + 2 c0 t: h = (2 c0 - (x - x0)/t)^2 / (9 g), c0 = sqrt(g h0).
 TEST(SimWaterCpu, FloodRitterDryDamBreak) {
