@@ -8,6 +8,7 @@
 #include <vector>
 
 #include <strata/terrain/sim/cpu_simulation.hpp>
+#include <strata/terrain/sim/sim_host.hpp>
 
 #include "sim_scenes.hpp"
 
@@ -186,6 +187,29 @@ TEST(SimWaterCpu, SourcesOutflowAndEvaporationBalance) {
     const double moved = st.initialWaterM3 + st.inflowM3 + st.outflowM3;
     EXPECT_LT(std::abs(st.waterBalanceM3()), 1e-5 * moved);
   }
+}
+
+// W10 with sources, against its closed forms: a still, dry domain fed at r m/s takes
+// dt = (alpha L / sqrt(g r))^(2/3); with wave speed S and no source, alpha L / S.
+TEST(SimWaterCpu, StepCountsItsSources) {
+  SimParams p = floodParams();
+  p.cflAlpha = 0.5f;
+  p.maxDtS = 1000.0f;
+  const double g = p.gravityMS2, L = 20.0, r = 0.25;
+  EXPECT_NEAR(stepDt(p, 0.0, L, r), std::pow(0.5 * L / std::sqrt(g * r), 2.0 / 3.0), 1e-9);
+  EXPECT_NEAR(stepDt(p, 4.0, L), 0.5 * L / 4.0, 1e-12);
+  const double both = stepDt(p, 4.0, L, r);  // dt (S + sqrt(g r dt)) = alpha L
+  EXPECT_NEAR(both * (4.0 + std::sqrt(g * r * both)), 0.5 * L, 1e-9);
+  EXPECT_EQ(stepDt(p, 0.0, L, 0.0), 1000.0);  // still and unfed: the cap
+  // The rate bound: the hydrograph's peak inside the window, shared by the source's cells, over
+  // the cell area; plus rain (uniform + the raster's maximum).
+  Source s;
+  s.cells = {{1, 1}, {2, 1}};
+  s.hydrographM3S = {{0.0, 0.0}, {10.0, 80.0}, {20.0, 0.0}};
+  p.rainMmPerHour = 36.0f;  // 1e-5 m/s
+  const std::vector<double> dx = {10.0};
+  EXPECT_NEAR(sourceDepthRate(p, 0.0, {s}, dx, 4.0, 0.0, 5.0), 40.0 / 2.0 / 40.0 + 1e-5, 1e-9);    // Q(5) = 40
+  EXPECT_NEAR(sourceDepthRate(p, 72.0, {s}, dx, 4.0, 5.0, 30.0), 80.0 / 2.0 / 40.0 + 3e-5, 1e-9);  // peak 80
 }
 
 // Flood mode with a long step cap: a strong spring on a steep, dry hillside (the start of the
