@@ -33,9 +33,9 @@ render::gl::HeadlessContext& ctx() {
 
 // Bytes per cell per step, summed over the kernels (see the kernel headers for what each reads
 // and writes): sources 40, pipe_flux 56, pipe_update 56; erode 76, thermal_flux 40,
-// thermal_apply 56; flood: fv_face 2 x 48, fv_update 2 x 56 (+ sediment, accumulators), wave
-// speed 16.
-constexpr double kPipeBytes = 152, kErosionBytes = 152 + 172, kFloodBytes = 40 + 96 + 136 + 16;
+// thermal_apply 56; flood: fv_face 2 x 48, fv_update 2 x 56 (+ sediment, accumulators, the
+// corrector's 4 B of W25 limits), fv_limit 52 (own faces, state, limit), wave speed 16.
+constexpr double kPipeBytes = 152, kErosionBytes = 152 + 172, kFloodBytes = 40 + 96 + 140 + 52 + 16;
 
 // A rolling 4-layer terrain with water in its hollows, n x n cells of 10 m.
 ts::SimInput terrainOf(int n) {

@@ -1,6 +1,6 @@
 #version 450
 // Flood mode: W18 conservative update from the face fluxes, W23 centred bed-slope source,
-// W24 force noise floor. final = 0: Heun predictor U1 = U0 - dt L(U0) into `stage`;
+// W24 force noise floor, W25 outflow limits (corrector). final = 0: Heun predictor U1 = U0 - dt L(U0) into `stage`;
 // final = 1: U0 - dt (L(U0) + L(U1)) / 2 into stateOut (W22), then W19 Manning friction,
 // E5 sediment transport, E0 tilt.
 #include "../common/sim.glsl"
@@ -13,6 +13,7 @@ layout(std430, binding = 8) buffer Stage { vec4 stage[]; };
 layout(std430, binding = 10) readonly buffer FaceX { vec4 faceX[]; };
 layout(std430, binding = 11) readonly buffer FaceY { vec4 faceY[]; };
 layout(std430, binding = 12) writeonly buffer Tilt { float tilt[]; };
+layout(std430, binding = 20) readonly buffer Limit { float limit_[]; };  // W25, from fv_limit.comp
 uniform int final_;
 vec4 stateAt(int which, int i) { return which == 0 ? state[i] : stage[i]; }
 #include "../common/sim_fv.glsl"
@@ -28,11 +29,22 @@ vec2 bedSource(int which, ivec2 p) {
   return vec2(sx, sy);
 }
 
-// Volume rate leaving cell q through its four faces (m^3/s).
+// W25: the share of a face's mass flux its upwind cell can give (l: left / top cell, r: right /
+// bottom); only outflow crosses an edge, so an upwind cell outside the grid never limits.
+float limitOfFace(float massFlux, ivec2 l, ivec2 r) {
+  const ivec2 up = massFlux > 0.0 ? l : r;
+  return insideGrid(up) ? limit_[cellOf(up)] : 1.0;
+}
+
+// Volume rate leaving cell q through its four faces (m^3/s), with W25's limits (corrector only).
 float outflowTotal(ivec2 q) {
   const int w = P.width;
-  const float fW = faceX[q.y * (w + 1) + q.x].x, fE = faceX[q.y * (w + 1) + q.x + 1].x;
-  const float fN = faceY[q.y * w + q.x].x, fS = faceY[(q.y + 1) * w + q.x].x;
+  float fW = faceX[q.y * (w + 1) + q.x].x, fE = faceX[q.y * (w + 1) + q.x + 1].x;
+  float fN = faceY[q.y * w + q.x].x, fS = faceY[(q.y + 1) * w + q.x].x;
+  fW *= limitOfFace(fW, q - ivec2(1, 0), q);
+  fE *= limitOfFace(fE, q, q + ivec2(1, 0));
+  fN *= limitOfFace(fN, q - ivec2(0, 1), q);
+  fS *= limitOfFace(fS, q, q + ivec2(0, 1));
   return (max(-fW, 0.0) + max(fE, 0.0)) * P.dyM + max(-fN, 0.0) * faceWidthY(q.y) + max(fS, 0.0) * faceWidthY(q.y + 1);
 }
 
@@ -42,8 +54,16 @@ void main() {
   const int i = cellOf(p), w = P.width;
   const float dt = P.dtS, g = P.gravityMS2, dry = P.dryDepthM, n2 = P.manningN * P.manningN;
   const float A = cellArea(p.y), wN = faceWidthY(p.y), wS = faceWidthY(p.y + 1), dy = P.dyM;
-  const vec4 W = faceX[p.y * (w + 1) + p.x], E = faceX[p.y * (w + 1) + p.x + 1];
-  const vec4 N = faceY[p.y * w + p.x], S = faceY[(p.y + 1) * w + p.x];
+  vec4 W = faceX[p.y * (w + 1) + p.x], E = faceX[p.y * (w + 1) + p.x + 1];
+  vec4 N = faceY[p.y * w + p.x], S = faceY[(p.y + 1) * w + p.x];
+  if (final_ != 0) {  // W25: the mass (and, with it, the tangential momentum) each upwind cell can give
+    const float kW = limitOfFace(W.x, p - ivec2(1, 0), p), kE = limitOfFace(E.x, p, p + ivec2(1, 0));
+    const float kN = limitOfFace(N.x, p - ivec2(0, 1), p), kS = limitOfFace(S.x, p, p + ivec2(0, 1));
+    W.xw *= kW;
+    E.xw *= kE;
+    N.xw *= kN;
+    S.xw *= kS;
+  }
   const vec4 s0 = state[i];
   const float h = s0.x, s = s0.y, hu = s0.z, hv = s0.w;
   vec2 src = bedSource(0, p);

@@ -49,6 +49,32 @@ inline terrain::sim::SimInput lakeAtRest(int n, double datumM) {
   return in;
 }
 
+/// A steep, dry hillside: 48 x 16 cells of 20 m falling east at 30% (6 m a cell) with a
+/// cross-slope ripple (gullies), datum 1500 m, no water; open to the east. Feed it with
+/// `steepSlopeSpring()`: a strong spring on the dry crest, the case where a long step used to
+/// break the water balance.
+inline terrain::sim::SimInput steepDrySlope() {
+  terrain::sim::SimInput in;
+  const int w = 48, h = 16;
+  in.baseM = gis::Grid<float>(w, h);
+  in.rowDxM = {20.0};
+  in.dyM = 20.0;
+  in.datumM = 1500.0;
+  fourLayers(in, 1.0f, 0.5f, 0.0f, 0.0f);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) in.baseM.at(x, y) = float(1800.0 - 6.0 * x + 3.0 * std::sin(0.9 * y + 0.3 * x));
+  }
+  return in;
+}
+
+/// 200 m^3/s over two crest cells of `steepDrySlope()`, rising from 0 in 60 s, for 20 minutes.
+inline terrain::sim::Source steepSlopeSpring() {
+  terrain::sim::Source s;
+  s.cells = {{1, 7}, {1, 8}};
+  s.hydrographM3S = {{0.0, 0.0}, {60.0, 200.0}, {1200.0, 200.0}};
+  return s;
+}
+
 /// A flat-bottomed closed box with a bumpy surface of water (a sloshing basin), 5 m cells.
 inline terrain::sim::SimInput sloshingBox(int n) {
   terrain::sim::SimInput in;

@@ -42,6 +42,7 @@ enum Slot : GLuint {
   kMaxSpeed = 17,
   kFluxDiag = 18,
   kFloodStats = 19,
+  kFvLimit = 20,
 };
 constexpr size_t kParamsDtOffset = offsetof(ts::SimParams, dtS);
 
@@ -50,7 +51,7 @@ void barrier() { glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT); }
 
 struct Simulation::Impl {
   ts::SimParams p{};
-  double datumM = 0, minCell = 1, timeS = 0, lastDt = 0, rainM3 = 0, inflowM3 = 0, rainRateM3S = 0;
+  double datumM = 0, minCell = 1, timeS = 0, lastDt = 0, rainM3 = 0, inflowM3 = 0, rainRateM3S = 0, maxRainMmH = 0;
   double initialWater = 0, initialMaterial = 0;
   long long steps = 0;
   std::vector<double> rowDxD;
@@ -59,11 +60,11 @@ struct Simulation::Impl {
   size_t n = 0;
 
   gl::Buffer params, materials, rowDx, base, bed, layers, stateA, stateB, stage, flux, fluxDiag, faceX, faceY, tilt,
-      accum, rain, thermal, sourceEntries, maxSpeed, floodStats;
+      accum, rain, thermal, sourceEntries, maxSpeed, floodStats, fvLimit;
   float wetThresholdM = -1;  // < 0: flood statistics off
   bool aIsCurrent = true;
-  gl::Program pSources, pPointSources, pWaveSpeed, pPipeFlux, pPipeUpdate, pFvFace, pFvUpdate, pErode, pThermalFlux,
-      pThermalApply, pFloodStats;
+  gl::Program pSources, pPointSources, pWaveSpeed, pPipeFlux, pPipeUpdate, pFvFace, pFvLimit, pFvUpdate, pErode,
+      pThermalFlux, pThermalApply, pFloodStats;
 
   const gl::Buffer& cur() const { return aIsCurrent ? stateA : stateB; }
   const gl::Buffer& next() const { return aIsCurrent ? stateB : stateA; }
@@ -88,6 +89,13 @@ struct Simulation::Impl {
     thermal.bindBase(GL_SHADER_STORAGE_BUFFER, kThermal);
     sourceEntries.bindBase(GL_SHADER_STORAGE_BUFFER, kSources);
     maxSpeed.bindBase(GL_SHADER_STORAGE_BUFFER, kMaxSpeed);
+    fvLimit.bindBase(GL_SHADER_STORAGE_BUFFER, kFvLimit);
+  }
+
+  // W10 with the step's sources (terrain::sim::stepDtWithSources).
+  double nextDt() {
+    if (p.cflAlpha <= 0) return p.maxDtS;  // no read-back
+    return ts::stepDtWithSources(p, maxWaveSpeed(), minCell, maxRainMmH, sources, rowDxD, double(p.dyM), timeS);
   }
 
   double maxWaveSpeed() {
@@ -143,6 +151,8 @@ struct Simulation::Impl {
       pFvFace.dispatchCovering(w, h);
       barrier();
       cur().bindBase(GL_SHADER_STORAGE_BUFFER, kStateIn);
+      pFvLimit.dispatchCovering(w, h);
+      barrier();
       pFvUpdate.set("final_", 1);
       pFvUpdate.dispatchCovering(w, h);
       barrier();
@@ -202,9 +212,9 @@ Result<Simulation> Simulation::create(const SimInput& input, const SimParams& pa
        {Kernel{&s.pSources, "sim/sources.comp"}, Kernel{&s.pPointSources, "sim/point_sources.comp"},
         Kernel{&s.pWaveSpeed, "sim/wave_speed.comp"}, Kernel{&s.pPipeFlux, "sim/pipe_flux.comp"},
         Kernel{&s.pPipeUpdate, "sim/pipe_update.comp"}, Kernel{&s.pFvFace, "sim/fv_face.comp"},
-        Kernel{&s.pFvUpdate, "sim/fv_update.comp"}, Kernel{&s.pErode, "sim/erode.comp"},
-        Kernel{&s.pThermalFlux, "sim/thermal_flux.comp"}, Kernel{&s.pThermalApply, "sim/thermal_apply.comp"},
-        Kernel{&s.pFloodStats, "sim/flood_stats.comp"}}) {
+        Kernel{&s.pFvLimit, "sim/fv_limit.comp"}, Kernel{&s.pFvUpdate, "sim/fv_update.comp"},
+        Kernel{&s.pErode, "sim/erode.comp"}, Kernel{&s.pThermalFlux, "sim/thermal_flux.comp"},
+        Kernel{&s.pThermalApply, "sim/thermal_apply.comp"}, Kernel{&s.pFloodStats, "sim/flood_stats.comp"}}) {
     auto prog = gl::Program::compute(name);
     if (!prog) return fail("sim: " + prog.message());
     *program = std::move(prog).value();
@@ -233,6 +243,7 @@ Result<Simulation> Simulation::create(const SimInput& input, const SimParams& pa
       input.rainMmPerHour.size() > 0 ? input.rainMmPerHour.data : std::vector<float>(n, 0.0f);
   s.rainRateM3S = ts::rainVolumeRate(s.p, rain, s.rowDxD, w);
   s.rainRaster = rain;
+  s.maxRainMmH = double(*std::max_element(rain.begin(), rain.end()));
   s.minCell = ts::minCellSize(s.rowDxD, input.dyM);
 
   const GLbitfield dyn = GL_DYNAMIC_STORAGE_BIT;
@@ -254,6 +265,8 @@ Result<Simulation> Simulation::create(const SimInput& input, const SimParams& pa
   s.faceX.fill(0u);
   s.faceY = gl::Buffer(flood ? 16 * size_t(w) * size_t(h + 1) : 16);
   s.faceY.fill(0u);
+  s.fvLimit = gl::Buffer(flood ? 4 * n : 16);
+  s.fvLimit.fill(0u);
   s.tilt = gl::Buffer(4 * n);
   s.tilt.fill(0u);
   s.accum = gl::Buffer(32 * n);
@@ -305,14 +318,14 @@ Status Simulation::setParams(const SimParams& params) {
 }
 
 void Simulation::step(int n) {
-  for (int k = 0; k < n; ++k) impl_->takeStep(ts::stepDt(impl_->p, impl_->maxWaveSpeed(), impl_->minCell));
+  for (int k = 0; k < n; ++k) impl_->takeStep(impl_->nextDt());
 }
 
 void Simulation::advance(double seconds) {
   Impl& s = *impl_;
   const double end = s.timeS + seconds;
   while (s.timeS < end - 1e-9 * std::max(1.0, end)) {
-    s.takeStep(std::min(ts::stepDt(s.p, s.maxWaveSpeed(), s.minCell), end - s.timeS));
+    s.takeStep(std::min(s.nextDt(), end - s.timeS));
   }
 }
 
@@ -503,6 +516,11 @@ std::vector<float> Simulation::readFaceMassFlux() const {
   for (size_t i = 0; i < fx.size(); i += 4) out.push_back(fx[i]);
   for (size_t i = 0; i < fy.size(); i += 4) out.push_back(fy[i]);
   return out;
+}
+
+double Simulation::sourceDepthRateMS(double t1S) const {
+  const Impl& s = *impl_;
+  return ts::sourceDepthRate(s.p, s.maxRainMmH, s.sources, s.rowDxD, double(s.p.dyM), s.timeS, t1S);
 }
 
 SimStats Simulation::stats() const {

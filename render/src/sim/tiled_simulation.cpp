@@ -128,7 +128,13 @@ void TiledSimulation::step(int n) {
     if (p_.cflAlpha > 0) {
       for (auto& tile : tiles_) speed = std::max(speed, tile.sim.maxWaveSpeedMS());
     }
-    const double dt = ts::stepDt(p_, speed, minCell_);
+    // W10 with the sources: each tile bounds the depth rate its own rain and source cells get.
+    double rate = 0;
+    if (p_.cflAlpha > 0) {
+      const double window = ts::stepDt(p_, speed, minCell_);
+      for (auto& tile : tiles_) rate = std::max(rate, tile.sim.sourceDepthRateMS(timeS_ + window));
+    }
+    const double dt = ts::stepDt(p_, speed, minCell_, rate);
     for (const auto& e : ts::mergeSources(sources_, width_, timeS_, timeS_ + double(float(dt)))) {
       inflowM3_ += double(e.rateM3S) * double(float(dt));
     }

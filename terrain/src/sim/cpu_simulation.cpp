@@ -4,6 +4,7 @@
 #include <strata/terrain/sim/cpu_simulation.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numeric>
 #include <string>
@@ -112,6 +113,7 @@ Result<CpuSimulation> CpuSimulation::create(const SimInput& input, const SimPara
   s.stateNext_ = s.state_;
   s.stage_ = s.state_;
   s.flux_.assign(4 * n, 0.0f);
+  s.limit_.assign(n, 1.0f);
   s.fluxDiag_.assign(4 * n, 0.0f);
   s.faceX_.assign(4 * size_t(w + 1) * size_t(h), 0.0f);
   s.faceY_.assign(4 * size_t(w) * size_t(h + 1), 0.0f);
@@ -120,6 +122,7 @@ Result<CpuSimulation> CpuSimulation::create(const SimInput& input, const SimPara
   s.thermal_.assign(4 * n, 0.0f);
   s.rain_ = input.rainMmPerHour.size() > 0 ? input.rainMmPerHour.data : std::vector<float>(n, 0.0f);
   s.rainRateM3S_ = rainVolumeRate(s.p_, s.rain_, s.rowDxD_, w);
+  s.maxRainMmH_ = double(*std::max_element(s.rain_.begin(), s.rain_.end()));
   s.minCell_ = minCellSize(s.rowDxD_, input.dyM);
   const auto st = s.stats();
   s.initialWater_ = st.storedWaterM3;
@@ -196,14 +199,17 @@ double CpuSimulation::maxWaveSpeed() const {
   return double(m);
 }
 
+double CpuSimulation::nextDt() const {
+  return stepDtWithSources(p_, maxWaveSpeed(), minCell_, maxRainMmH_, sources_, rowDxD_, double(p_.dyM), timeS_);
+}
+
 void CpuSimulation::step(int n) {
-  for (int k = 0; k < n; ++k) takeStep(stepDt(p_, maxWaveSpeed(), minCell_));
+  for (int k = 0; k < n; ++k) takeStep(nextDt());
 }
 
 void CpuSimulation::advance(double seconds) {
   const double end = timeS_ + seconds;
-  while (timeS_ < end - 1e-9 * std::max(1.0, end))
-    takeStep(std::min(stepDt(p_, maxWaveSpeed(), minCell_), end - timeS_));
+  while (timeS_ < end - 1e-9 * std::max(1.0, end)) takeStep(std::min(nextDt(), end - timeS_));
 }
 
 void CpuSimulation::takeStep(double dtS) {
@@ -219,6 +225,7 @@ void CpuSimulation::takeStep(double dtS) {
     fvFacePass(state_, false);
     fvUpdatePass(false);
     fvFacePass(stage_, true);
+    fvLimitPass();
     fvUpdatePass(true);
   }
   std::swap(state_, stateNext_);
@@ -445,15 +452,43 @@ void CpuSimulation::fvFacePass(const std::vector<float>& st, bool average) {
   }
 }
 
-float CpuSimulation::outflowTotalFv(int x, int y) const {
-  // Volume rate leaving cell (x, y) through its four faces (m^3/s).
+// W25: the share of a face's mass flux its upwind cell can give, that cell's limit K (1 when
+// it holds enough water); (xl, yl) is the face's left / top cell, (xr, yr) its right / bottom one.
+float CpuSimulation::limitOfFace(float massFlux, int xl, int yl, int xr, int yr) const {
+  const int x = massFlux > 0.0f ? xl : xr, y = massFlux > 0.0f ? yl : yr;
+  if (x < 0 || y < 0 || x >= p_.width || y >= p_.height) return 1.0f;  // only outflow crosses an edge
+  return limit_[idx(x, y)];
+}
+
+float CpuSimulation::outflowTotalFv(int x, int y, bool limited) const {
+  // Volume rate leaving cell (x, y) through its four faces (m^3/s), with W25's limits or without.
   const int w = p_.width;
-  const float fW = faceX_[4 * (size_t(y) * size_t(w + 1) + size_t(x))];
-  const float fE = faceX_[4 * (size_t(y) * size_t(w + 1) + size_t(x + 1))];
-  const float fN = faceY_[4 * (size_t(y) * size_t(w) + size_t(x))];
-  const float fS = faceY_[4 * (size_t(y + 1) * size_t(w) + size_t(x))];
+  float fW = faceX_[4 * (size_t(y) * size_t(w + 1) + size_t(x))];
+  float fE = faceX_[4 * (size_t(y) * size_t(w + 1) + size_t(x + 1))];
+  float fN = faceY_[4 * (size_t(y) * size_t(w) + size_t(x))];
+  float fS = faceY_[4 * (size_t(y + 1) * size_t(w) + size_t(x))];
+  if (limited) {
+    fW *= limitOfFace(fW, x - 1, y, x, y);
+    fE *= limitOfFace(fE, x, y, x + 1, y);
+    fN *= limitOfFace(fN, x, y - 1, x, y);
+    fS *= limitOfFace(fS, x, y, x, y + 1);
+  }
   return (std::max(-fW, 0.0f) + std::max(fE, 0.0f)) * p_.dyM + std::max(-fN, 0.0f) * faceWidthY(y) +
          std::max(fS, 0.0f) * faceWidthY(y + 1);
+}
+
+// shaders/sim/fv_limit.comp, W25: after the corrector's faces, the share K = min(1, h A /
+// (outflow dt)) of its outgoing mass fluxes each cell can give without going below zero (as the
+// pipe model's W2), so the corrector never has to clip a depth, which would create water.
+void CpuSimulation::fvLimitPass() {
+  const float dt = p_.dtS;
+  for (int y = 0; y < p_.height; ++y) {
+    for (int x = 0; x < p_.width; ++x) {
+      const size_t i = idx(x, y);
+      const float out = outflowTotalFv(x, y, false) * dt, have = state_[4 * i] * area(y);
+      limit_[i] = out > have ? have / out : 1.0f;
+    }
+  }
 }
 
 // W23: the centred bed-slope source of the second-order hydrostatic reconstruction, plus the
@@ -478,10 +513,16 @@ void CpuSimulation::fvUpdatePass(bool final) {
     for (int x = 0; x < w; ++x) {
       const size_t i = idx(x, y);
       const float A = area(y), wN = faceWidthY(y), wS = faceWidthY(y + 1), dy = p_.dyM;
-      const float* W = &faceX_[4 * (size_t(y) * size_t(w + 1) + size_t(x))];
-      const float* E = &faceX_[4 * (size_t(y) * size_t(w + 1) + size_t(x + 1))];
-      const float* N = &faceY_[4 * (size_t(y) * size_t(w) + size_t(x))];
-      const float* S = &faceY_[4 * (size_t(y + 1) * size_t(w) + size_t(x))];
+      std::array<float, 4> W, E, N, S;
+      std::copy_n(&faceX_[4 * (size_t(y) * size_t(w + 1) + size_t(x))], 4, W.begin());
+      std::copy_n(&faceX_[4 * (size_t(y) * size_t(w + 1) + size_t(x + 1))], 4, E.begin());
+      std::copy_n(&faceY_[4 * (size_t(y) * size_t(w) + size_t(x))], 4, N.begin());
+      std::copy_n(&faceY_[4 * (size_t(y + 1) * size_t(w) + size_t(x))], 4, S.begin());
+      if (final) {  // W25: the mass (and, with it, the tangential momentum) each upwind cell can give
+        const float kW = limitOfFace(W[0], x - 1, y, x, y), kE = limitOfFace(E[0], x, y, x + 1, y);
+        const float kN = limitOfFace(N[0], x, y - 1, x, y), kS = limitOfFace(S[0], x, y, x, y + 1);
+        W[0] *= kW, W[3] *= kW, E[0] *= kE, E[3] *= kE, N[0] *= kN, N[3] *= kN, S[0] *= kS, S[3] *= kS;
+      }
       const float h = state_[4 * i], s = state_[4 * i + 1], hu = state_[4 * i + 2], hv = state_[4 * i + 3];
       auto [sx, sy] = bedSource(state_, x, y);
       if (final) {
@@ -523,7 +564,7 @@ void CpuSimulation::fvUpdatePass(bool final) {
         hvNew /= c;
       }
       // E5: suspended sediment moves with the water volume crossing each face, upwind.
-      const float denI = std::max(h * A, outflowTotalFv(x, y) * dt);
+      const float denI = std::max(h * A, outflowTotalFv(x, y, true) * dt);
       float sNew = s;
       auto exchange = [&](float volOut, int nx, int ny, bool boundary) {
         // volOut > 0: leaves this cell; < 0: enters from the neighbour.
@@ -537,7 +578,7 @@ void CpuSimulation::fvUpdatePass(bool final) {
         } else if (volOut < 0.0f && !boundary) {
           const size_t j = idx(nx, ny);
           const float Aj = area(ny);
-          const float denJ = std::max(state_[4 * j] * Aj, outflowTotalFv(nx, ny) * dt);
+          const float denJ = std::max(state_[4 * j] * Aj, outflowTotalFv(nx, ny, true) * dt);
           if (denJ > 0.0f) sNew += state_[4 * j + 1] * Aj * (-volOut) / denJ / A;
         }
       };

@@ -129,9 +129,48 @@ std::vector<SourceEntry> mergeSources(const std::vector<Source>& sources, int wi
   return out;
 }
 
-double stepDt(const SimParams& params, double maxWaveSpeedMS, double minCellM) {
-  if (params.cflAlpha <= 0 || maxWaveSpeedMS <= 0) return params.maxDtS;
-  return std::min(double(params.maxDtS), double(params.cflAlpha) * minCellM / maxWaveSpeedMS);
+double stepDt(const SimParams& params, double maxWaveSpeedMS, double minCellM, double sourceDepthRateMS) {
+  const double cap = params.maxDtS, reach = double(params.cflAlpha) * minCellM;
+  if (params.cflAlpha <= 0 || (maxWaveSpeedMS <= 0 && sourceDepthRateMS <= 0)) return cap;
+  const double k = std::sqrt(double(params.gravityMS2) * std::max(sourceDepthRateMS, 0.0));
+  // W10: dt (S + k sqrt(dt)) grows with dt; bisect for where it reaches alpha * min cell.
+  auto travel = [&](double dt) { return dt * (maxWaveSpeedMS + k * std::sqrt(dt)); };
+  if (travel(cap) <= reach) return cap;
+  double lo = 0.0, hi = cap;
+  for (int i = 0; i < 60; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (travel(mid) <= reach ? lo : hi) = mid;
+  }
+  return lo;
+}
+
+double sourceDepthRate(const SimParams& params, double maxRainRasterMmH, const std::vector<Source>& sources,
+                       const std::vector<double>& rowDxM, double dyM, double t0S, double t1S) {
+  std::map<std::pair<int, int>, double> perCell;  // m^3/s
+  for (const auto& s : sources) {
+    if (s.cells.empty()) continue;
+    // Peak of the piecewise-linear hydrograph over the window: its ends and the samples inside.
+    double peak = std::max(s.rateAt(t0S), s.rateAt(t1S));
+    for (const auto& [t, q] : s.hydrographM3S) {
+      if (t > t0S && t < t1S) peak = std::max(peak, q);
+    }
+    for (const auto& c : s.cells) perCell[c] += peak / double(s.cells.size());
+  }
+  double cellRate = 0;
+  for (const auto& [c, q] : perCell) {
+    const double dx = rowDxM.size() == 1 ? rowDxM[0] : rowDxM[size_t(c.second)];
+    cellRate = std::max(cellRate, q / (dx * dyM));
+  }
+  return cellRate + (double(params.rainMmPerHour) + maxRainRasterMmH) / 3.6e6;
+}
+
+double stepDtWithSources(const SimParams& params, double maxWaveSpeedMS, double minCellM, double maxRainRasterMmH,
+                         const std::vector<Source>& sources, const std::vector<double>& rowDxM, double dyM,
+                         double timeS) {
+  if (params.cflAlpha <= 0) return params.maxDtS;
+  const double window = stepDt(params, maxWaveSpeedMS, minCellM);
+  const double r = sourceDepthRate(params, maxRainRasterMmH, sources, rowDxM, dyM, timeS, timeS + window);
+  return stepDt(params, maxWaveSpeedMS, minCellM, r);
 }
 
 double minCellSize(const std::vector<double>& rowDxM, double dyM) {

@@ -83,7 +83,7 @@ struct Scenario {
     WaterModel kind = WaterModel::Flood;
     double manningN = 0.035;  ///< s/m^(1/3)
     double cfl = 0.45;        ///< flood mode needs <= 0.5 (positivity of the finite-volume scheme)
-    double maxStepS = 2.0;    ///< cap on the adaptive step (s); see docs/scenario.md
+    double maxStepS = 30.0;   ///< cap on the adaptive step (s); see docs/scenario.md
     std::array<Boundary, 4> boundaries{Boundary::Open, Boundary::Open, Boundary::Open, Boundary::Open};  ///< W E S N
   } model;
 

@@ -92,6 +92,9 @@ class Simulation {
   double maxWaveSpeedMS();
   /// One step of exactly `dtS` seconds (tiles must all take the same step).
   void stepWithDt(double dtS);
+  /// Bound on the depth per second this simulation's rain and sources add to one cell from
+  /// now to `t1S` (m/s; terrain::sim::sourceDepthRate, W10).
+  double sourceDepthRateMS(double t1S) const;
 
   /// For adaptive runs (AdaptiveSimulation): the state alone, 4 floats per cell (h, s, hu, hv),
   /// without the round trip of the other buffers that readRaw/writeRaw make.

@@ -46,13 +46,16 @@ class CpuSimulation {
   CpuSimulation() = default;
   void takeStep(double dtS);
   double maxWaveSpeed() const;
+  double nextDt() const;  // W10 with this step's sources
   float dx(int y) const { return rowDx_[size_t(y)]; }
   float area(int y) const { return rowDx_[size_t(y)] * p_.dyM; }
   float faceWidthY(int yFace) const;
   size_t idx(int x, int y) const { return size_t(y) * size_t(p_.width) + size_t(x); }
   int topLayer(size_t i) const;
   float recomputeBed(size_t i);
-  float outflowTotalFv(int x, int y) const;
+  float outflowTotalFv(int x, int y, bool limited) const;
+  float limitOfFace(float massFlux, int xl, int yl, int xr, int yr) const;
+  void fvLimitPass();
 
   void sourcesPass();
   void pipeFluxPass();
@@ -79,13 +82,14 @@ class CpuSimulation {
   std::vector<float> flux_;                 // vec4 per cell: pipe outflows W, E, N, S (m^3/s)
   std::vector<float> fluxDiag_;             // vec4 per cell: diagonal outflows NW, NE, SW, SE (m^3/s)
   std::vector<float> faceX_, faceY_;        // vec4 per face (flood mode)
+  std::vector<float> limit_;                // W25: per cell, the share of its outflow it can give
   std::vector<float> tilt_;                 // sin(bed tilt)
   std::vector<float> accum_;                // 8 per cell: (sum, error) of water out, evaporated, sediment out (m^3)
   std::vector<float> rain_;                 // raster (mm/h)
   std::vector<float> thermal_;              // vec4 per cell: material shed W, E, N, S (m over this cell)
   std::vector<Source> sources_;
   std::vector<SourceEntry> entries_;
-  double timeS_ = 0, lastDt_ = 0, rainM3_ = 0, inflowM3_ = 0, rainRateM3S_ = 0, minCell_ = 1;
+  double timeS_ = 0, lastDt_ = 0, rainM3_ = 0, inflowM3_ = 0, rainRateM3S_ = 0, minCell_ = 1, maxRainMmH_ = 0;
   double initialWater_ = 0, initialMaterial_ = 0, datumM_ = 0;
   long long steps_ = 0;
 };

@@ -20,9 +20,25 @@ static_assert(sizeof(SourceEntry) == 8);
 /// per cell (each cell once, sorted by cell index).
 std::vector<SourceEntry> mergeSources(const std::vector<Source>& sources, int width, double t0S, double t1S);
 
-/// Step length (W10): maxDtS when cflAlpha <= 0 or the domain is still; otherwise
-/// alpha * minCellM / maxWaveSpeedMS, capped by maxDtS. `maxWaveSpeedMS` is max(|u| + sqrt(g h)).
-double stepDt(const SimParams& params, double maxWaveSpeedMS, double minCellM);
+/// Step length (W10): maxDtS when cflAlpha <= 0 or the domain is still; otherwise the longest
+/// dt <= maxDtS with dt * (S + sqrt(g r dt)) <= alpha * minCellM, S = `maxWaveSpeedMS` =
+/// max(|u| + sqrt(g h)) before the step and r = `sourceDepthRateMS`, a bound on the depth per
+/// second the step's sources add to any one cell (sourceDepthRate()): the wave speed after they
+/// pour in is at most S + sqrt(g r dt), so the step is not too long for the water it adds.
+double stepDt(const SimParams& params, double maxWaveSpeedMS, double minCellM, double sourceDepthRateMS = 0.0);
+
+/// Bound on the depth per second (m/s) rain and sources add to any one cell over [t0S, t1S]:
+/// max over cells of the uniform rain, plus `maxRainRasterMmH`, plus the sum of the peak
+/// discharges over the window of the sources feeding the cell divided by its area. Any step
+/// inside the window adds at most this times its length to a cell.
+double sourceDepthRate(const SimParams& params, double maxRainRasterMmH, const std::vector<Source>& sources,
+                       const std::vector<double>& rowDxM, double dyM, double t0S, double t1S);
+
+/// Both above for the step starting at `timeS`: the sources' window is the step the wave speed
+/// alone would allow (the source-aware step is never longer).
+double stepDtWithSources(const SimParams& params, double maxWaveSpeedMS, double minCellM, double maxRainRasterMmH,
+                         const std::vector<Source>& sources, const std::vector<double>& rowDxM, double dyM,
+                         double timeS);
 
 /// Smallest cell side over all rows (m).
 double minCellSize(const std::vector<double>& rowDxM, double dyM);
