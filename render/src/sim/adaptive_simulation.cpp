@@ -443,9 +443,20 @@ void AdaptiveSimulation::step(int n) {
   for (size_t L = 0; L < mips_.size(); ++L)
     minCell.push_back(ts::minCellSize(mips_[L].rowDxM, input_.dyM * double(1 << L)));
   for (int s = 0; s < n; ++s) {
-    double dt = std::numeric_limits<double>::infinity();
+    // W10 over every tile at its own cell size, counting the depth rate the sources add (as
+    // TiledSimulation does).
+    std::vector<double> speed;
+    double window = std::numeric_limits<double>::infinity(), rate = 0;
     for (auto& t : tiles_) {
-      dt = std::min(dt, ts::stepDt(p_, t.sims[size_t(t.level)]->maxWaveSpeedMS(), minCell[size_t(t.level)]));
+      speed.push_back(t.sims[size_t(t.level)]->maxWaveSpeedMS());
+      window = std::min(window, ts::stepDt(p_, speed.back(), minCell[size_t(t.level)]));
+    }
+    if (p_.cflAlpha > 0) {
+      for (auto& t : tiles_) rate = std::max(rate, t.sims[size_t(t.level)]->sourceDepthRateMS(timeS_ + window));
+    }
+    double dt = std::numeric_limits<double>::infinity();
+    for (size_t k = 0; k < tiles_.size(); ++k) {
+      dt = std::min(dt, ts::stepDt(p_, speed[k], minCell[size_t(tiles_[k].level)], rate));
     }
     const double dtF = double(float(dt));
     for (const auto& e : ts::mergeSources(sources_, width_, timeS_, timeS_ + dtF)) inflowM3_ += double(e.rateM3S) * dtF;

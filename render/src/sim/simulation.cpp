@@ -511,10 +511,27 @@ std::vector<float> Simulation::readFaceMassFlux() const {
   STRATA_CHECK(s.p.waterModel == int32_t(ts::WaterModel::kFiniteVolume)) << "face fluxes exist in flood mode only";
   glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
   const auto fx = s.faceX.read<float>(), fy = s.faceY.read<float>();
+  const auto limit = s.fvLimit.read<float>();
+  const int w = s.p.width, h = s.p.height;
+  // The flux the last corrector applied: scaled by its upwind cell's W25 limit (fv_update.comp).
+  auto limited = [&](float f, int upX, int upY) {
+    const bool inside = upX >= 0 && upY >= 0 && upX < w && upY < h;
+    return inside ? f * limit[size_t(upY) * size_t(w) + size_t(upX)] : f;
+  };
   std::vector<float> out;
   out.reserve(fx.size() / 4 + fy.size() / 4);
-  for (size_t i = 0; i < fx.size(); i += 4) out.push_back(fx[i]);
-  for (size_t i = 0; i < fy.size(); i += 4) out.push_back(fy[i]);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x <= w; ++x) {
+      const float f = fx[4 * (size_t(y) * size_t(w + 1) + size_t(x))];
+      out.push_back(f > 0 ? limited(f, x - 1, y) : limited(f, x, y));
+    }
+  }
+  for (int y = 0; y <= h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const float f = fy[4 * (size_t(y) * size_t(w) + size_t(x))];
+      out.push_back(f > 0 ? limited(f, x, y - 1) : limited(f, x, y));
+    }
+  }
   return out;
 }
 

@@ -101,8 +101,8 @@ class Simulation {
   std::vector<float> readStateRaw() const;
   void writeStateRaw(const std::vector<float>& state);
   /// Flood mode: the mass flux per unit width (m^2/s, positive east / south) the last step moved
-  /// through each face (the Heun average, W22): x faces ((width + 1) x height, face x is the west
-  /// face of cell x) then y faces (width x (height + 1), face y is the north face of row y).
+  /// through each face (the Heun average, W22, scaled by W25's outflow limits): x faces ((width + 1) x height, face x
+  /// is the west face of cell x) then y faces (width x (height + 1), face y is the north face of row y).
   std::vector<float> readFaceMassFlux() const;
 
  private:
