@@ -6,11 +6,10 @@
 // Figures go to docs/benchmarks.md.
 #include <benchmark/benchmark.h>
 
-#include <cmath>
-#include <cstdio>
-#include <optional>
+#include "bench_context.hpp"
 
-#include <strata/render/gl/context.hpp>
+#include <cmath>
+
 #include <strata/render/gl/objects.hpp>
 #include <strata/render/sim/simulation.hpp>
 #include <strata/terrain/material.hpp>
@@ -18,18 +17,6 @@
 namespace {
 using namespace strata;
 namespace ts = strata::terrain::sim;
-
-render::gl::HeadlessContext& ctx() {
-  static std::optional<render::gl::HeadlessContext> c = [] {
-    auto r = render::gl::HeadlessContext::create({.debugOutput = false});
-    if (!r) {
-      std::fprintf(stderr, "%s\n", r.message().c_str());
-      std::exit(1);
-    }
-    return std::optional<render::gl::HeadlessContext>(std::move(r).value());
-  }();
-  return *c;
-}
 
 // Bytes per cell per step, summed over the kernels (see the kernel headers for what each reads
 // and writes): sources 40, pipe_flux 56, pipe_update 56; erode 76, thermal_flux 40,
@@ -59,7 +46,7 @@ ts::SimInput terrainOf(int n) {
 }
 
 void run(benchmark::State& state, ts::SimParams p, double bytesPerCell) {
-  ctx();
+  strata::bench::glContext();
   const int n = int(state.range(0));
   auto sim = render::sim::Simulation::create(terrainOf(n), p);
   if (!sim) {
@@ -124,12 +111,4 @@ BENCHMARK(BM_SimFlood)->Arg(256)->Arg(512)->Arg(1024)->Arg(2048)->UseManualTime(
 
 }  // namespace
 
-int main(int argc, char** argv) {
-  benchmark::Initialize(&argc, argv);
-  const auto& i = ctx().info();
-  benchmark::AddCustomContext("gl_renderer", i.renderer);
-  benchmark::AddCustomContext("gl_version", i.version);
-  benchmark::RunSpecifiedBenchmarks();
-  benchmark::Shutdown();
-  return 0;
-}
+int main(int argc, char** argv) { return strata::bench::benchGlMain(argc, argv); }
