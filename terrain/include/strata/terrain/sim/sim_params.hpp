@@ -105,6 +105,17 @@ struct Source {
   double volume(double t0S, double t1S) const;
 };
 
+/// A fixed water level (W25): each step the listed cells are set to depth max(0, stage(t) - bed),
+/// a Dirichlet condition; the water this puts in or takes out is counted per cell (inflow where a
+/// cell gained on balance, outflow where it lost). The stage is linearly interpolated between
+/// samples and holds its end values outside their span.
+struct LevelBoundary {
+  std::vector<std::pair<int, int>> cells;         ///< (x, y) cells held at the level
+  std::vector<std::pair<double, double>> stageM;  ///< (time s, water surface elevation m), time increasing
+  /// Water surface elevation at time `tS` (m, the same reference as SimInput::baseM).
+  double stageAt(double tS) const;
+};
+
 /// Water and material bookkeeping since the start (volumes in m^3, summed in double).
 struct SimStats {
   double timeS = 0;              ///< simulated time
