@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <memory>
 #include <set>
 
@@ -388,6 +389,53 @@ Result<ScenarioDomain> buildDomain(const Scenario& s) {
     if (pts.back()[1] != 0) src.hydrographM3S.push_back({pts.back()[0] * (1 + 1e-9) + 1e-6, 0.0});
     d.sources.push_back(std::move(src));
     d.sourceNames.push_back(in.name);
+  }
+
+  // Fixed levels: the cells of a line (as inflow lines) or of a polygon (centres inside), which
+  // must lie in the region, and a stage that rises above the bed of at least one of them.
+  for (size_t i = 0; i < s.water.levels.size(); ++i) {
+    const auto& lv = s.water.levels[i];
+    STRATA_TRY(auto demPx, mapper.pixels(s, lv.place));
+    const auto px = toRegion(demPx);
+    sim::LevelBoundary level;
+    if (lv.polygon) {
+      for (int y = 0; y < h; ++y) {
+        for (int x = 0; x < w; ++x) {
+          if (d.inside.at(x, y) && insidePolygon(px, x + 0.5, y + 0.5)) level.cells.push_back({x, y});
+        }
+      }
+      if (level.cells.empty()) {
+        return placeError(s, lv.place, "the level \"" + lv.name + "\" covers no cell of the region");
+      }
+    } else {
+      for (const auto& pt : px) {
+        const int cx = int(std::floor(pt[0])), cy = int(std::floor(pt[1]));
+        if (cx < 0 || cy < 0 || cx >= w || cy >= h || !d.inside.at(cx, cy)) {
+          return placeError(s, lv.place, "the level \"" + lv.name + "\" is outside the region");
+        }
+      }
+      level.cells = cellsAlong(px, w, h);
+      std::erase_if(level.cells, [&](auto c) { return !d.inside.at(c.first, c.second); });
+    }
+    double lowestBed = 1e300, highestStage = -1e300;
+    for (auto [x, y] : level.cells) {
+      double b = d.input.baseM.at(x, y);
+      for (const auto& l : d.input.layersM) b += l.at(x, y);
+      lowestBed = std::min(lowestBed, b);
+    }
+    for (const auto& st : lv.stage) highestStage = std::max(highestStage, st[1]);
+    if (highestStage <= lowestBed) {
+      char msg[200];
+      std::snprintf(msg, sizeof msg,
+                    "the stage (at most %.2f m) never rises above the bed of the level's cells (lowest %.2f m): "
+                    "it would hold no water",
+                    highestStage, lowestBed);
+      return fail(s.file.string() + ":" + std::to_string(lv.stageLine) + ": key 'water.level[" + std::to_string(i) +
+                  "].stage': " + msg);
+    }
+    for (const auto& st : lv.stage) level.stageM.push_back({st[0], st[1]});
+    d.levels.push_back(std::move(level));
+    d.levelNames.push_back(lv.name);
   }
 
   // Rain.
