@@ -127,7 +127,6 @@ struct Simulation::Impl {
       pPointSources.dispatchCovering(int(entries.size()));
       barrier();
     }
-    if (!levels.empty()) levelPass();
     if (p.waterModel == int32_t(ts::WaterModel::kVirtualPipes)) {
       pPipeFlux.dispatchCovering(w, h);
       barrier();
@@ -152,6 +151,7 @@ struct Simulation::Impl {
     aIsCurrent = !aIsCurrent;
     cur().bindBase(GL_SHADER_STORAGE_BUFFER, kStateIn);
     next().bindBase(GL_SHADER_STORAGE_BUFFER, kStateOut);
+    if (!levels.empty()) levelPass();
     if (p.erosionEnabled) {
       pErode.dispatchCovering(w, h);
       barrier();
@@ -523,7 +523,8 @@ SimStats Simulation::stats() const {
     out.outflowM3 += double(acc[8 * i]);
     out.evaporatedM3 += double(acc[8 * i + 2]);
     out.sedimentOutflowM3 += double(acc[8 * i + 4]);
-    (acc[8 * i + 6] > 0 ? levelIn : levelOut) += double(acc[8 * i + 6]);
+    levelIn += double(acc[8 * i + 6]);
+    levelOut += double(acc[8 * i + 7]);
   }
   const double dy = double(s.p.dyM);
   out.timeS = s.timeS;
@@ -532,8 +533,8 @@ SimStats Simulation::stats() const {
   out.storedWaterM3 = ts::integrate(h, s.rowDxD, dy, s.p.width);
   out.initialWaterM3 = s.initialWater;
   out.rainM3 = s.rainM3;
-  out.inflowM3 = s.inflowM3 + levelIn;  // W25: a fixed-level cell that gained water on balance
-  out.outflowM3 -= levelOut;
+  out.inflowM3 = s.inflowM3 + levelIn;  // W25: water put in by fixed levels
+  out.outflowM3 += levelOut;            // and taken out by them
   out.suspendedM3 = ts::integrate(sus, s.rowDxD, dy, s.p.width);
   out.materialM3 = out.suspendedM3 + ts::integrate(layers, s.rowDxD, dy, s.p.width);
   out.initialMaterialM3 = s.initialMaterial;

@@ -218,7 +218,6 @@ void CpuSimulation::takeStep(double dtS) {
   for (const auto& e : entries_) inflowM3_ += double(e.rateM3S) * double(p_.dtS);
   rainM3_ += rainRateM3S_ * double(p_.dtS);
   sourcesPass();
-  if (!levels_.empty()) levelPass();
   if (p_.waterModel == int32_t(WaterModel::kVirtualPipes)) {
     pipeFluxPass();
     pipeUpdatePass();
@@ -229,6 +228,7 @@ void CpuSimulation::takeStep(double dtS) {
     fvUpdatePass(true);
   }
   std::swap(state_, stateNext_);
+  if (!levels_.empty()) levelPass();
   if (p_.erosionEnabled) erosionPass();
   if (p_.thermalEnabled) {
     thermalFluxPass();
@@ -259,9 +259,10 @@ void CpuSimulation::sourcesPass() {
   }
 }
 
-// shaders/sim/level_boundary.comp: W25, the fixed levels at the end of the step: depth
-// max(0, stage - bed), the discharge scaled with the depth (the velocity kept), the volume put in
-// (or taken out, < 0) summed per cell.
+// shaders/sim/level_boundary.comp: W25, the fixed levels at the end of the step (after the
+// water update, before erosion, so every output shows them held): depth
+// max(0, stage - bed), the discharge scaled with the depth (the velocity kept), the volumes put
+// in and taken out summed per cell (slots 6 and 7, plain float sums as on the GPU).
 void CpuSimulation::levelPass() {
   for (const auto& e : levelEntries(levels_, p_.width, timeS_ + double(p_.dtS), datumM_)) {
     const size_t i = e.cell;
@@ -271,7 +272,9 @@ void CpuSimulation::levelPass() {
     state_[4 * i] = h1;
     state_[4 * i + 2] *= keep;
     state_[4 * i + 3] *= keep;
-    kahanAdd(&accum_[8 * i + 6], (h1 - h0) * area(y));
+    const float dv = (h1 - h0) * area(y);
+    accum_[8 * i + 6] += std::max(dv, 0.0f);
+    accum_[8 * i + 7] += std::max(-dv, 0.0f);
   }
 }
 
@@ -740,7 +743,8 @@ SimStats CpuSimulation::stats() const {
     outW[i] = accum_[8 * i];
     evap[i] = accum_[8 * i + 2];
     outS[i] = accum_[8 * i + 4];
-    (accum_[8 * i + 6] > 0 ? levelIn : levelOut) += double(accum_[8 * i + 6]);
+    levelIn += double(accum_[8 * i + 6]);
+    levelOut += double(accum_[8 * i + 7]);
     hmax = std::max(hmax, h[i]);
   }
   const double dy = double(p_.dyM);
@@ -750,9 +754,9 @@ SimStats CpuSimulation::stats() const {
   s.storedWaterM3 = integrate(h, rowDxD_, dy, w);
   s.initialWaterM3 = initialWater_;
   s.rainM3 = rainM3_;
-  s.inflowM3 = inflowM3_ + levelIn;  // W25: a fixed-level cell that gained water on balance
+  s.inflowM3 = inflowM3_ + levelIn;  // W25: water put in by fixed levels
   s.evaporatedM3 = std::accumulate(evap.begin(), evap.end(), 0.0);
-  s.outflowM3 = std::accumulate(outW.begin(), outW.end(), 0.0) - levelOut;
+  s.outflowM3 = std::accumulate(outW.begin(), outW.end(), 0.0) + levelOut;
   s.sedimentOutflowM3 = std::accumulate(outS.begin(), outS.end(), 0.0);
   s.suspendedM3 = integrate(sus, rowDxD_, dy, w);
   s.materialM3 = s.suspendedM3 + integrate(layers_, rowDxD_, dy, w);

@@ -106,9 +106,8 @@ struct Source {
 };
 
 /// A fixed water level (W25): each step the listed cells are set to depth max(0, stage(t) - bed),
-/// a Dirichlet condition; the water this puts in or takes out is counted per cell (inflow where a
-/// cell gained on balance, outflow where it lost). The stage is linearly interpolated between
-/// samples and holds its end values outside their span.
+/// a Dirichlet condition; the water this puts in counts as inflow, what it takes out as outflow. The stage is linearly
+/// interpolated between samples and holds its end values outside their span.
 struct LevelBoundary {
   std::vector<std::pair<int, int>> cells;         ///< (x, y) cells held at the level
   std::vector<std::pair<double, double>> stageM;  ///< (time s, water surface elevation m), time increasing
