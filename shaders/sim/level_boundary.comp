@@ -2,11 +2,11 @@
 // W25: fixed water levels (a Dirichlet condition), at the end of the step's water update (before
 // erosion): each listed cell gets depth
 // max(0, stage - bed), its discharge scaled with the depth (the velocity kept); the volume put in
-// is summed into the cell's accumulator slot 6, the volume taken out into slot 7 (plain float
-// sums: the Kahan pairs of W20 need two slots each, and only these two are free). One invocation
-// per entry, each cell listed once.
+// (< 0: taken out) is summed per cell, compensated (W20), in the accumulator pair at slot 6 (the
+// one pair free: a plain float sum loses the small late exchanges of a nearly full basin). One
+// invocation per entry, each cell listed once.
 #include "../common/sim.glsl"
-#include "../common/sim_accum.glsl"  // the accumulator buffer (kahanAdd is not used here)
+#include "../common/sim_accum.glsl"
 layout(local_size_x = 64) in;
 layout(std430, binding = 4) readonly buffer Bed { float bed[]; };
 layout(std430, binding = 6) buffer StateIn { vec4 state[]; };
@@ -22,7 +22,5 @@ void main() {
   const float h1 = max(0.0, e.stageM - bed[i]);
   const float keep = s.x > P.dryDepthM ? h1 / s.x : 0.0;
   state[i] = vec4(h1, s.y, s.z * keep, s.w * keep);
-  const float dv = (h1 - s.x) * cellArea(y);
-  accum[8 * i + 6] += max(dv, 0.0);
-  accum[8 * i + 7] += max(-dv, 0.0);
+  kahanAdd(8 * i + 6, (h1 - s.x) * cellArea(y));
 }

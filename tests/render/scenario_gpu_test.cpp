@@ -209,8 +209,11 @@ TEST_F(GlTest, FloodScenarioWithARisingAndFallingLevelBalances) {
                 (in - out - stored) / in);
     EXPECT_LT(std::abs(in - out - stored), 1e-4 * in) << "t = " << r[0];
   }
-  EXPECT_GT(rows[1][5], 1e6);                   // the rising stage pours millions of m3 in
-  EXPECT_GT(rows.back()[7], 0.1 * rows[1][5]);  // and the falling one takes a good part back out
+  EXPECT_GT(rows[1][5], 1e6);  // the rising stage pours millions of m3 in
+  // and the falling one takes a good part back out (nothing has reached an open edge yet). The
+  // exchange is counted net per cell since the start, so the level's inflow column falls.
+  EXPECT_LT(rows.back()[3], 0.9 * rows[2][3]);
+  EXPECT_LT(rows.back()[5], rows[2][5]);
   // The level's cells end at the final stage: depth = 820 m - bed.
   auto domain = strata::terrain::buildDomain(*scenario);
   ASSERT_TRUE(domain) << domain.message();

@@ -330,7 +330,7 @@ TEST(SimWaterCpu, LevelBoundaryFillsABasinFlatAtTheStage) {
   // Settled after an hour: the surface is the stage to 1 mm (measured 3.4e-5 m).
   EXPECT_LT(maxDev, 1e-3);
   EXPECT_NEAR(st.storedWaterM3, below, 1e-3 * 100.0 * 24 * 24);  // 1 mm over the bowl
-  EXPECT_NEAR(st.outflowM3, 0.0, 1e-6 * st.storedWaterM3);       // the stage only rose: nothing went out
+  EXPECT_NEAR(st.outflowM3, 0.0, 1e-6 * st.storedWaterM3);       // no cell lost water on balance
   // The exchange is summed per cell with compensation (W20): float32 rounding only (measured 9e-8).
   EXPECT_LT(std::abs(st.waterBalanceM3()), 1e-6 * st.inflowM3);
 

@@ -523,8 +523,7 @@ SimStats Simulation::stats() const {
     out.outflowM3 += double(acc[8 * i]);
     out.evaporatedM3 += double(acc[8 * i + 2]);
     out.sedimentOutflowM3 += double(acc[8 * i + 4]);
-    levelIn += double(acc[8 * i + 6]);
-    levelOut += double(acc[8 * i + 7]);
+    (acc[8 * i + 6] > 0 ? levelIn : levelOut) += double(acc[8 * i + 6]);
   }
   const double dy = double(s.p.dyM);
   out.timeS = s.timeS;
@@ -533,8 +532,8 @@ SimStats Simulation::stats() const {
   out.storedWaterM3 = ts::integrate(h, s.rowDxD, dy, s.p.width);
   out.initialWaterM3 = s.initialWater;
   out.rainM3 = s.rainM3;
-  out.inflowM3 = s.inflowM3 + levelIn;  // W25: water put in by fixed levels
-  out.outflowM3 += levelOut;            // and taken out by them
+  out.inflowM3 = s.inflowM3 + levelIn;  // W25: level cells that gained water on balance
+  out.outflowM3 -= levelOut;            // and those that lost
   out.suspendedM3 = ts::integrate(sus, s.rowDxD, dy, s.p.width);
   out.materialM3 = out.suspendedM3 + ts::integrate(layers, s.rowDxD, dy, s.p.width);
   out.initialMaterialM3 = s.initialMaterial;

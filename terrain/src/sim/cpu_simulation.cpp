@@ -261,8 +261,8 @@ void CpuSimulation::sourcesPass() {
 
 // shaders/sim/level_boundary.comp: W25, the fixed levels at the end of the step (after the
 // water update, before erosion, so every output shows them held): depth
-// max(0, stage - bed), the discharge scaled with the depth (the velocity kept), the volumes put
-// in and taken out summed per cell (slots 6 and 7, plain float sums as on the GPU).
+// max(0, stage - bed), the discharge scaled with the depth (the velocity kept), the volume put in
+// (< 0: taken out) summed per cell with compensation (slot 6).
 void CpuSimulation::levelPass() {
   for (const auto& e : levelEntries(levels_, p_.width, timeS_ + double(p_.dtS), datumM_)) {
     const size_t i = e.cell;
@@ -272,9 +272,7 @@ void CpuSimulation::levelPass() {
     state_[4 * i] = h1;
     state_[4 * i + 2] *= keep;
     state_[4 * i + 3] *= keep;
-    const float dv = (h1 - h0) * area(y);
-    accum_[8 * i + 6] += std::max(dv, 0.0f);
-    accum_[8 * i + 7] += std::max(-dv, 0.0f);
+    kahanAdd(&accum_[8 * i + 6], (h1 - h0) * area(y));
   }
 }
 
@@ -743,8 +741,7 @@ SimStats CpuSimulation::stats() const {
     outW[i] = accum_[8 * i];
     evap[i] = accum_[8 * i + 2];
     outS[i] = accum_[8 * i + 4];
-    levelIn += double(accum_[8 * i + 6]);
-    levelOut += double(accum_[8 * i + 7]);
+    (accum_[8 * i + 6] > 0 ? levelIn : levelOut) += double(accum_[8 * i + 6]);
     hmax = std::max(hmax, h[i]);
   }
   const double dy = double(p_.dyM);
@@ -754,9 +751,9 @@ SimStats CpuSimulation::stats() const {
   s.storedWaterM3 = integrate(h, rowDxD_, dy, w);
   s.initialWaterM3 = initialWater_;
   s.rainM3 = rainM3_;
-  s.inflowM3 = inflowM3_ + levelIn;  // W25: water put in by fixed levels
+  s.inflowM3 = inflowM3_ + levelIn;  // W25: level cells that gained water on balance
   s.evaporatedM3 = std::accumulate(evap.begin(), evap.end(), 0.0);
-  s.outflowM3 = std::accumulate(outW.begin(), outW.end(), 0.0) + levelOut;
+  s.outflowM3 = std::accumulate(outW.begin(), outW.end(), 0.0) - levelOut;
   s.sedimentOutflowM3 = std::accumulate(outS.begin(), outS.end(), 0.0);
   s.suspendedM3 = integrate(sus, rowDxD_, dy, w);
   s.materialM3 = s.suspendedM3 + integrate(layers_, rowDxD_, dy, w);

@@ -84,7 +84,7 @@ class CpuSimulation {
   std::vector<float> faceX_, faceY_;        // vec4 per face (flood mode)
   std::vector<float> tilt_;                 // sin(bed tilt)
   std::vector<float> accum_;                // 8 per cell: (sum, error) of water out, evaporated, sediment out,
-                                            // water put in, taken out by fixed levels (m^3, plain sums)
+                                            // net water put in by fixed levels (m^3)
   std::vector<float> rain_;                 // raster (mm/h)
   std::vector<float> thermal_;              // vec4 per cell: material shed W, E, N, S (m over this cell)
   std::vector<Source> sources_;

@@ -106,7 +106,8 @@ struct Source {
 };
 
 /// A fixed water level (W25): each step the listed cells are set to depth max(0, stage(t) - bed),
-/// a Dirichlet condition; the water this puts in counts as inflow, what it takes out as outflow. The stage is linearly
+/// a Dirichlet condition. The water this puts in or takes out is summed per cell since the start:
+/// a cell that gained on balance counts as inflow, one that lost as outflow. The stage is linearly
 /// interpolated between samples and holds its end values outside their span.
 struct LevelBoundary {
   std::vector<std::pair<int, int>> cells;         ///< (x, y) cells held at the level
