@@ -7,26 +7,6 @@
 
 namespace strata::test {
 
-Result<gis::Raster> readDemLonLat(const std::string& path) {
-  STRATA_TRY(auto dem, gis::readDem(path));
-  auto& g = dem.georef;
-  if (g.geographic) return dem;
-  const bool equirectangular = g.crsWkt.find("Equirectangular") != std::string::npos ||
-                               g.crsWkt.find("Equidistant Cylindrical") != std::string::npos;
-  if (!equirectangular || !g.body.isSphere()) {
-    return fail(path + ": not geographic and not equirectangular on a sphere (" + g.crsName + ")");
-  }
-  const std::string key = "\"Longitude of natural origin\",";
-  const auto at = g.crsWkt.find(key);
-  if (at == std::string::npos) return fail(path + ": equirectangular CRS without a longitude of natural origin");
-  const double centralDeg = std::stod(g.crsWkt.substr(at + key.size()));
-  const double mPerDeg = g.body.semiMajorM * 3.14159265358979323846 / 180;
-  for (int k : {0, 1, 3, 5}) g.transform.c[k] /= mPerDeg;
-  g.transform.c[0] += centralDeg;
-  g.geographic = true;
-  return dem;
-}
-
 GoldenResult compareWithGolden(const std::string& name, const render::Image8& actual, int maxChannelDiff,
                                double allowedFraction, const std::filesystem::path& outDir) {
   GoldenResult res;
