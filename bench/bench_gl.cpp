@@ -3,33 +3,19 @@
 //   build/bench/strata_bench_gl [--benchmark_filter=...]
 #include <benchmark/benchmark.h>
 
+#include "bench_context.hpp"
+
 #include <epoxy/gl.h>
 
-#include <cstdio>
-#include <optional>
-
-#include <strata/render/gl/context.hpp>
 #include <strata/render/gl/objects.hpp>
 #include <strata/render/gpu_layouts.hpp>
 
 namespace {
 using namespace strata::render;
 
-gl::HeadlessContext& ctx() {
-  static std::optional<gl::HeadlessContext> c = [] {
-    auto r = gl::HeadlessContext::create({.debugOutput = false});
-    if (!r) {
-      std::fprintf(stderr, "%s\n", r.message().c_str());
-      std::exit(1);
-    }
-    return std::optional<gl::HeadlessContext>(std::move(r).value());
-  }();
-  return *c;
-}
-
 // Device-to-device copy: bytes read + bytes written per second.
 void BM_BufferCopy(benchmark::State& state) {
-  ctx();
+  strata::bench::glContext();
   const size_t bytes = size_t(state.range(0)) << 20;
   gl::Buffer a(bytes), b(bytes);
   a.fill(0x3f800000u);
@@ -45,7 +31,7 @@ void BM_BufferCopy(benchmark::State& state) {
 BENCHMARK(BM_BufferCopy)->Arg(64)->Arg(256)->UseManualTime()->Unit(benchmark::kMillisecond);
 
 void BM_LaplacianStencil(benchmark::State& state) {
-  ctx();
+  strata::bench::glContext();
   const int n = int(state.range(0));
   auto src = gl::Texture::create2D(gl::kR32F, n, n), dst = gl::Texture::create2D(gl::kR32F, n, n);
   std::vector<float> zeros(size_t(n) * size_t(n), 1.0f);
@@ -78,12 +64,4 @@ BENCHMARK(BM_LaplacianStencil)->Arg(256)->Arg(1024)->Arg(2048)->UseManualTime()-
 
 }  // namespace
 
-int main(int argc, char** argv) {
-  benchmark::Initialize(&argc, argv);
-  const auto& i = ctx().info();
-  benchmark::AddCustomContext("gl_renderer", i.renderer);
-  benchmark::AddCustomContext("gl_version", i.version);
-  benchmark::RunSpecifiedBenchmarks();
-  benchmark::Shutdown();
-  return 0;
-}
+int main(int argc, char** argv) { return strata::bench::benchGlMain(argc, argv); }

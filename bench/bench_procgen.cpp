@@ -4,14 +4,13 @@
 // Figures: docs/benchmarks.md, "Procedural".
 #include <benchmark/benchmark.h>
 
+#include "bench_context.hpp"
+
 #include <epoxy/gl.h>
 
 #include <chrono>
 #include <cmath>
-#include <cstdio>
-#include <optional>
 
-#include <strata/render/gl/context.hpp>
 #include <strata/render/procgen/generator.hpp>
 #include <strata/render/procgen/wavelet_gpu.hpp>
 #include <strata/terrain/procgen/wavelet.hpp>
@@ -19,18 +18,6 @@
 namespace {
 using namespace strata::render;
 constexpr int kLevels = 6;
-
-gl::HeadlessContext& ctx() {
-  static std::optional<gl::HeadlessContext> c = [] {
-    auto r = gl::HeadlessContext::create({.debugOutput = false});
-    if (!r) {
-      std::fprintf(stderr, "%s\n", r.message().c_str());
-      std::exit(1);
-    }
-    return std::optional<gl::HeadlessContext>(std::move(r).value());
-  }();
-  return *c;
-}
 
 strata::gis::Grid<float> field(int n) {
   strata::gis::Grid<float> g(n, n);
@@ -41,7 +28,7 @@ strata::gis::Grid<float> field(int n) {
 }
 
 void BM_WaveletGpu(benchmark::State& state, bool inverse, strata::terrain::procgen::Wavelet kind) {
-  ctx();
+  strata::bench::glContext();
   const int n = int(state.range(0));
   auto wavelet = procgen::WaveletGpu::create();
   if (!wavelet) {
@@ -85,7 +72,7 @@ BENCHMARK(BM_Cdf97ForwardCpu)->Arg(512)->Arg(1024)->Arg(2048)->Unit(benchmark::k
 // A whole run of seed example 1 (height form) and of a level-form script with histogram
 // matching against a DEM (the CPU sort per band included), wall time.
 void BM_Generate(benchmark::State& state, const char* glsl, bool withDem) {
-  ctx();
+  strata::bench::glContext();
   const int n = int(state.range(0));
   procgen::GenerateOptions o;
   o.width = o.height = n;
@@ -121,4 +108,4 @@ BENCHMARK(BM_GenerateLikeDem)->Arg(512)->Arg(1024)->Arg(2048)->Unit(benchmark::k
 
 }  // namespace
 
-BENCHMARK_MAIN();
+int main(int argc, char** argv) { return strata::bench::benchGlMain(argc, argv); }

@@ -15,15 +15,15 @@
 // Figures: docs/benchmarks.md ("Render").
 #include <benchmark/benchmark.h>
 
+#include "bench_context.hpp"
+
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <map>
 #include <memory>
-#include <optional>
 
-#include <strata/render/gl/context.hpp>
 #include <strata/render/gl/objects.hpp>
 #include <strata/render/terrain/screen_error.hpp>
 #include <strata/render/terrain/sliding_grid.hpp>
@@ -36,18 +36,6 @@ namespace {
 using namespace strata::render;
 using namespace strata::render::terrain;
 
-gl::HeadlessContext& ctx() {
-  static std::optional<gl::HeadlessContext> c = [] {
-    auto r = gl::HeadlessContext::create({.debugOutput = false});
-    if (!r) {
-      std::fprintf(stderr, "%s\n", r.message().c_str());
-      std::exit(1);
-    }
-    return std::optional<gl::HeadlessContext>(std::move(r).value());
-  }();
-  return *c;
-}
-
 // Synthetic DEM of size^2 cells of 30 m, cached; the camera 1500 m above its south-centre,
 // looking north 20 degrees down.
 struct Setup {
@@ -59,7 +47,7 @@ Setup& synthetic(int size) {
   static std::map<int, Setup> cache;
   auto it = cache.find(size);
   if (it != cache.end()) return it->second;
-  ctx();
+  strata::bench::glContext();
   auto scene = TerrainScene::create(syntheticDem(size, 30.0, 400.0, 1));
   if (!scene) {
     std::fprintf(stderr, "%s\n", scene.message().c_str());
@@ -298,4 +286,4 @@ BENCHMARK(BM_StreamRefill)
     ->MinTime(0.3);
 
 }  // namespace
-BENCHMARK_MAIN();
+int main(int argc, char** argv) { return strata::bench::benchGlMain(argc, argv); }

@@ -6,11 +6,10 @@
 // Figures go to docs/benchmarks.md.
 #include <benchmark/benchmark.h>
 
-#include <cmath>
-#include <cstdio>
-#include <optional>
+#include "bench_context.hpp"
 
-#include <strata/render/gl/context.hpp>
+#include <cmath>
+
 #include <strata/render/gl/objects.hpp>
 #include <strata/render/sim/simulation.hpp>
 #include <strata/terrain/material.hpp>
@@ -18,18 +17,6 @@
 namespace {
 using namespace strata;
 namespace ts = strata::terrain::sim;
-
-render::gl::HeadlessContext& ctx() {
-  static std::optional<render::gl::HeadlessContext> c = [] {
-    auto r = render::gl::HeadlessContext::create({.debugOutput = false});
-    if (!r) {
-      std::fprintf(stderr, "%s\n", r.message().c_str());
-      std::exit(1);
-    }
-    return std::optional<render::gl::HeadlessContext>(std::move(r).value());
-  }();
-  return *c;
-}
 
 // Bytes per cell per step, summed over the kernels (see the kernel headers for what each reads
 // and writes): sources 40, pipe_flux 56, pipe_update 56; erode 76, thermal_flux 40,
@@ -58,13 +45,21 @@ ts::SimInput terrainOf(int n) {
   return in;
 }
 
-void run(benchmark::State& state, ts::SimParams p, double bytesPerCell) {
-  ctx();
+// `levelEdge`: the whole west column held at a fixed level (W26) 1 m above the datum.
+void run(benchmark::State& state, ts::SimParams p, double bytesPerCell, bool levelEdge = false) {
+  strata::bench::glContext();
   const int n = int(state.range(0));
-  auto sim = render::sim::Simulation::create(terrainOf(n), p);
+  const auto input = terrainOf(n);
+  auto sim = render::sim::Simulation::create(input, p);
   if (!sim) {
     state.SkipWithError(sim.message().c_str());
     return;
+  }
+  if (levelEdge) {
+    ts::LevelBoundary level;
+    for (int y = 0; y < n; ++y) level.cells.push_back({0, y});
+    level.stageM = {{0.0, input.datumM + 1.0}};
+    if (auto st = sim->addLevel(level); !st) state.SkipWithError(st.message().c_str());
   }
   sim->step(2);  // warm up: first dispatches compile and page in
   const int stepsPerIteration = n >= 1024 ? 1 : 4;
@@ -112,6 +107,16 @@ void BM_SimFlood(benchmark::State& state) {
   run(state, p, kFloodBytes);
 }
 
+// BM_SimFlood with a fixed level on its west edge: the level pass's cost, side by side.
+void BM_SimFloodLevelEdge(benchmark::State& state) {
+  ts::SimParams p;
+  p.waterModel = int32_t(ts::WaterModel::kFiniteVolume);
+  p.maxDtS = 5.0f;
+  p.cflAlpha = 0.45f;
+  p.manningN = 0.03f;
+  run(state, p, kFloodBytes, true);
+}
+
 BENCHMARK(BM_SimPipes)->Arg(256)->Arg(512)->Arg(1024)->Arg(2048)->UseManualTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_SimPipesErosion4Layers)
     ->Arg(256)
@@ -121,15 +126,8 @@ BENCHMARK(BM_SimPipesErosion4Layers)
     ->UseManualTime()
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_SimFlood)->Arg(256)->Arg(512)->Arg(1024)->Arg(2048)->UseManualTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_SimFloodLevelEdge)->Arg(256)->Arg(512)->Arg(1024)->UseManualTime()->Unit(benchmark::kMillisecond);
 
 }  // namespace
 
-int main(int argc, char** argv) {
-  benchmark::Initialize(&argc, argv);
-  const auto& i = ctx().info();
-  benchmark::AddCustomContext("gl_renderer", i.renderer);
-  benchmark::AddCustomContext("gl_version", i.version);
-  benchmark::RunSpecifiedBenchmarks();
-  benchmark::Shutdown();
-  return 0;
-}
+int main(int argc, char** argv) { return strata::bench::benchGlMain(argc, argv); }

@@ -16,7 +16,6 @@
 #include <strata/core/log.hpp>
 #include <strata/gis/dem_io.hpp>
 #include <strata/render/gl/context.hpp>
-#include <strata/render/terrain/lon_lat_dem.hpp>
 #include <strata/render/viewer/store_io.hpp>
 #include <strata/render/viewer/viewer.hpp>
 #include <strata/terrain/tile_store.hpp>
@@ -122,8 +121,7 @@ int run(const Args& a) {
     loaded.emplace(std::move(*l));
     dem = loaded->surface;
   } else {
-    auto d = gis::readDem(a.input);
-    if (d && a.planetary) d = render::terrain::toLonLat(std::move(*d), a.input);
+    auto d = a.planetary ? gis::readDemLonLat(a.input) : gis::readDem(a.input);
     if (!d) {
       std::fprintf(stderr, "strata-view: %s\n", d.message().c_str());
       return 1;

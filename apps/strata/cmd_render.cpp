@@ -52,7 +52,7 @@ struct RenderArgs {
 
 // "synthetic:SIZE[:SEED]" (a rough fractal terrain of SIZE^2 cells of 30 m), else a DEM file
 // (any raster GDAL reads, through strata::gis::readDem).
-Result<gis::Raster> loadDem(const std::string& spec) {
+Result<gis::Raster> loadDem(const std::string& spec, bool planetary) {
   if (spec.rfind("synthetic:", 0) == 0) {
     int size = 0;
     unsigned seed = 1;
@@ -61,7 +61,9 @@ Result<gis::Raster> loadDem(const std::string& spec) {
     }
     return syntheticDem(size, 30.0, 400.0, seed);
   }
-  return gis::readDem(spec);
+  // Planetary mode draws on the body's ellipsoid from lon/lat: an equirectangular DEM on a
+  // sphere (LOLA's LDEM) is relabelled in degrees on the fly.
+  return planetary ? gis::readDemLonLat(spec) : gis::readDem(spec);
 }
 
 Result<std::unique_ptr<TerrainRenderer>> makeRenderer(const RenderArgs& a) {
@@ -138,7 +140,7 @@ void run(const RenderArgs& a) {
   // A folder with a manifest is a tile store: its elevation is streamed around the viewer.
   auto scene = [&]() -> Result<TerrainScene> {
     if (!std::filesystem::is_regular_file(std::filesystem::path(a.dem) / "manifest.toml")) {
-      STRATA_TRY(auto dem, loadDem(a.dem));
+      STRATA_TRY(auto dem, loadDem(a.dem, a.planetary));
       return TerrainScene::create(dem, {.planetary = a.planetary});
     }
     STRATA_TRY(auto opened, strata::terrain::TileStore::open(a.dem));
@@ -226,7 +228,9 @@ void addRenderCommand(CLI::App& app) {
   cmd->add_option("--renderer", a->renderer,
                   "ring (concentric rings), sliding (sliding sampling grid) or grid (brute-force full grid)");
   cmd->add_option("--circles", a->circles, "Ring renderer: circles (6n^2 triangles)")->check(CLI::Range(1, 2048));
-  cmd->add_flag("--planetary", a->planetary, "Draw on the body's ellipsoid (geographic DEMs)");
+  cmd->add_flag(
+      "--planetary", a->planetary,
+      "Draw on the body's ellipsoid (geographic DEMs, or equirectangular ones on a sphere such as LOLA's LDEM)");
   cmd->add_option("--exaggeration", a->exaggeration, "Vertical exaggeration");
   cmd->add_option("--sea-level", a->seaLevel, "Water wherever the terrain is below this elevation (m)");
   cmd->add_option("--palette", a->palette, "hypsometric, grey or rust");

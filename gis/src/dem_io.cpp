@@ -7,6 +7,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <numbers>
+#include <optional>
 #include <sstream>
 
 #include "gdal_util.hpp"
@@ -264,6 +267,47 @@ Status writeGeoTiff(const std::string& path, const Raster& raster, const WriteOp
     return fail(path + ": cannot rename the written temporary into place");
   }
   return {};
+}
+
+namespace {
+// The numeric value of PARAMETER["name", value, ...] in a WKT2 string.
+std::optional<double> wktParameter(const std::string& wkt, const std::string& name) {
+  const std::string key = "\"" + name + "\",";
+  const auto at = wkt.find(key);
+  if (at == std::string::npos) return std::nullopt;
+  return std::strtod(wkt.c_str() + at + key.size(), nullptr);
+}
+}  // namespace
+
+Result<Raster> readDemLonLat(const std::string& path, const ReadOptions& options) {
+  STRATA_TRY(auto dem, readDem(path, options));
+  return toLonLat(std::move(dem), path);
+}
+
+Result<Raster> toLonLat(Raster dem, const std::string& label) {
+  auto& g = dem.georef;
+  if (g.geographic) return dem;
+  const bool equirectangular = g.crsWkt.find("Equirectangular") != std::string::npos ||
+                               g.crsWkt.find("Equidistant Cylindrical") != std::string::npos;
+  if (!equirectangular || !g.body.isSphere()) {
+    return fail(label + ": not geographic and not equirectangular on a sphere (" + g.crsName +
+                "); reproject it to lon/lat first (gdalwarp -t_srs with the body's geographic CRS)");
+  }
+  const auto central = wktParameter(g.crsWkt, "Longitude of natural origin");
+  if (!central) return fail(label + ": equirectangular CRS without a longitude of natural origin");
+  const double parallel = wktParameter(g.crsWkt, "Latitude of 1st standard parallel").value_or(0.0);
+  if (parallel != 0.0) {
+    return fail(label + ": equirectangular with its standard parallel at " + std::to_string(parallel) +
+                " degrees; only 0 (x linear in longitude at the body's radius) is supported");
+  }
+  if (std::abs(g.transform.c[2]) > 0 || std::abs(g.transform.c[4]) > 0) {
+    return fail(label + ": rotated geotransform");
+  }
+  const double mPerDeg = g.body.semiMajorM * std::numbers::pi / 180;
+  for (int k : {0, 1, 3, 5}) g.transform.c[k] /= mPerDeg;
+  g.transform.c[0] += *central;
+  g.geographic = true;
+  return dem;
 }
 
 }  // namespace strata::gis

@@ -47,6 +47,11 @@ struct SourceEntry {
   float rateM3S;
 };
 
+struct LevelEntry {
+  uint cell;
+  float stageM;
+};
+
 layout(std430, binding = 0) readonly buffer SimParamsBlock { SimParams P; };
 layout(std430, binding = 2) readonly buffer RowDxBlock { float rowDx[]; };
 

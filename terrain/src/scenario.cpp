@@ -154,39 +154,60 @@ struct Reader {
   }
 };
 
-Result<Hydrograph> readHydrograph(const Reader& r, const toml::table& t, const std::string& prefix) {
-  const auto* pts = t.get("hydrograph");
-  if (!pts) return r.errorAt(int(t.source().begin.line), prefix + ".hydrograph", "missing (pairs [time, discharge])");
-  std::string timeUnit = "s", flowUnit = "m3/s";
-  if (const auto* u = t.get("hydrograph_units")) {
+// A curve of [time, value] pairs under `key`, with optional `<key>_units` = [time unit, value
+// unit] (defaults "s" and `valueUnit`); times strictly increasing and not negative.
+struct CurveSpec {
+  const char* key;           // "hydrograph", "stage"
+  const char* valueName;     // "discharge", "water surface elevation"
+  const char* dimension;     // of the value, for parseQuantity
+  const char* valueUnit;     // default unit of the value
+  bool nonNegative = false;  // refuse negative values
+};
+
+Result<std::vector<std::array<double, 2>>> readCurve(const Reader& r, const toml::table& t, const std::string& prefix,
+                                                     const CurveSpec& c) {
+  const std::string key = prefix + "." + c.key, unitsKey = key + "_units";
+  const std::string pairText = std::string("[time, ") + c.valueName + "]";
+  const auto* pts = t.get(c.key);
+  if (!pts) return r.errorAt(int(t.source().begin.line), key, "missing (pairs " + pairText + ")");
+  std::string timeUnit = "s", valueUnit = c.valueUnit;
+  const auto* u = t.get(std::string(c.key) + "_units");
+  if (u) {
     const auto* a = u->as_array();
     if (!a || a->size() != 2 || !(*a)[0].is_string() || !(*a)[1].is_string()) {
-      return r.error(*u, prefix + ".hydrograph_units", "expected [time unit, discharge unit], e.g. [\"h\", \"m3/s\"]");
+      return r.error(
+          *u, unitsKey,
+          std::string("expected [time unit, ") + c.dimension + " unit], e.g. [\"h\", \"" + c.valueUnit + "\"]");
     }
     timeUnit = (*a)[0].value<std::string>().value();
-    flowUnit = (*a)[1].value<std::string>().value();
+    valueUnit = (*a)[1].value<std::string>().value();
   }
   auto tScale = parseQuantity("1 " + timeUnit, "time");
-  if (!tScale) return r.error(*t.get("hydrograph_units"), prefix + ".hydrograph_units", tScale.message());
-  auto qScale = parseQuantity("1 " + flowUnit, "discharge");
-  if (!qScale) return r.error(*t.get("hydrograph_units"), prefix + ".hydrograph_units", qScale.message());
+  if (!tScale) return r.error(u ? *u : *pts, unitsKey, tScale.message());
+  auto vScale = parseQuantity("1 " + valueUnit, c.dimension);
+  if (!vScale) return r.error(u ? *u : *pts, unitsKey, vScale.message());
   const auto* arr = pts->as_array();
-  if (!arr || arr->empty()) return r.error(*pts, prefix + ".hydrograph", "expected [[time, discharge], ...]");
-  Hydrograph h;
+  if (!arr || arr->empty()) return r.error(*pts, key, "expected [" + pairText + ", ...]");
+  std::vector<std::array<double, 2>> out;
   for (const auto& n : *arr) {
     const auto* p = n.as_array();
     if (!p || p->size() != 2 || !(*p)[0].is_number() || !(*p)[1].is_number()) {
-      return r.error(n, prefix + ".hydrograph", "expected a pair [time, discharge] of numbers");
+      return r.error(n, key, "expected a pair " + pairText + " of numbers");
     }
-    const double ts = (*p)[0].value<double>().value() * *tScale, q = (*p)[1].value<double>().value() * *qScale;
-    if (q < 0) return r.error(n, prefix + ".hydrograph", "negative discharge " + std::to_string(q) + " m3/s");
-    if (!h.points.empty() && ts <= h.points.back()[0]) {
-      return r.error(n, prefix + ".hydrograph", "times must increase strictly");
+    const double ts = (*p)[0].value<double>().value() * *tScale, v = (*p)[1].value<double>().value() * *vScale;
+    if (c.nonNegative && v < 0) {
+      return r.error(n, key, std::string("negative ") + c.valueName + " " + std::to_string(v) + " " + c.valueUnit);
     }
-    if (ts < 0) return r.error(n, prefix + ".hydrograph", "negative time");
-    h.points.push_back({ts, q});
+    if (!out.empty() && ts <= out.back()[0]) return r.error(n, key, "times must increase strictly");
+    if (ts < 0) return r.error(n, key, "negative time");
+    out.push_back({ts, v});
   }
-  return h;
+  return out;
+}
+
+Result<Hydrograph> readHydrograph(const Reader& r, const toml::table& t, const std::string& prefix) {
+  STRATA_TRY(auto points, readCurve(r, t, prefix, {"hydrograph", "discharge", "discharge", "m3/s", true}));
+  return Hydrograph{std::move(points)};
 }
 
 Status readTerrain(const Reader& r, const toml::table& root, Scenario& s) {
@@ -359,7 +380,7 @@ Status readErosion(const Reader& r, const toml::table& root, Scenario& s) {
 Status readWater(const Reader& r, const toml::table& root, Scenario& s) {
   const auto* t = root["water"].as_table();
   if (!t) return {};
-  STRATA_TRY_STATUS(r.onlyKeys(*t, "water", {"inflow", "rain", "dam_break", "evaporation"}));
+  STRATA_TRY_STATUS(r.onlyKeys(*t, "water", {"inflow", "rain", "dam_break", "level", "evaporation"}));
   if (const auto* e = t->get("evaporation")) {
     STRATA_TRY(s.water.evaporationMPerS, r.quantity(*e, "water.evaporation", "rate"));
     if (s.water.evaporationMPerS < 0) return r.error(*e, "water.evaporation", "must not be negative");
@@ -427,6 +448,33 @@ Status readWater(const Reader& r, const toml::table& root, Scenario& s) {
         return r.errorAt(int(dt->source().begin.line), key + ".surface", "missing (water surface elevation)");
       STRATA_TRY(d.surfaceElevationM, r.quantity(*dt->get("surface"), key + ".surface", "length"));
       s.water.damBreaks.push_back(std::move(d));
+    }
+  }
+  if (const auto* lv = t->get("level")) {
+    const auto* arr = lv->as_array();
+    if (!arr) return r.error(*lv, "water.level", "expected [[water.level]] tables");
+    for (size_t i = 0; i < arr->size(); ++i) {
+      const std::string key = "water.level[" + std::to_string(i) + "]";
+      const auto* lt = (*arr)[i].as_table();
+      if (!lt) return r.error((*arr)[i], key, "expected a table");
+      STRATA_TRY_STATUS(r.onlyKeys(
+          *lt, key, {"name", "line_lonlat", "line_xy", "polygon_lonlat", "polygon_xy", "stage", "stage_units"}));
+      Level l;
+      l.name = lt->get("name") ? lt->get("name")->value_or(std::string()) : "level " + std::to_string(i + 1);
+      STRATA_TRY(auto line, r.placeKey(*lt, key, "line", false));
+      STRATA_TRY(auto poly, r.placeKey(*lt, key, "polygon", false));
+      if (line && poly) return r.errorAt(poly->line, poly->key, "give a line (line_...) or a polygon, not both");
+      if (!line && !poly) {
+        return r.errorAt(int(lt->source().begin.line), key,
+                         "missing line_lonlat / line_xy / polygon_lonlat / polygon_xy");
+      }
+      if (line && line->points.size() < 2) return r.errorAt(line->line, line->key, "a line needs at least 2 points");
+      if (poly && poly->points.size() < 3) return r.errorAt(poly->line, poly->key, "a polygon needs at least 3 points");
+      l.place = line ? *line : *poly;
+      l.polygon = bool(poly);
+      STRATA_TRY(l.stage, readCurve(r, *lt, key, {"stage", "water surface elevation", "length", "m", false}));
+      l.stageLine = int(lt->get("stage")->source().begin.line);
+      s.water.levels.push_back(std::move(l));
     }
   }
   return {};
@@ -560,8 +608,8 @@ Result<Scenario> parseScenario(std::string_view text, const std::filesystem::pat
   STRATA_TRY_STATUS(readWater(r, root, s));
   STRATA_TRY_STATUS(readTime(r, root, s));
   STRATA_TRY_STATUS(readOutputs(r, root, s));
-  if (s.water.inflows.empty() && !s.water.rain && s.water.damBreaks.empty()) {
-    return fail(r.file + ": [water] has no source: add an inflow, rain or a dam_break");
+  if (s.water.inflows.empty() && !s.water.rain && s.water.damBreaks.empty() && s.water.levels.empty()) {
+    return fail(r.file + ": [water] has no source: add an inflow, rain, a dam_break or a level");
   }
   if (std::find(s.outputs.maps.begin(), s.outputs.maps.end(), "terrain_change") != s.outputs.maps.end() &&
       !s.erosion.enabled) {

@@ -2,12 +2,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <memory>
 #include <set>
 
 #include <strata/gis/dem_io.hpp>
 #include <strata/gis/geodesy.hpp>
 #include <strata/gis/mosaic.hpp>
 #include <strata/terrain/material.hpp>
+#include <strata/terrain/tile_store.hpp>
 
 namespace strata::terrain {
 namespace {
@@ -74,6 +77,98 @@ std::string describeExtent(const gis::Georef& g) {
   return buf;
 }
 
+// A material layer read from a tile store: its thickness (m) on the region and its material.
+struct StoredLayer {
+  gis::Raster thickness;
+  int material = 0;  ///< index into TerrainSource::materials()
+};
+
+// Where the bed (and stored layers) come from: DEM files read through GDAL, or a tile store read
+// at its base level (level 0, full resolution). The region's window, the resampling and
+// everything after are the same for both.
+class TerrainSource {
+ public:
+  static Result<TerrainSource> open(const Scenario& s) {
+    TerrainSource t;
+    if (s.terrain.store.empty()) {
+      t.path_ = s.terrain.dems.front();
+      STRATA_TRY(auto info, gis::probeDem(t.path_));
+      t.georef_ = info.georef;
+      return t;
+    }
+    t.path_ = s.terrain.store;
+    const std::string key = s.file.string() + ": key 'terrain.store': ";
+    auto store = TileStore::open(t.path_);
+    if (!store) return fail(key + store.message());
+    for (size_t f = 0; f < store->desc().fields.size(); ++f) {
+      const auto& field = store->desc().fields[f];
+      if (field.kind == LayerKind::Bedrock && t.bedField_ < 0) t.bedField_ = int(f);
+      if (field.kind == LayerKind::Material) {
+        if (findMaterial(store->desc().materials, field.material) < 0) {
+          return fail(key + t.path_ + ": field '" + field.name + "' has material \"" + field.material +
+                      "\", which the store's material table lacks");
+        }
+        t.layerFields_.push_back(int(f));
+      }
+    }
+    if (t.bedField_ < 0) return fail(key + t.path_ + ": the store has no bedrock field");
+    t.georef_ = store->windowGeoref({0, 0, store->width(), store->height()}, 0);
+    t.store_ = std::make_shared<TileStore>(std::move(store).value());
+    return t;
+  }
+
+  /// The full base grid (the first DEM's, or the store's level 0).
+  const gis::Georef& georef() const { return georef_; }
+  const std::string& path() const { return path_; }
+  std::string kind() const { return store_ ? "store" : "DEM"; }
+  /// "DEM <path>" or "store <path>", for messages.
+  std::string name() const { return kind() + " " + path_; }
+  std::vector<Material> materials() const { return store_ ? store_->desc().materials : defaultMaterials(); }
+
+  /// The bed elevation of `w` (base-grid cells), at the source's own resolution.
+  Result<gis::Raster> readBed(const gis::PixelWindow& w) const {
+    if (!store_) {
+      gis::ReadOptions ro;
+      ro.window = w;
+      return gis::readDem(path_, ro);
+    }
+    return readField(bedField_, w);
+  }
+
+  /// What gis::warpToGrid resamples the bed from: the DEM file itself (GDAL reads what it needs),
+  /// or, for a store, the window already read (`nativeBed`), held in memory.
+  gis::MosaicInput resampleInput(const gis::Raster& nativeBed) const {
+    if (!store_) return {path_, std::nullopt};
+    return {"", nativeBed};
+  }
+
+  /// The store's material layers over `w`, bottom first (none for DEMs).
+  Result<std::vector<StoredLayer>> readLayers(const gis::PixelWindow& w) const {
+    std::vector<StoredLayer> out;
+    for (int f : layerFields_) {
+      STRATA_TRY(auto r, readField(f, w));
+      out.push_back({std::move(r), findMaterial(store_->desc().materials, store_->desc().fields[size_t(f)].material)});
+    }
+    return out;
+  }
+
+ private:
+  Result<gis::Raster> readField(int field, const gis::PixelWindow& w) const {
+    const Window sw{w.x, w.y, w.width, w.height};
+    auto values = store_->readWindow(field, sw, 0);
+    if (!values) {
+      return fail(path_ + ": field '" + store_->desc().fields[size_t(field)].name + "': " + values.message());
+    }
+    return gis::Raster{store_->windowGeoref(sw, 0), std::move(values).value()};
+  }
+
+  std::string path_;
+  gis::Georef georef_;
+  std::shared_ptr<TileStore> store_;  // shared: readWindow caches tiles (non-const)
+  int bedField_ = -1;
+  std::vector<int> layerFields_;
+};
+
 }  // namespace
 
 std::vector<std::pair<int, int>> cellsAlong(const std::vector<std::array<double, 2>>& pts, int width, int height) {
@@ -103,14 +198,8 @@ bool insidePolygon(const std::vector<std::array<double, 2>>& poly, double x, dou
 }
 
 Result<ScenarioDomain> buildDomain(const Scenario& s) {
-  if (!s.terrain.store.empty()) {
-    return fail(s.file.string() +
-                ": key 'terrain.store': runs from a tile store are not supported by strata flood yet; "
-                "export a window (strata export) and give it as terrain.dem");
-  }
-  const std::string& demPath = s.terrain.dems.front();
-  STRATA_TRY(auto info, gis::probeDem(demPath));
-  const gis::Georef& full = info.georef;
+  STRATA_TRY(auto source, TerrainSource::open(s));
+  const gis::Georef& full = source.georef();
   STRATA_TRY(auto mapper, PixelMapper::create(full));
 
   // The window: the region's pixel bounding box, which must lie inside the DEM.
@@ -129,7 +218,7 @@ Result<ScenarioDomain> buildDomain(const Scenario& s) {
         y1 > full.height + 1e-3) {  // 1e-3 pixel: rounding of the corners
       return placeError(
           s, s.region.place,
-          "the region is not inside the DEM " + demPath + " (extent " + describeExtent(full) + " in its CRS)");
+          "the region is not inside the " + source.name() + " (extent " + describeExtent(full) + " in its CRS)");
     }
     window.x = std::clamp(int(std::floor(x0 + 1e-6)), 0, full.width - 1);
     window.y = std::clamp(int(std::floor(y0 + 1e-6)), 0, full.height - 1);
@@ -142,9 +231,8 @@ Result<ScenarioDomain> buildDomain(const Scenario& s) {
   }
 
   ScenarioDomain d;
-  gis::ReadOptions ro;
-  ro.window = window;
-  STRATA_TRY(d.bed, gis::readDem(demPath, ro));
+  STRATA_TRY(d.bed, source.readBed(window));
+  STRATA_TRY(auto storeLayers, source.readLayers(window));
   // Optional resampling to a coarser (or finer) grid of about region.cell_size metres.
   double scale = 1.0;  // region cells per DEM cell, along each axis
   if (s.region.cellSizeM > 0) {
@@ -161,9 +249,13 @@ Result<ScenarioDomain> buildDomain(const Scenario& s) {
     scale = double(target.width) / g0.width;
     // Coarser cells take the lowest of the cells they cover: averaging (bilinear) raises a
     // canyon's narrow floor towards its rim and dams the river (docs/scenario.md).
-    gis::MosaicInput in{demPath, std::nullopt};
+    gis::MosaicInput in = source.resampleInput(d.bed);
     in.resampling = scale < 1 ? gis::Resampling::Minimum : gis::Resampling::Bilinear;
     STRATA_TRY(d.bed, gis::warpToGrid(in, target));
+    // Stored layer thicknesses are averaged (bilinear): their volume is what matters, not a channel.
+    for (auto& layer : storeLayers) {
+      STRATA_TRY(layer.thickness, gis::warpToGrid({"", std::move(layer.thickness)}, target));
+    }
   }
   auto toRegion = [&](std::vector<std::array<double, 2>> px) {
     for (auto& p : px) p = {(p[0] - window.x) * scale, (p[1] - window.y) * scale};
@@ -180,7 +272,8 @@ Result<ScenarioDomain> buildDomain(const Scenario& s) {
   const int w = g.width, h = g.height;
   for (size_t i = 0; i < d.bed.values.size(); ++i) {
     if (gis::isNoData(d.bed.values.data[i])) {
-      return fail(demPath + ": the region has cells without data (nodata); choose a region the DEM covers");
+      return fail(source.path() + ": the region has cells without data (nodata); choose a region the " + source.kind() +
+                  " covers");
     }
   }
 
@@ -217,8 +310,14 @@ Result<ScenarioDomain> buildDomain(const Scenario& s) {
   for (size_t i = 0; i < d.input.baseM.size(); ++i) {
     if (!d.inside.data[i]) d.input.baseM.data[i] = kWallElevationM;
   }
-  const auto table = defaultMaterials();
-  if (s.terrain.layers.empty()) {
+  const auto table = source.materials();
+  for (auto& layer : storeLayers) {
+    gis::Grid<float> thickness = std::move(layer.thickness.values);
+    for (auto& v : thickness.data) v = gis::isNoData(v) ? 0.0f : std::max(0.0f, v);
+    d.input.layersM.push_back(std::move(thickness));
+    d.input.materials.push_back(table[size_t(layer.material)]);
+  }
+  if (d.input.layersM.empty() && s.terrain.layers.empty()) {
     // Bare rock: one layer of zero thickness so erosion has a material to read.
     d.input.layersM.push_back(gis::Grid<float>(w, h, 0.0f));
     d.input.materials.push_back(table[size_t(findMaterial(table, "rock"))]);
@@ -227,8 +326,10 @@ Result<ScenarioDomain> buildDomain(const Scenario& s) {
     const auto& spec = s.terrain.layers[l];
     const int m = findMaterial(table, spec.material);
     if (m < 0) {
+      std::string names;
+      for (const auto& mat : table) names += (names.empty() ? "" : ", ") + mat.name;
       return fail(s.file.string() + ": key 'terrain.layer[" + std::to_string(l) + "].material': unknown material \"" +
-                  spec.material + "\" (rock, soil, sand, sediment)");
+                  spec.material + "\" (" + names + ")");
     }
     gis::Grid<float> thickness(w, h, float(spec.thicknessM));
     if (!spec.raster.empty()) {
@@ -288,6 +389,53 @@ Result<ScenarioDomain> buildDomain(const Scenario& s) {
     if (pts.back()[1] != 0) src.hydrographM3S.push_back({pts.back()[0] * (1 + 1e-9) + 1e-6, 0.0});
     d.sources.push_back(std::move(src));
     d.sourceNames.push_back(in.name);
+  }
+
+  // Fixed levels: the cells of a line (as inflow lines) or of a polygon (centres inside), which
+  // must lie in the region, and a stage that rises above the bed of at least one of them.
+  for (size_t i = 0; i < s.water.levels.size(); ++i) {
+    const auto& lv = s.water.levels[i];
+    STRATA_TRY(auto demPx, mapper.pixels(s, lv.place));
+    const auto px = toRegion(demPx);
+    sim::LevelBoundary level;
+    if (lv.polygon) {
+      for (int y = 0; y < h; ++y) {
+        for (int x = 0; x < w; ++x) {
+          if (d.inside.at(x, y) && insidePolygon(px, x + 0.5, y + 0.5)) level.cells.push_back({x, y});
+        }
+      }
+      if (level.cells.empty()) {
+        return placeError(s, lv.place, "the level \"" + lv.name + "\" covers no cell of the region");
+      }
+    } else {
+      for (const auto& pt : px) {
+        const int cx = int(std::floor(pt[0])), cy = int(std::floor(pt[1]));
+        if (cx < 0 || cy < 0 || cx >= w || cy >= h || !d.inside.at(cx, cy)) {
+          return placeError(s, lv.place, "the level \"" + lv.name + "\" is outside the region");
+        }
+      }
+      level.cells = cellsAlong(px, w, h);
+      std::erase_if(level.cells, [&](auto c) { return !d.inside.at(c.first, c.second); });
+    }
+    double lowestBed = 1e300, highestStage = -1e300;
+    for (auto [x, y] : level.cells) {
+      double b = d.input.baseM.at(x, y);
+      for (const auto& l : d.input.layersM) b += l.at(x, y);
+      lowestBed = std::min(lowestBed, b);
+    }
+    for (const auto& st : lv.stage) highestStage = std::max(highestStage, st[1]);
+    if (highestStage <= lowestBed) {
+      char msg[200];
+      std::snprintf(msg, sizeof msg,
+                    "the stage (at most %.2f m) never rises above the bed of the level's cells (lowest %.2f m): "
+                    "it would hold no water",
+                    highestStage, lowestBed);
+      return fail(s.file.string() + ":" + std::to_string(lv.stageLine) + ": key 'water.level[" + std::to_string(i) +
+                  "].stage': " + msg);
+    }
+    for (const auto& st : lv.stage) level.stageM.push_back({st[0], st[1]});
+    d.levels.push_back(std::move(level));
+    d.levelNames.push_back(lv.name);
   }
 
   // Rain.

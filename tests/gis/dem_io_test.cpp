@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include <strata/gis/dem_io.hpp>
+#include <strata/gis/geodesy.hpp>
 
 #include "gis_test_util.hpp"
 #include "strata_test.hpp"
@@ -289,6 +290,37 @@ TEST(DemIo, WriteRefusesAValueEqualToNodata) {
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.message().find(path + ": cannot write: the value -32768"), std::string::npos) << s.message();
   EXPECT_FALSE(std::filesystem::exists(path));
+}
+
+// readDemLonLat: the Moon's LDEM (equirectangular on the 1737.4 km sphere, central meridian
+// 180) relabelled in degrees gives, at every probed cell corner, the lon/lat PROJ computes from
+// its projected georeference, and the same cells; a geographic DEM comes back unchanged.
+TEST(DemIo, ReadDemLonLatRelabelsTheMoonsEquirectangularGrid) {
+  const std::string path = test::dataFile("moon/LDEM_4.LBL");
+  auto projected = readDem(path);
+  ASSERT_TRUE(projected) << projected.message();
+  auto ll = readDemLonLat(path);
+  ASSERT_TRUE(ll) << ll.message();
+  EXPECT_TRUE(ll->georef.geographic);
+  EXPECT_EQ(ll->georef.body.name, projected->georef.body.name);
+  EXPECT_EQ(ll->values.data, projected->values.data);  // relabelled, not resampled
+  // 4 pixels per degree, up to the label's map scale rounded to the metre (7581.9 m: 0.25000008).
+  EXPECT_NEAR(ll->georef.transform.c[1], 0.25, 1e-6);
+  EXPECT_NEAR(ll->georef.transform.c[5], -0.25, 1e-6);
+  for (auto [col, row] : {std::pair{0.0, 0.0}, std::pair{100.5, 300.25}, std::pair{1439.0, 719.0}}) {
+    auto expect = pixelToLonLat(projected->georef, col, row);
+    ASSERT_TRUE(expect) << expect.message();
+    double lon = ll->georef.transform.x(col, row), lat = ll->georef.transform.y(col, row);
+    while (lon - expect->lonDeg > 180) lon -= 360;  // PROJ answers in -180..180
+    while (expect->lonDeg - lon > 180) lon += 360;
+    // 1e-9 degree: the relabelling is exact up to rounding of the geotransform.
+    EXPECT_NEAR(lon, expect->lonDeg, 1e-9) << col << ", " << row;
+    EXPECT_NEAR(lat, expect->latDeg, 1e-9) << col << ", " << row;
+  }
+  auto gc = readDemLonLat(test::dataFile("grand_canyon/grand_canyon_512.tif"));
+  auto gcDirect = readDem(test::dataFile("grand_canyon/grand_canyon_512.tif"));
+  ASSERT_TRUE(gc && gcDirect);
+  for (int k = 0; k < 6; ++k) EXPECT_EQ(gc->georef.transform.c[k], gcDirect->georef.transform.c[k]);
 }
 
 }  // namespace

@@ -126,7 +126,7 @@ TEST(GpuLayouts, SimParamsMatchesGlsl) {
                                            STRATA_FIELD(SimParams, pad1)});
 }
 
-TEST(GpuLayouts, SimMaterialAndSourceEntryMatchGlsl) {
+TEST(GpuLayouts, SimMaterialSourceAndLevelEntryMatchGlsl) {
   using strata::terrain::sim::SimMaterial;
   using strata::terrain::sim::SourceEntry;
   expectSimLayout<SimMaterial>("SimMaterial",
@@ -140,6 +140,12 @@ TEST(GpuLayouts, SimMaterialAndSourceEntryMatchGlsl) {
   EXPECT_EQ(fields[0].offset, offsetof(SourceEntry, cell));
   EXPECT_EQ(fields[1].offset, offsetof(SourceEntry, rateM3S));
   EXPECT_EQ(sizeof(SourceEntry), 8u);
+  using strata::terrain::sim::LevelEntry;
+  const auto level = glslLayout(std::string(STRATA_SOURCE_DIR) + "/shaders/common/sim.glsl", "LevelEntry", size);
+  ASSERT_EQ(level.size(), 2u);
+  EXPECT_EQ(level[0].offset, offsetof(LevelEntry, cell));
+  EXPECT_EQ(level[1].offset, offsetof(LevelEntry, stageM));
+  EXPECT_EQ(sizeof(LevelEntry), 8u);
 }
 
 }  // namespace

@@ -120,7 +120,8 @@ TEST_F(GlTest, SimRainAndSourcesBalance) {
 // multiply-add or orders a sum differently (~1 ulp per operation), which the dynamics then
 // amplify a little each step.
 void expectAgreement(const strata::terrain::sim::SimInput& in, const SimParams& params, int steps, double depthTol,
-                     double layerTol, const strata::terrain::sim::Source* source) {
+                     double layerTol, const strata::terrain::sim::Source* source,
+                     const strata::terrain::sim::LevelBoundary* level = nullptr) {
   auto gpu = Simulation::create(in, params);
   ASSERT_TRUE(gpu) << gpu.message();
   auto cpu = CpuSimulation::create(in, params);
@@ -128,6 +129,10 @@ void expectAgreement(const strata::terrain::sim::SimInput& in, const SimParams& 
   if (source) {
     ASSERT_TRUE(gpu->addSource(*source));
     ASSERT_TRUE(cpu->addSource(*source));
+  }
+  if (level) {
+    ASSERT_TRUE(gpu->addLevel(*level));
+    ASSERT_TRUE(cpu->addLevel(*level));
   }
   gpu->step(steps);
   cpu->step(steps);
@@ -147,6 +152,8 @@ void expectAgreement(const strata::terrain::sim::SimInput& in, const SimParams& 
   EXPECT_LT(ds, layerTol);
   EXPECT_LT(dl, layerTol);
   EXPECT_NEAR(sg.storedWaterM3, sc.storedWaterM3, 1e-5 * sc.storedWaterM3);
+  EXPECT_NEAR(sg.inflowM3, sc.inflowM3, 1e-5 * std::max(1.0, sc.inflowM3));
+  EXPECT_NEAR(sg.outflowM3, sc.outflowM3, 1e-5 * std::max(1.0, sc.outflowM3 + sc.inflowM3));
   EXPECT_NEAR(sg.materialM3, sc.materialM3, 1e-6 * sc.materialM3);
 }
 
@@ -194,6 +201,22 @@ TEST_F(GlTest, SimFloodLongStepAgreesWithCpuAndKeepsBalance) {
               st.timeS, st.inflowM3, st.outflowM3, st.waterBalanceM3() / moved);
   EXPECT_GT(st.inflowM3, 1000.0);
   EXPECT_LT(std::abs(st.waterBalanceM3()), 1e-6 * moved);
+}
+
+TEST_F(GlTest, SimLevelBoundaryAgreesWithCpuReference) {
+  // W26: a dry bowl filled through a rising fixed level (level_boundary.comp against
+  // CpuSimulation::levelPass), in both water models; the exchanged volume counts as inflow.
+  auto basin = test::levelBasin(24, 3.0);
+  auto flood = floodParams();
+  flood.manningN = 0.05f;
+  expectAgreement(basin.input, flood, 200, 1e-4, 1e-6, nullptr, &basin.level);
+  auto fast = basin.level;  // pipe steps are 0.1 s: a stage above the level cells' bed from the start
+  fast.stageM = {{0.0, 502.0}, {20.0, 503.0}};
+  expectAgreement(basin.input, pipeParams(), 200, 1e-4, 1e-6, nullptr, &fast);
+  // Water is taken out where the stage falls below the surface: a lowering level.
+  basin.level.stageM = {{0.0, 503.0}, {60.0, 501.0}};
+  basin.input.waterDepthM = gis::Grid<float>(24, 24, 1.5f);
+  expectAgreement(basin.input, flood, 200, 1e-4, 1e-6, nullptr, &basin.level);
 }
 
 TEST_F(GlTest, SimErosionAgreesWithCpuReference) {

@@ -1,17 +1,11 @@
 #include "terrain_fixture.hpp"
 
 #include <strata/gis/dem_io.hpp>
-#include <strata/render/terrain/lon_lat_dem.hpp>
 
 #include <algorithm>
 #include <cmath>
 
 namespace strata::test {
-
-Result<gis::Raster> readDemLonLat(const std::string& path) {
-  STRATA_TRY(auto dem, gis::readDem(path));
-  return render::terrain::toLonLat(std::move(dem), path);
-}
 
 GoldenResult compareWithGolden(const std::string& name, const render::Image8& actual, int maxChannelDiff,
                                double allowedFraction, const std::filesystem::path& outDir) {

@@ -12,11 +12,6 @@
 
 namespace strata::test {
 
-/// Reads a DEM with strata::gis::readDem. A grid in an equirectangular projection on a sphere
-/// (the LOLA LDEM: metres from a central meridian) is re-expressed in lon/lat degrees (its cells
-/// are already parallels and meridians), for planetary mode.
-Result<gis::Raster> readDemLonLat(const std::string& path);
-
 /// Golden comparison: a pixel differs when any channel differs by more than `maxChannelDiff`;
 /// passes when at most `allowedFraction` of the pixels differ. On failure (or when the golden
 /// is missing) writes <name>.actual.png and <name>.diff.png to `outDir` and says so.

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <numeric>
 
+#include <strata/gis/dem_io.hpp>
 #include <strata/render/image_io.hpp>
 #include <strata/render/terrain/screen_error.hpp>
 #include <strata/render/terrain/sliding_grid.hpp>
@@ -37,7 +38,7 @@ double mean(const std::vector<double>& v) {
 }
 
 Result<TerrainScene> grandCanyon() {
-  STRATA_TRY(auto dem, test::readDemLonLat(test::dataPath("grand_canyon/grand_canyon_512.tif")));
+  STRATA_TRY(auto dem, gis::readDemLonLat(test::dataPath("grand_canyon/grand_canyon_512.tif")));
   return TerrainScene::create(dem);
 }
 
@@ -264,7 +265,7 @@ class PlanetGolden : public GlTest, public ::testing::WithParamInterface<PlanetV
 
 TEST_P(PlanetGolden, FromOrbitMatchesGoldenImage) {
   const PlanetView& v = GetParam();
-  auto dem = test::readDemLonLat(test::dataPath(v.path));
+  auto dem = gis::readDemLonLat(test::dataPath(v.path));
   ASSERT_TRUE(dem) << dem.message();
   EXPECT_EQ(dem->georef.body.name, v.body.name);
   auto scene = TerrainScene::create(*dem, {.planetary = true});
@@ -307,6 +308,53 @@ INSTANTIATE_TEST_SUITE_P(
                    CameraPose{.lon = -40, .lat = 20, .heightM = 2.0e7 - 6378137.0, .pitchDeg = -90, .fovYDeg = 40},
                    10.0f, Palette::Hypsometric, true}),
     [](const ::testing::TestParamInfo<PlanetView>& p) { return std::string(p.param.name); });
+
+// `strata render --planetary` straight on the Moon's projected LDEM (equirectangular metres on
+// the 1737.4 km sphere; relabelled in lon/lat on the fly by gis::readDemLonLat): the near side
+// from 4,000 km as in the golden view above. The CLI has its own sun and shading, so the check is
+// the globe's shape: a disc centred in the image covering 0.3 .. pi/4 of it, black corners.
+TEST_F(GlTest, CliRendersTheMoonsProjectedDemInPlanetaryMode) {
+  const auto out = test::outputDir("render") / "cli_moon_planetary.png";
+  std::filesystem::remove(out);
+  const std::string cmd = std::string(STRATA_CLI) + " render '" + test::dataPath("moon/LDEM_4.LBL") +
+                          "' --planetary --lon 0 --lat 0 --height 4e6 --pitch -90 --exaggeration 3 --palette grey "
+                          "--circles 128 --size 192x192 -o '" +
+                          out.string() + "' 2>&1";
+  std::string log;
+  FILE* p = popen(cmd.c_str(), "r");
+  ASSERT_NE(p, nullptr);
+  char buf[512];
+  while (fgets(buf, sizeof buf, p)) log += buf;
+  ASSERT_EQ(pclose(p), 0) << cmd << "\n" << log;
+  auto img = render::readImage8(out.string());
+  ASSERT_TRUE(img) << img.message();
+  ASSERT_EQ(img->width, 192);
+  auto lit = [&](int x, int y) {
+    const auto* px = &img->pixels[(size_t(y) * size_t(img->width) + size_t(x)) * size_t(img->channels)];
+    return (px[0] | px[1] | px[2]) != 0;
+  };
+  long covered = 0;
+  double cx = 0, cy = 0;
+  for (int y = 0; y < 192; ++y) {
+    for (int x = 0; x < 192; ++x) {
+      if (!lit(x, y)) continue;
+      ++covered;
+      cx += x + 0.5;
+      cy += y + 0.5;
+    }
+  }
+  ASSERT_GT(covered, 0) << log;
+  const double fraction = double(covered) / (192.0 * 192.0);
+  std::printf("CLI Moon: disc covers %.3f of the image, centred at (%.1f, %.1f)\n", fraction, cx / covered,
+              cy / covered);
+  EXPECT_GT(fraction, 0.3);
+  EXPECT_LT(fraction, 0.79);
+  EXPECT_NEAR(cx / covered, 96.0, 2.0);  // the camera looks straight down at the centre
+  EXPECT_NEAR(cy / covered, 96.0, 2.0);
+  for (auto [x, y] : {std::pair{0, 0}, std::pair{191, 0}, std::pair{0, 191}, std::pair{191, 191}}) {
+    EXPECT_FALSE(lit(x, y)) << "corner " << x << ", " << y << " is space";
+  }
+}
 
 class NoJitter : public GlTest, public ::testing::WithParamInterface<double> {};
 
@@ -421,7 +469,7 @@ TEST_F(GlTest, RainierRidgeCloseViewMatchesGoldenImage) {
   // south-west of the summit, looking at it. Ground-level views need a larger softening floor
   // than the default 50 m: with H = 50 m the circles 8 km out are ~8 km apart (spacing grows as
   // r^2 / H) and the 4,392 m summit is averaged away. The error report shows the effect.
-  auto dem = test::readDemLonLat(test::dataPath("rainier/mt_rainier_90m.tif"));
+  auto dem = gis::readDemLonLat(test::dataPath("rainier/mt_rainier_90m.tif"));
   ASSERT_TRUE(dem) << dem.message();
   auto scene = TerrainScene::create(*dem);
   ASSERT_TRUE(scene) << scene.message();

@@ -75,6 +75,32 @@ inline terrain::sim::Source steepSlopeSpring() {
   return s;
 }
 
+/// A dry bowl (bed datum + 0.5 m at the centre, + 1.5 m at the edges' midpoints, + 2.5 m at the
+/// corners; 10 m cells) and a fixed level on five cells in the middle of its west edge whose stage
+/// rises from 1 m to `stageM` above the datum over the first 600 s, then holds.
+struct LevelBasin {
+  terrain::sim::SimInput input;
+  terrain::sim::LevelBoundary level;
+};
+inline LevelBasin levelBasin(int n, double stageM) {
+  LevelBasin b;
+  auto& in = b.input;
+  in.baseM = gis::Grid<float>(n, n);
+  in.rowDxM = {10.0};
+  in.dyM = 10.0;
+  in.datumM = 500.0;
+  fourLayers(in, 0.0f, 0.0f, 0.0f, 0.0f);
+  for (int y = 0; y < n; ++y) {
+    for (int x = 0; x < n; ++x) {
+      const double fx = (x + 0.5) / n - 0.5, fy = (y + 0.5) / n - 0.5;
+      in.baseM.at(x, y) = float(in.datumM + 0.5 + 4.0 * (fx * fx + fy * fy));
+    }
+  }
+  for (int y = n / 2 - 2; y <= n / 2 + 2; ++y) b.level.cells.push_back({0, y});
+  b.level.stageM = {{0.0, in.datumM + 1.0}, {600.0, in.datumM + stageM}};
+  return b;
+}
+
 /// A flat-bottomed closed box with a bumpy surface of water (a sloshing basin), 5 m cells.
 inline terrain::sim::SimInput sloshingBox(int n) {
   terrain::sim::SimInput in;

@@ -110,3 +110,58 @@ TEST(ScenarioDomain, LinesAndPolygonsOnCells) {
 
 }  // namespace
 }  // namespace strata::terrain
+
+namespace strata::terrain {
+namespace {
+
+// A fixed level across the Colorado at the inflow's longitude (lines 5-8 of domainOf's text).
+std::string levelWater(const std::string& stage, const std::string& place =
+                                                     "line_lonlat = [[-112.0225, 36.063], "
+                                                     "[-112.0225, 36.08]]") {
+  return "[[water.level]]\nname = \"river stage\"\n" + place + "\nstage = " + stage + "\n";
+}
+
+TEST(ScenarioDomain, FixedLevelOnTheCellsOfItsLine) {
+  auto d = domainOf("bbox_lonlat = [-112.5, 36.01, -112.001, 36.3]", levelWater("[[0, 700], [3600, 900]]"));
+  ASSERT_TRUE(d) << d.message();
+  ASSERT_EQ(d->levels.size(), 1u);
+  EXPECT_EQ(d->levelNames[0], "river stage");
+  // 36.063 .. 36.08 at 1/512 degree: 9 or 10 rows of one column.
+  EXPECT_GE(d->levels[0].cells.size(), 9u);
+  EXPECT_LE(d->levels[0].cells.size(), 10u);
+  for (auto [x, y] : d->levels[0].cells) EXPECT_EQ(x, d->levels[0].cells[0].first);
+  EXPECT_EQ(d->levels[0].stageAt(1800), 800.0);  // absolute elevations, interpolated
+  EXPECT_EQ(d->levels[0].stageAt(7200), 900.0);  // held after the last sample
+  // A polygon takes the cells whose centre is inside.
+  auto p =
+      domainOf("bbox_lonlat = [-112.5, 36.01, -112.001, 36.3]",
+               levelWater("[[0, 700], [3600, 900]]",
+                          "polygon_lonlat = [[-112.1, 36.05], [-112.05, 36.05], [-112.05, 36.1], [-112.1, 36.1]]"));
+  ASSERT_TRUE(p) << p.message();
+  // 0.05 degrees a side at 1/512 degree: about 25 x 25 cells.
+  EXPECT_NEAR(double(p->levels[0].cells.size()), 25.6 * 25.6, 60.0);
+}
+
+TEST(ScenarioDomain, FixedLevelErrorsNameTheKey) {
+  const std::string region = "bbox_lonlat = [-112.5, 36.01, -112.001, 36.3]";
+  auto below = domainOf(region, levelWater("[[0, 0], [3600, 10]]"));
+  ASSERT_FALSE(below);
+  // The river bed under the line is at 803 m.
+  EXPECT_EQ(below.message(),
+            "/runs/t.toml:8: key 'water.level[0].stage': the stage (at most 10.00 m) never rises above the bed of the "
+            "level's cells (lowest 803.34 m): it would hold no water");
+  auto outside = domainOf(region, levelWater("[[0, 700]]", "line_lonlat = [[-112.0225, 36.063], [-112.6, 36.08]]"));
+  ASSERT_FALSE(outside);
+  EXPECT_EQ(outside.message(),
+            "/runs/t.toml:7: key 'water.level[0].line_lonlat': the level \"river stage\" is outside the region");
+  auto empty = domainOf(region, levelWater("[[0, 700]]",
+                                           "polygon_lonlat = [[-112.3, 36.1], [-112.3, 36.2], "
+                                           "[-112.3001, 36.15]]"));
+  ASSERT_FALSE(empty);
+  EXPECT_EQ(
+      empty.message(),
+      "/runs/t.toml:7: key 'water.level[0].polygon_lonlat': the level \"river stage\" covers no cell of the region");
+}
+
+}  // namespace
+}  // namespace strata::terrain

@@ -126,7 +126,74 @@ TEST(Scenario, NeedsASource) {
   text = text.substr(0, text.find("[[water.inflow]]")) + text.substr(text.find("[time]"));
   auto s = parse(text);
   ASSERT_FALSE(s);
-  EXPECT_EQ(s.message(), "/data/runs/gc.toml: [water] has no source: add an inflow, rain or a dam_break");
+  EXPECT_EQ(s.message(), "/data/runs/gc.toml: [water] has no source: add an inflow, rain, a dam_break or a level");
+}
+
+// A fixed level on a line, its stage in hours and metres (lines 1-5 of the text).
+constexpr const char* kLevel = R"([terrain]
+dem = "dem.tif"
+[[water.level]]
+name = "lake"
+line_lonlat = [[-112.2, 36.2], [-112.2, 36.3]]
+stage = [[0, 700], [1, 730.5], [3, 730.5]]
+stage_units = ["h", "m"]
+[time]
+duration = "6 h"
+)";
+
+TEST(Scenario, ReadsAFixedLevel) {
+  auto s = parse(kLevel);
+  ASSERT_TRUE(s) << s.message();
+  ASSERT_EQ(s->water.levels.size(), 1u);
+  const auto& l = s->water.levels[0];
+  EXPECT_EQ(l.name, "lake");
+  EXPECT_FALSE(l.polygon);
+  EXPECT_EQ(l.place.points.size(), 2u);
+  EXPECT_EQ(l.stageLine, 6);
+  ASSERT_EQ(l.stage.size(), 3u);
+  EXPECT_EQ(l.stage[1][0], 3600.0);
+  EXPECT_EQ(l.stage[1][1], 730.5);
+  // A polygon, and the stage in kilometres (any length unit).
+  auto p = parse(replaced(
+      replaced(kLevel, "line_lonlat = [[-112.2, 36.2], [-112.2, 36.3]]", "polygon_xy = [[0, 0], [10, 0], [10, 10]]"),
+      "[\"h\", \"m\"]", "[\"min\", \"km\"]"));
+  ASSERT_TRUE(p) << p.message();
+  EXPECT_TRUE(p->water.levels[0].polygon);
+  EXPECT_EQ(p->water.levels[0].place.frame, CoordFrame::DemCrs);
+  EXPECT_EQ(p->water.levels[0].stage[1][0], 60.0);
+  EXPECT_EQ(p->water.levels[0].stage[1][1], 730500.0);
+}
+
+TEST(Scenario, FixedLevelBadInput) {
+  const std::pair<std::pair<const char*, const char*>, const char*> cases[] = {
+      {{"[1, 730.5], [3, 730.5]", "[1, 730.5], [0.5, 730.5]"},
+       "/data/runs/gc.toml:6: key 'water.level[0].stage': times must increase strictly"},
+      {{"[\"h\", \"m\"]", "[\"h\", \"m3/s\"]"},
+       "/data/runs/gc.toml:7: key 'water.level[0].stage_units': unit 'm3/s' is a discharge, not a length (use one "
+       "of m, km, mm, cm)"},
+      {{"stage = [[0, 700], [1, 730.5], [3, 730.5]]", "stage = [[0, \"700 m\"]]"},
+       "/data/runs/gc.toml:6: key 'water.level[0].stage': expected a pair [time, water surface elevation] of numbers"},
+      {{"stage = [[0, 700], [1, 730.5], [3, 730.5]]\n", ""},
+       "/data/runs/gc.toml:3: key 'water.level[0].stage': missing (pairs [time, water surface elevation])"},
+      {{"line_lonlat = [[-112.2, 36.2], [-112.2, 36.3]]", "line_lonlat = [[-112.2, 36.2]]"},
+       "/data/runs/gc.toml:5: key 'water.level[0].line_lonlat': a line needs at least 2 points"},
+      {{"line_lonlat = [[-112.2, 36.2], [-112.2, 36.3]]", "at_lonlat = [-112.2, 36.2]"},
+       "/data/runs/gc.toml:5: key 'water.level[0].at_lonlat': unknown key (expected one of: name, line_lonlat, "
+       "line_xy, polygon_lonlat, polygon_xy, stage, stage_units)"},
+      {{"line_lonlat = [[-112.2, 36.2], [-112.2, 36.3]]", "name2 = 1"},
+       "/data/runs/gc.toml:5: key 'water.level[0].name2': unknown key (expected one of: name, line_lonlat, line_xy, "
+       "polygon_lonlat, polygon_xy, stage, stage_units)"},
+  };
+  for (const auto& [edit, message] : cases) {
+    auto s = parse(replaced(kLevel, edit.first, edit.second));
+    ASSERT_FALSE(s) << edit.second;
+    EXPECT_EQ(s.message(), message) << edit.second;
+  }
+  // Neither a line nor a polygon.
+  auto none = parse(replaced(kLevel, "line_lonlat = [[-112.2, 36.2], [-112.2, 36.3]]\n", ""));
+  ASSERT_FALSE(none);
+  EXPECT_EQ(none.message(),
+            "/data/runs/gc.toml:3: key 'water.level[0]': missing line_lonlat / line_xy / polygon_lonlat / polygon_xy");
 }
 
 TEST(Scenario, MissingFile) {

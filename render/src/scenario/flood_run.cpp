@@ -232,7 +232,8 @@ Result<RunSummary> runScenario(const strata::terrain::Scenario& s, const RunOpti
   const auto& g = domain.bed.georef;
   const int w = g.width, h = g.height;
   log::info("flood") << s.name << ": " << w << " x " << h << " cells, " << domain.totalAreaM2 / 1e6 << " km^2, "
-                     << domain.sources.size() << " inflow(s), " << formatDuration(s.durationS) << " simulated";
+                     << domain.sources.size() << " inflow(s), " << domain.levels.size() << " fixed level(s), "
+                     << formatDuration(s.durationS) << " simulated";
 
   std::error_code ec;
   fs::create_directories(opt.outDir / "maps", ec);
@@ -244,6 +245,7 @@ Result<RunSummary> runScenario(const strata::terrain::Scenario& s, const RunOpti
   STRATA_TRY(auto ctx, gl::HeadlessContext::create());
   STRATA_TRY(auto sim, sim::Simulation::create(domain.input, domain.params));
   for (const auto& src : domain.sources) STRATA_TRY_STATUS(sim.addSource(src));
+  for (const auto& level : domain.levels) STRATA_TRY_STATUS(sim.addLevel(level));
   sim.enableFloodStats(float(s.outputs.wetThresholdM));
 
   std::optional<Pictures> pictures;

@@ -115,8 +115,10 @@ Status writeReport(const fs::path& runDir, const ReportInput& in) {
     hi = std::max(hi, d.bed.values.data[i]);
   }
   md += "| | |\n|---|---|\n";
-  md += "| terrain | `" + s.terrain.dems.front() + "` (" + g.crsName +
-        (g.epsg ? ", EPSG:" + std::to_string(*g.epsg) : "") + ", " + g.body.name + ") |\n";
+  const std::string terrain =
+      s.terrain.store.empty() ? "`" + s.terrain.dems.front() + "`" : "tile store `" + s.terrain.store + "`";
+  md += "| terrain | " + terrain + " (" + g.crsName + (g.epsg ? ", EPSG:" + std::to_string(*g.epsg) : "") + ", " +
+        g.body.name + ") |\n";
   md += "| region | " + std::to_string(g.width) + " x " + std::to_string(g.height) + " cells of about " +
         fmt("%.0f", d.input.rowDxM[d.input.rowDxM.size() / 2]) + " x " + fmt("%.0f", d.input.dyM) + " m, " +
         fmt("%.0f", d.totalAreaM2 / 1e6) + " km², elevations " + fmt("%.0f", lo) + " to " + fmt("%.0f", hi) + " m |\n";

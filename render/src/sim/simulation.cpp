@@ -56,15 +56,16 @@ struct Simulation::Impl {
   long long steps = 0;
   std::vector<double> rowDxD;
   std::vector<ts::Source> sources;
+  std::vector<ts::LevelBoundary> levels;
   std::vector<float> rainRaster;  // host copy, for the rain volume rate after setParams
   size_t n = 0;
 
   gl::Buffer params, materials, rowDx, base, bed, layers, stateA, stateB, stage, flux, fluxDiag, faceX, faceY, tilt,
-      accum, rain, thermal, sourceEntries, maxSpeed, floodStats, fvLimit;
+      accum, rain, thermal, sourceEntries, maxSpeed, floodStats, fvLimit, levelEntries;
   float wetThresholdM = -1;  // < 0: flood statistics off
   bool aIsCurrent = true;
   gl::Program pSources, pPointSources, pWaveSpeed, pPipeFlux, pPipeUpdate, pFvFace, pFvLimit, pFvUpdate, pErode,
-      pThermalFlux, pThermalApply, pFloodStats;
+      pThermalFlux, pThermalApply, pFloodStats, pLevel;
 
   const gl::Buffer& cur() const { return aIsCurrent ? stateA : stateB; }
   const gl::Buffer& next() const { return aIsCurrent ? stateB : stateA; }
@@ -160,6 +161,7 @@ struct Simulation::Impl {
     aIsCurrent = !aIsCurrent;
     cur().bindBase(GL_SHADER_STORAGE_BUFFER, kStateIn);
     next().bindBase(GL_SHADER_STORAGE_BUFFER, kStateOut);
+    if (!levels.empty()) levelPass();
     if (p.erosionEnabled) {
       pErode.dispatchCovering(w, h);
       barrier();
@@ -181,6 +183,20 @@ struct Simulation::Impl {
       pFloodStats.dispatchCovering(int(n));
       barrier();
     }
+  }
+
+  // W26: the fixed levels at the end of the step (shaders/sim/level_boundary.comp).
+  void levelPass() {
+    const auto entries = ts::levelEntries(levels, p.width, timeS + double(p.dtS), datumM);
+    if (entries.empty()) return;
+    const size_t bytes = entries.size() * sizeof(ts::LevelEntry);
+    if (levelEntries.size() < bytes) levelEntries = gl::Buffer(bytes);
+    levelEntries.upload(0, bytes, entries.data());
+    levelEntries.bindBase(GL_SHADER_STORAGE_BUFFER, kSources);
+    pLevel.set("entryCount", unsigned(entries.size()));
+    pLevel.dispatchCovering(int(entries.size()));
+    barrier();
+    sourceEntries.bindBase(GL_SHADER_STORAGE_BUFFER, kSources);
   }
 
   std::vector<float> readState() const {
@@ -214,7 +230,8 @@ Result<Simulation> Simulation::create(const SimInput& input, const SimParams& pa
         Kernel{&s.pPipeUpdate, "sim/pipe_update.comp"}, Kernel{&s.pFvFace, "sim/fv_face.comp"},
         Kernel{&s.pFvLimit, "sim/fv_limit.comp"}, Kernel{&s.pFvUpdate, "sim/fv_update.comp"},
         Kernel{&s.pErode, "sim/erode.comp"}, Kernel{&s.pThermalFlux, "sim/thermal_flux.comp"},
-        Kernel{&s.pThermalApply, "sim/thermal_apply.comp"}, Kernel{&s.pFloodStats, "sim/flood_stats.comp"}}) {
+        Kernel{&s.pThermalApply, "sim/thermal_apply.comp"}, Kernel{&s.pFloodStats, "sim/flood_stats.comp"},
+        Kernel{&s.pLevel, "sim/level_boundary.comp"}}) {
     auto prog = gl::Program::compute(name);
     if (!prog) return fail("sim: " + prog.message());
     *program = std::move(prog).value();
@@ -304,6 +321,12 @@ Status Simulation::addSource(const Source& source) {
     }
   }
   impl_->sources.push_back(source);
+  return {};
+}
+
+Status Simulation::addLevel(const LevelBoundary& level) {
+  STRATA_TRY_STATUS(ts::checkLevel(level, impl_->p.width, impl_->p.height));
+  impl_->levels.push_back(level);
   return {};
 }
 
@@ -549,6 +572,7 @@ SimStats Simulation::stats() const {
   std::vector<float> h(n), sus(n);
   float hmax = 0.0f;
   SimStats out;
+  double levelIn = 0, levelOut = 0;
   for (size_t i = 0; i < n; ++i) {
     h[i] = st[4 * i];
     sus[i] = st[4 * i + 1];
@@ -556,6 +580,7 @@ SimStats Simulation::stats() const {
     out.outflowM3 += double(acc[8 * i]);
     out.evaporatedM3 += double(acc[8 * i + 2]);
     out.sedimentOutflowM3 += double(acc[8 * i + 4]);
+    (acc[8 * i + 6] > 0 ? levelIn : levelOut) += double(acc[8 * i + 6]);
   }
   const double dy = double(s.p.dyM);
   out.timeS = s.timeS;
@@ -564,7 +589,8 @@ SimStats Simulation::stats() const {
   out.storedWaterM3 = ts::integrate(h, s.rowDxD, dy, s.p.width);
   out.initialWaterM3 = s.initialWater;
   out.rainM3 = s.rainM3;
-  out.inflowM3 = s.inflowM3;
+  out.inflowM3 = s.inflowM3 + levelIn;  // W26: level cells that gained water on balance
+  out.outflowM3 -= levelOut;            // and those that lost
   out.suspendedM3 = ts::integrate(sus, s.rowDxD, dy, s.p.width);
   out.materialM3 = out.suspendedM3 + ts::integrate(layers, s.rowDxD, dy, s.p.width);
   out.initialMaterialM3 = s.initialMaterial;

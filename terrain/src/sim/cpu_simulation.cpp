@@ -130,6 +130,12 @@ Result<CpuSimulation> CpuSimulation::create(const SimInput& input, const SimPara
   return s;
 }
 
+Status CpuSimulation::addLevel(const LevelBoundary& level) {
+  STRATA_TRY_STATUS(checkLevel(level, p_.width, p_.height));
+  levels_.push_back(level);
+  return {};
+}
+
 Status CpuSimulation::addSource(const Source& source) {
   for (auto [x, y] : source.cells) {
     if (x < 0 || y < 0 || x >= p_.width || y >= p_.height) {
@@ -229,6 +235,7 @@ void CpuSimulation::takeStep(double dtS) {
     fvUpdatePass(true);
   }
   std::swap(state_, stateNext_);
+  if (!levels_.empty()) levelPass();
   if (p_.erosionEnabled) erosionPass();
   if (p_.thermalEnabled) {
     thermalFluxPass();
@@ -256,6 +263,23 @@ void CpuSimulation::sourcesPass() {
   for (const auto& e : entries_) {
     const int y = int(e.cell / uint32_t(p_.width));
     state_[4 * e.cell] += e.rateM3S * dt / area(y);
+  }
+}
+
+// shaders/sim/level_boundary.comp: W26, the fixed levels at the end of the step (after the
+// water update, before erosion, so every output shows them held): depth
+// max(0, stage - bed), the discharge scaled with the depth (the velocity kept), the volume put in
+// (< 0: taken out) summed per cell with compensation (slot 6).
+void CpuSimulation::levelPass() {
+  for (const auto& e : levelEntries(levels_, p_.width, timeS_ + double(p_.dtS), datumM_)) {
+    const size_t i = e.cell;
+    const int y = int(e.cell / uint32_t(p_.width));
+    const float h0 = state_[4 * i], h1 = std::max(0.0f, e.stageM - bed_[i]);
+    const float keep = h0 > p_.dryDepthM ? h1 / h0 : 0.0f;
+    state_[4 * i] = h1;
+    state_[4 * i + 2] *= keep;
+    state_[4 * i + 3] *= keep;
+    kahanAdd(&accum_[8 * i + 6], (h1 - h0) * area(y));
   }
 }
 
@@ -750,6 +774,7 @@ SimStats CpuSimulation::stats() const {
   const int w = p_.width;
   const size_t n = size_t(w) * size_t(p_.height);
   std::vector<float> h(n), sus(n), outW(n), evap(n), outS(n);
+  double levelIn = 0, levelOut = 0;
   float hmax = 0.0f;
   for (size_t i = 0; i < n; ++i) {
     h[i] = state_[4 * i];
@@ -757,6 +782,7 @@ SimStats CpuSimulation::stats() const {
     outW[i] = accum_[8 * i];
     evap[i] = accum_[8 * i + 2];
     outS[i] = accum_[8 * i + 4];
+    (accum_[8 * i + 6] > 0 ? levelIn : levelOut) += double(accum_[8 * i + 6]);
     hmax = std::max(hmax, h[i]);
   }
   const double dy = double(p_.dyM);
@@ -766,9 +792,9 @@ SimStats CpuSimulation::stats() const {
   s.storedWaterM3 = integrate(h, rowDxD_, dy, w);
   s.initialWaterM3 = initialWater_;
   s.rainM3 = rainM3_;
-  s.inflowM3 = inflowM3_;
+  s.inflowM3 = inflowM3_ + levelIn;  // W26: level cells that gained water on balance
   s.evaporatedM3 = std::accumulate(evap.begin(), evap.end(), 0.0);
-  s.outflowM3 = std::accumulate(outW.begin(), outW.end(), 0.0);
+  s.outflowM3 = std::accumulate(outW.begin(), outW.end(), 0.0) - levelOut;
   s.sedimentOutflowM3 = std::accumulate(outS.begin(), outS.end(), 0.0);
   s.suspendedM3 = integrate(sus, rowDxD_, dy, w);
   s.materialM3 = s.suspendedM3 + integrate(layers_, rowDxD_, dy, w);

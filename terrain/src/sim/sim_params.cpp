@@ -40,6 +40,48 @@ double Source::volume(double t0S, double t1S) const {
   return v;
 }
 
+double LevelBoundary::stageAt(double tS) const {
+  if (stageM.empty()) return 0.0;
+  if (tS <= stageM.front().first) return stageM.front().second;
+  if (tS >= stageM.back().first) return stageM.back().second;
+  auto it = std::upper_bound(stageM.begin(), stageM.end(), tS,
+                             [](double t, const std::pair<double, double>& p) { return t < p.first; });
+  const auto& [t1, z1] = *it;
+  const auto& [t0, z0] = *(it - 1);
+  return z0 + (z1 - z0) * (tS - t0) / (t1 - t0);
+}
+
+Status checkLevel(const LevelBoundary& level, int width, int height) {
+  if (level.stageM.empty()) return fail("sim level: no stage samples");
+  for (size_t i = 1; i < level.stageM.size(); ++i) {
+    if (!(level.stageM[i].first > level.stageM[i - 1].first)) {
+      return fail("sim level: stage times must increase (sample " + std::to_string(i) + ")");
+    }
+  }
+  for (auto [x, y] : level.cells) {
+    if (x < 0 || y < 0 || x >= width || y >= height) {
+      return fail("sim level: cell (" + std::to_string(x) + ", " + std::to_string(y) + ") is outside the " +
+                  std::to_string(width) + "x" + std::to_string(height) + " grid");
+    }
+  }
+  return {};
+}
+
+std::vector<LevelEntry> levelEntries(const std::vector<LevelBoundary>& levels, int width, double tS, double datumM) {
+  std::map<uint32_t, double> perCell;  // a cell held by several levels takes the highest
+  for (const auto& l : levels) {
+    const double z = l.stageAt(tS) - datumM;
+    for (auto [x, y] : l.cells) {
+      auto [it, fresh] = perCell.emplace(uint32_t(y) * uint32_t(width) + uint32_t(x), z);
+      if (!fresh) it->second = std::max(it->second, z);
+    }
+  }
+  std::vector<LevelEntry> out;
+  out.reserve(perCell.size());
+  for (auto [cell, z] : perCell) out.push_back({cell, float(z)});
+  return out;
+}
+
 namespace {
 
 Status checkGrid(const gis::Grid<float>& g, int w, int h, const std::string& field, bool nonNegative) {

@@ -52,6 +52,14 @@ Result<DemInfo> probeDem(const std::string& path, const ReadOptions& options = {
 /// than as the nodata value) are an error. The Georef describes the window read.
 Result<Raster> readDem(const std::string& path, const ReadOptions& options = {});
 
+/// Reads a DEM on a lon/lat grid of its body, as planetary rendering needs: a geographic DEM as
+/// it is; an equirectangular (equidistant cylindrical) DEM on a sphere with its standard parallel
+/// at the equator, such as LOLA's LDEM, by relabelling its grid in degrees (x and y are linear in
+/// lon and lat there, so no cell is resampled). Other projections are refused, naming the CRS.
+Result<Raster> readDemLonLat(const std::string& path, const ReadOptions& options = {});
+/// The same for a DEM already in memory (`label` names it in errors).
+Result<Raster> toLonLat(Raster dem, const std::string& label);
+
 /// How to write a GeoTIFF.
 struct WriteOptions {
   bool cog = false;          ///< Cloud Optimized GeoTIFF (GDAL's COG driver, with overviews)

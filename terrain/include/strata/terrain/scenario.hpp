@@ -54,6 +54,16 @@ struct DamBreak {
   double surfaceElevationM = 0;  ///< water surface inside the polygon
 };
 
+/// A fixed water level (a Dirichlet condition, docs/sim-water.md W26): the cells of a line or a
+/// polygon are held at depth max(0, stage(t) - bed).
+struct Level {
+  std::string name;
+  Place place;                               ///< a polyline or a polygon
+  bool polygon = false;                      ///< place is a polygon (cells whose centre is inside), else a line
+  std::vector<std::array<double, 2>> stage;  ///< (seconds, water surface elevation m), times strictly increasing
+  int stageLine = 0;                         ///< line of `stage` in the file, for later messages
+};
+
 enum class WaterModel { Pipe, Flood };
 enum class Boundary { Closed, Open };
 
@@ -97,6 +107,7 @@ struct Scenario {
     std::vector<Inflow> inflows;
     std::optional<Rain> rain;
     std::vector<DamBreak> damBreaks;
+    std::vector<Level> levels;
     double evaporationMPerS = 0;
   } water;
 

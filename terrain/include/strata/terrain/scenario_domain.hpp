@@ -23,6 +23,8 @@ struct ScenarioDomain {
   sim::SimParams params;             ///< from [model], [erosion], [water]
   std::vector<sim::Source> sources;  ///< inflows, on cells
   std::vector<std::string> sourceNames;
+  std::vector<sim::LevelBoundary> levels;  ///< fixed water levels, on cells (stage in m above the DEM's reference)
+  std::vector<std::string> levelNames;
   double rainMmPerHour = 0;             ///< uniform rain rate while it falls
   double rainStartS = 0, rainEndS = 0;  ///< rain falls in [start, end)
   double damBreakVolumeM3 = 0;          ///< initial water from dam breaks

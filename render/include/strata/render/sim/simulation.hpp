@@ -15,6 +15,7 @@
 
 namespace strata::render::sim {
 
+using strata::terrain::sim::LevelBoundary;
 using strata::terrain::sim::SimInput;
 using strata::terrain::sim::SimParams;
 using strata::terrain::sim::SimStats;
@@ -39,6 +40,8 @@ class Simulation {
 
   /// Adds an inflow source (spring, inflow line with a hydrograph); cells must be inside.
   Status addSource(const Source& source);
+  /// Adds a fixed water level (W26) on its cells; cells must be inside, stage times increasing.
+  Status addLevel(const LevelBoundary& level);
   /// Changes the run-time parameters (rain, evaporation, friction, erosion constants, edges, time
   /// step rule) from the next step on; grid size, layers and water model stay as created.
   Status setParams(const SimParams& params);

@@ -25,6 +25,8 @@ class CpuSimulation {
 
   /// Adds an inflow source (spring, inflow line with a hydrograph); cells must be inside.
   Status addSource(const Source& source);
+  /// Adds a fixed water level (W26) on its cells; cells must be inside, stage times increasing.
+  Status addLevel(const LevelBoundary& level);
   /// Changes the run-time parameters (rain, evaporation, friction, erosion constants, edges, time
   /// step rule) from the next step on; grid size, layers and water model stay as created.
   Status setParams(const SimParams& params);
@@ -58,6 +60,7 @@ class CpuSimulation {
   void fvLimitPass();
 
   void sourcesPass();
+  void levelPass();
   void pipeFluxPass();
   void pipeUpdatePass();
   struct Side {
@@ -84,11 +87,13 @@ class CpuSimulation {
   std::vector<float> faceX_, faceY_;        // vec4 per face (flood mode)
   std::vector<float> limit_;                // W25: per cell, the share of its outflow it can give
   std::vector<float> tilt_;                 // sin(bed tilt)
-  std::vector<float> accum_;                // 8 per cell: (sum, error) of water out, evaporated, sediment out (m^3)
+  std::vector<float> accum_;                // 8 per cell: (sum, error) of water out, evaporated, sediment out,
+                                            // net water put in by fixed levels (m^3)
   std::vector<float> rain_;                 // raster (mm/h)
   std::vector<float> thermal_;              // vec4 per cell: material shed W, E, N, S (m over this cell)
   std::vector<Source> sources_;
   std::vector<SourceEntry> entries_;
+  std::vector<LevelBoundary> levels_;
   double timeS_ = 0, lastDt_ = 0, rainM3_ = 0, inflowM3_ = 0, rainRateM3S_ = 0, minCell_ = 1, maxRainMmH_ = 0;
   double initialWater_ = 0, initialMaterial_ = 0, datumM_ = 0;
   long long steps_ = 0;

@@ -16,6 +16,19 @@ struct SourceEntry {
 };
 static_assert(sizeof(SourceEntry) == 8);
 
+/// One cell held at a fixed level this step (std430 mirror of `LevelEntry` in shaders/common/sim.glsl).
+struct LevelEntry {
+  uint32_t cell = 0;    ///< y * width + x
+  float stageM = 0.0f;  ///< water surface elevation relative to the datum (m)
+};
+static_assert(sizeof(LevelEntry) == 8);
+
+/// The levels' stages at `tS` relative to `datumM`, per cell (each cell once, sorted by index; a
+/// cell held by several levels takes the highest).
+std::vector<LevelEntry> levelEntries(const std::vector<LevelBoundary>& levels, int width, double tS, double datumM);
+/// Checks a level's cells against the grid and its stage times (strictly increasing).
+Status checkLevel(const LevelBoundary& level, int width, int height);
+
 /// The sources' mean discharges over [t0S, t1S] (exact integrals of the hydrographs), merged
 /// per cell (each cell once, sorted by cell index).
 std::vector<SourceEntry> mergeSources(const std::vector<Source>& sources, int width, double t0S, double t1S);

@@ -105,6 +105,17 @@ struct Source {
   double volume(double t0S, double t1S) const;
 };
 
+/// A fixed water level (W26): each step the listed cells are set to depth max(0, stage(t) - bed),
+/// a Dirichlet condition. The water this puts in or takes out is summed per cell since the start:
+/// a cell that gained on balance counts as inflow, one that lost as outflow. The stage is linearly
+/// interpolated between samples and holds its end values outside their span.
+struct LevelBoundary {
+  std::vector<std::pair<int, int>> cells;         ///< (x, y) cells held at the level
+  std::vector<std::pair<double, double>> stageM;  ///< (time s, water surface elevation m), time increasing
+  /// Water surface elevation at time `tS` (m, the same reference as SimInput::baseM).
+  double stageAt(double tS) const;
+};
+
 /// Water and material bookkeeping since the start (volumes in m^3, summed in double).
 struct SimStats {
   double timeS = 0;              ///< simulated time

@@ -1,0 +1,39 @@
+#pragma once
+// The headless GL context every GPU benchmark program shares: created once, on first use, with
+// GL debug output off (it costs time on every call); a program that cannot get one exits with the
+// reason. benchGlMain() is the main() of those programs: it records the renderer and GL version
+// in the benchmark's JSON context so figures say what they were measured on.
+
+#include <benchmark/benchmark.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <optional>
+
+#include <strata/render/gl/context.hpp>
+
+namespace strata::bench {
+
+inline render::gl::HeadlessContext& glContext() {
+  static std::optional<render::gl::HeadlessContext> c = [] {
+    auto r = render::gl::HeadlessContext::create({.debugOutput = false});
+    if (!r) {
+      std::fprintf(stderr, "%s\n", r.message().c_str());
+      std::exit(1);
+    }
+    return std::optional<render::gl::HeadlessContext>(std::move(r).value());
+  }();
+  return *c;
+}
+
+inline int benchGlMain(int argc, char** argv) {
+  benchmark::Initialize(&argc, argv);
+  const auto& i = glContext().info();
+  benchmark::AddCustomContext("gl_renderer", i.renderer);
+  benchmark::AddCustomContext("gl_version", i.version);
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}
+
+}  // namespace strata::bench
