@@ -14,7 +14,11 @@ fs;
 
 layout(binding = 1) uniform sampler2D uWater;   // water depth (m), optional
 layout(binding = 2) uniform sampler2D uLayers;  // thickness (m) of up to four layers, bottom first, optional
+layout(binding = 5) uniform sampler2D uSediment;  // suspended sediment (m of material), optional
 uniform int uHasWater;
+uniform int uHasSediment;
+uniform vec3 uSiltColour;        // water colour at high sediment concentration
+uniform float uSiltConcentration; // concentration s / h at which water is 1 - 1/e of the way to silt
 uniform int uHasLayers;
 uniform float uSeaLevelM;        // water below this elevation when uHasSea
 uniform int uHasSea;
@@ -78,12 +82,18 @@ void main() {
   float light = 0.25 + 0.75 * max(dot(n, uSunDir), 0.0);
   vec3 colour = albedo * light;
 
-  float depth = 0.0;
-  if (uHasWater != 0) depth = max(depth, textureLod(uWater, uv, lod).r);
+  float depth = 0.0, simDepth = 0.0;
+  if (uHasWater != 0) simDepth = textureLod(uWater, uv, lod).r;
+  depth = max(depth, simDepth);
   if (uHasSea != 0) depth = max(depth, uSeaLevelM - elev);
   if (depth > 0.0) {
     float k = 1.0 - exp(-depth / uWaterDepthScaleM);
     vec3 water = mix(vec3(0.25, 0.62, 0.70), vec3(0.02, 0.10, 0.32), k);
+    if (uHasSediment != 0 && simDepth > 0.0) {
+      // Suspended sediment tints the simulated water by its concentration s / h.
+      float conc = max(textureLod(uSediment, uv, lod).r, 0.0) / simDepth;
+      water = mix(water, uSiltColour, 1.0 - exp(-conc / uSiltConcentration));
+    }
     float sunOnWater = 0.6 + 0.4 * max(dot(up, uSunDir), 0.0);
     colour = mix(colour, water * sunOnWater, 0.55 + 0.45 * k);
   }

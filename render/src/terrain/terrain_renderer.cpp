@@ -70,6 +70,9 @@ Status setCommonUniforms(const gl::Program& p, const TerrainScene& scene, const 
                               float(1.0 / (c[5] * h * kDeg))));
   p.set("uHasWater", scene.waterTexture() ? 1 : 0);
   p.set("uHasLayers", scene.layerTexture() ? 1 : 0);
+  p.set("uHasSediment", scene.sedimentTexture() && scene.waterTexture() ? 1 : 0);
+  p.set("uSiltColour", shading.siltColour);
+  p.set("uSiltConcentration", shading.siltConcentration);
   p.set("uHasSea", shading.seaLevelM ? 1 : 0);
   p.set("uSeaLevelM", shading.seaLevelM.value_or(0.0f));
   p.set("uWaterDepthScaleM", shading.waterDepthScaleM);
@@ -88,6 +91,7 @@ Status setCommonUniforms(const gl::Program& p, const TerrainScene& scene, const 
   p.set("uFogM", shading.fogM);
   if (scene.waterTexture()) scene.waterTexture()->bind(1);
   if (scene.layerTexture()) scene.layerTexture()->bind(2);
+  if (scene.sedimentTexture()) scene.sedimentTexture()->bind(5);
   StreamedElevation* s = scene.streamed();
   p.set("uStreamed", s ? 1 : 0);
   if (!s) {
@@ -186,6 +190,19 @@ Status TerrainScene::setWaterDepth(const gis::Grid<float>& depthM) {
   water_ = gl::Texture::create2D(gl::kR32F, width(), height(), 0);
   water_.upload(depthM.data.data());
   water_.generateMipmap();
+  return {};
+}
+
+Status TerrainScene::setSuspendedSediment(const gis::Grid<float>& sedimentM) {
+  if (streamed_) return fail("render: suspended sediment is drawn on whole-DEM scenes only (this one is streamed)");
+  if (sedimentM.width != width() || sedimentM.height != height()) {
+    return fail("render: suspended sediment grid " + std::to_string(sedimentM.width) + "x" +
+                std::to_string(sedimentM.height) + " differs from the DEM's " + std::to_string(width()) + "x" +
+                std::to_string(height()));
+  }
+  sediment_ = gl::Texture::create2D(gl::kR32F, width(), height(), 0);
+  sediment_.upload(sedimentM.data.data());
+  sediment_.generateMipmap();
   return {};
 }
 
