@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstring>
 #include <numbers>
+#include <span>
 
 #include <glm/glm.hpp>
 
@@ -405,24 +406,35 @@ TEST_F(ViewerGpu, ErosionInTheRegionMovesTheSurfaceWithTheLayers) {
   }
   EXPECT_NEAR(surfaceChange, layerChange, 1e-2);
   EXPECT_GT(maxCut, 1e-3) << "the spring's water eroded nothing";
-  // The suspended sediment reaches the scene: the region's field, bit for bit, zero outside.
-  ASSERT_NE(v.scene().sedimentTexture(), nullptr);
-  const auto drawn = v.scene().sedimentTexture()->read<float>();
-  const auto suspended = v.region()->sim->readSuspended();
-  double carried = 0;
-  for (int y = 0; y < 64; ++y) {
-    for (int x = 0; x < 64; ++x) {
-      const bool inRegion = x >= 12 && x < 52 && y >= 12 && y < 52;
-      const float want = inRegion ? suspended.at(x - 12, y - 12) : 0.0f;
-      ASSERT_EQ(drawn[size_t(y) * 64 + size_t(x)], want) << x << " " << y;
-      carried += want;
+  // The water and the suspended sediment reach the scene (a GPU-to-GPU copy of the state): the
+  // region's fields, bit for bit, zero outside.
+  ASSERT_NE(v.scene().waterStateTexture(), nullptr);
+  auto checkDrawn = [&](bool wantSediment) {
+    const auto drawn = v.scene().waterStateTexture()->read<float>();
+    ASSERT_EQ(drawn.size(), size_t(64 * 64 * 4));
+    const auto depth = v.region()->sim->readWaterDepth();
+    const auto suspended = v.region()->sim->readSuspended();
+    double carried = 0;
+    for (int y = 0; y < 64; ++y) {
+      for (int x = 0; x < 64; ++x) {
+        const bool inRegion = x >= 12 && x < 52 && y >= 12 && y < 52;
+        const size_t i = (size_t(y) * 64 + size_t(x)) * 4;
+        ASSERT_EQ(drawn[i], inRegion ? depth.at(x - 12, y - 12) : 0.0f) << x << " " << y;
+        ASSERT_EQ(drawn[i + 1], inRegion ? suspended.at(x - 12, y - 12) : 0.0f) << x << " " << y;
+        carried += drawn[i + 1];
+      }
     }
-  }
-  EXPECT_GT(carried, 1e-3) << "no sediment in suspension";
+    if (wantSediment) {
+      EXPECT_GT(carried, 1e-3) << "no sediment in suspension";
+    } else {
+      EXPECT_EQ(carried, 0.0);
+    }
+  };
+  checkDrawn(true);
   // Erosion off: the sim carries none, and the tint goes.
   ASSERT_TRUE(v.handle(SimCommand{SimCommand::kErosionOff}));
   ASSERT_TRUE(v.handle(SimCommand{SimCommand::kStep, 1}));
-  for (float s : v.scene().sedimentTexture()->read<float>()) ASSERT_EQ(s, 0.0f);
+  checkDrawn(false);
 }
 
 TEST_F(ViewerGpu, SuspendedSedimentTintsTheWaterWhereItIs) {
@@ -481,6 +493,19 @@ TEST_F(ViewerGpu, SuspendedSedimentTintsTheWaterWhereItIs) {
       }
     }
   }
+  // The same fields as a simulation state buffer (h, s, hu, hv per cell) copied GPU-to-GPU into
+  // a fresh scene: the same image, pixel for pixel.
+  auto stateScene = TerrainScene::create(planarDem(n, n, [](int, int) { return 500.0f; }));
+  ASSERT_TRUE(stateScene) << stateScene.message();
+  std::vector<float> state(size_t(n) * size_t(n) * 4, 0.0f);
+  for (size_t i = 0; i < size_t(n) * size_t(n); ++i) {
+    state[4 * i] = 1.0f;
+    state[4 * i + 1] = sediment.data[i];
+  }
+  const auto stateBuffer = render::gl::Buffer::from(std::span<const float>(state));
+  stateScene->copyWaterState(stateBuffer, 0, 0, n, n);
+  ASSERT_TRUE((*renderer)->draw(*stateScene, camera, shading, *target));
+  EXPECT_EQ(target->colour(), tinted);
   // The tint is visible: the silty water is at least 20 levels away from the clear in some channel.
   const glm::dvec3 diff = glm::abs(siltWant - clearWant);
   EXPECT_GT(std::max({diff.x, diff.y, diff.z}), 20.0);

@@ -331,6 +331,7 @@ Status Viewer::startRegion(double lon0, double lat0, double lon1, double lat1) {
   if (x1 - x0 < 4 || y1 - y0 < 4) return fail("region: needs at least 4x4 cells inside the terrain");
   region_.emplace();
   region_->rect = {x0, y0, x1 - x0, y1 - y0};
+  scene_.clearWaterState();  // the previous region's water
   STRATA_TRY_STATUS(rebuildSimulation(gis::Grid<float>(x1 - x0, y1 - y0, 0.0f)));
   return showWater();
 }
@@ -448,20 +449,10 @@ Status Viewer::stepSimulation(int steps) {
 }
 
 Status Viewer::showWater() {
-  // A CPU round trip (read the region's depth, paste it into the scene's grid, upload): simple,
-  // and at viewer region sizes a few ms on llvmpipe (docs/viewer.md).
+  // A GPU-to-GPU copy of the region's state (h, s, hu, hv) into the scene's water-state texture:
+  // the depth is drawn as water, the suspended sediment (non-zero with erosion on) as silt.
   const auto& r = region_->rect;
-  auto toScene = [&](const gis::Grid<float>& field) {
-    gis::Grid<float> full(scene_.width(), scene_.height(), 0.0f);
-    for (int y = 0; y < r.h; ++y) std::copy_n(&field.data[size_t(y) * size_t(r.w)], r.w, &full.at(r.x, r.y + y));
-    return full;
-  };
-  STRATA_TRY_STATUS(scene_.setWaterDepth(toScene(region_->sim->readWaterDepth())));
-  // Suspended sediment tints the water (Shading::siltColour); only erosion carries any.
-  if (region_->erosion) return scene_.setSuspendedSediment(toScene(region_->sim->readSuspended()));
-  if (scene_.sedimentTexture()) {
-    return scene_.setSuspendedSediment(gis::Grid<float>(scene_.width(), scene_.height(), 0.0f));
-  }
+  scene_.copyWaterState(region_->sim->stateBuffer(), r.x, r.y, r.w, r.h);
   return {};
 }
 

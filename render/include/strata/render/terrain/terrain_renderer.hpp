@@ -79,6 +79,13 @@ class TerrainScene {
   /// Suspended sediment (m of material per cell area), same grid as the DEM: tints the water
   /// drawn from setWaterDepth by the concentration s / h (Shading::siltColour, siltConcentration).
   Status setSuspendedSediment(const gis::Grid<float>& sedimentM);
+  /// Water depth and suspended sediment straight from a simulation's state buffer (4 floats per
+  /// cell: h, s, hu, hv, row-major, as render::sim::Simulation::stateBuffer) for the `w` x `h`
+  /// cells at (x, y): a GPU-to-GPU copy into an rgba32f texture, no read-back. Cells outside keep
+  /// what they had (zero at first; clearWaterState zeroes them). Drawn as setWaterDepth and
+  /// setSuspendedSediment are.
+  void copyWaterState(const gl::Buffer& state, int x, int y, int w, int h);
+  void clearWaterState();
   /// Thicknesses (m) of up to four material layers (bottom first), same grid as the DEM;
   /// drawn with Shading::layerColours.
   Status setMaterialLayers(const std::vector<gis::Grid<float>>& thicknessM);
@@ -118,13 +125,14 @@ class TerrainScene {
   const gl::Texture* waterTexture() const { return water_ ? &water_ : nullptr; }
   const gl::Texture* layerTexture() const { return layers_ ? &layers_ : nullptr; }
   const gl::Texture* sedimentTexture() const { return sediment_ ? &sediment_ : nullptr; }
+  const gl::Texture* waterStateTexture() const { return waterState_ ? &waterState_ : nullptr; }
 
  private:
   gis::Georef georef_;
   gis::Grid<float> heights_;
   bool planetary_ = false;
   float minM_ = 0, maxM_ = 0;
-  gl::Texture height_, water_, layers_, sediment_;
+  gl::Texture height_, water_, layers_, sediment_, waterState_;
   std::shared_ptr<StreamedElevation> streamed_;
 };
 
