@@ -1,6 +1,7 @@
 // strata-view frame times offscreen (EGL: llvmpipe, or the NVIDIA GPU where there is one): the
 // Viewer flying over a DEM at 1280x720, without and with a live simulation region. Prints one
 // JSON line per configuration. Usage: strata_bench_viewer [DEM] [FRAMES]. docs/benchmarks.md.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -70,6 +71,35 @@ int main(int argc, char** argv) {
         "\"gpu_ms\": %.2f, \"sim_ms\": %.2f, \"size\": \"1280x720\", \"circles\": %d}\n",
         sim ? "flight+sim64x64x8" : "flight", ctx->info().renderer.c_str(), frames, wall / frames, cpu / frames,
         gpu / frames, simMs / frames, options.circles);
+    if (!sim) continue;
+    // Showing the region's water and suspended sediment, alone: the CPU round trip the viewer
+    // used first (read both fields back, paste them into scene-sized grids, upload with mips)
+    // against the GPU-to-GPU copy of the state buffer it uses now; glFinish after each.
+    const auto& sm = *v.region()->sim;
+    const auto& r = v.region()->rect;
+    auto& scene = v.scene();
+    auto timeMs = [&](auto&& body) {
+      glFinish();
+      const auto t = std::chrono::steady_clock::now();
+      for (int i = 0; i < frames; ++i) {
+        body();
+        glFinish();
+      }
+      return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count() / frames;
+    };
+    const double roundTrip = timeMs([&] {
+      for (int field = 0; field < 2; ++field) {
+        const auto g = field == 0 ? sm.readWaterDepth() : sm.readSuspended();
+        gis::Grid<float> full(scene.width(), scene.height(), 0.0f);
+        for (int y = 0; y < r.h; ++y) std::copy_n(&g.data[size_t(y) * size_t(r.w)], r.w, &full.at(r.x, r.y + y));
+        (void)(field == 0 ? scene.setWaterDepth(full) : scene.setSuspendedSediment(full));
+      }
+    });
+    const double gpuCopy = timeMs([&] { scene.copyWaterState(sm.stateBuffer(), r.x, r.y, r.w, r.h); });
+    std::printf(
+        "{\"config\": \"water-display\", \"renderer\": \"%s\", \"scene\": \"%dx%d\", \"region\": \"%dx%d\", "
+        "\"cpu_roundtrip_ms\": %.3f, \"gpu_copy_ms\": %.3f}\n",
+        ctx->info().renderer.c_str(), scene.width(), scene.height(), r.w, r.h, roundTrip, gpuCopy);
   }
   return 0;
 }

@@ -14,7 +14,13 @@ fs;
 
 layout(binding = 1) uniform sampler2D uWater;   // water depth (m), optional
 layout(binding = 2) uniform sampler2D uLayers;  // thickness (m) of up to four layers, bottom first, optional
+layout(binding = 5) uniform sampler2D uSediment;  // suspended sediment (m of material), optional
 uniform int uHasWater;
+layout(binding = 6) uniform sampler2D uWaterState;  // simulation state (h, s, hu, hv), optional
+uniform int uHasSediment;
+uniform int uHasWaterState;
+uniform vec3 uSiltColour;        // water colour at high sediment concentration
+uniform float uSiltConcentration; // concentration s / h at which water is 1 - 1/e of the way to silt
 uniform int uHasLayers;
 uniform float uSeaLevelM;        // water below this elevation when uHasSea
 uniform int uHasSea;
@@ -78,12 +84,25 @@ void main() {
   float light = 0.25 + 0.75 * max(dot(n, uSunDir), 0.0);
   vec3 colour = albedo * light;
 
-  float depth = 0.0;
-  if (uHasWater != 0) depth = max(depth, textureLod(uWater, uv, lod).r);
+  float depth = 0.0, simDepth = 0.0;
+  float sediment = 0.0;
+  if (uHasWater != 0) simDepth = textureLod(uWater, uv, lod).r;
+  if (uHasSediment != 0) sediment = textureLod(uSediment, uv, lod).r;
+  if (uHasWaterState != 0) {
+    vec4 st = textureLod(uWaterState, uv, lod);
+    simDepth = max(simDepth, st.r);
+    sediment = max(sediment, st.g);
+  }
+  depth = max(depth, simDepth);
   if (uHasSea != 0) depth = max(depth, uSeaLevelM - elev);
   if (depth > 0.0) {
     float k = 1.0 - exp(-depth / uWaterDepthScaleM);
     vec3 water = mix(vec3(0.25, 0.62, 0.70), vec3(0.02, 0.10, 0.32), k);
+    if (sediment > 0.0 && simDepth > 0.0) {
+      // Suspended sediment tints the simulated water by its concentration s / h.
+      float conc = sediment / simDepth;
+      water = mix(water, uSiltColour, 1.0 - exp(-conc / uSiltConcentration));
+    }
     float sunOnWater = 0.6 + 0.4 * max(dot(up, uSunDir), 0.0);
     colour = mix(colour, water * sunOnWater, 0.55 + 0.45 * k);
   }

@@ -1,15 +1,19 @@
 // strata-view's library on a real GL context (llvmpipe without a GPU): the height brushes and
 // their exact undo/redo, copy/paste, the fly-through camera, and a brush edit across a store's
 // tile boundary written back through TileStore::writeWindow.
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <numbers>
+#include <span>
 
 #include <glm/glm.hpp>
 
 #include <gtest/gtest.h>
 
 #include <strata/gis/dem_io.hpp>
+#include <strata/gis/geodesy.hpp>
 #include <strata/render/viewer/camera_controller.hpp>
 #include <strata/render/viewer/store_io.hpp>
 #include <strata/render/viewer/terrain_editor.hpp>
@@ -18,6 +22,7 @@
 
 #include "gl_fixture.hpp"
 #include "strata_test.hpp"
+#include "terrain_fixture.hpp"
 
 namespace strata {
 namespace {
@@ -289,6 +294,75 @@ TEST_F(ViewerGpu, PickFindsTheGroundPointUnderThePixel) {
   EXPECT_FALSE(v.pick(50.5, 10.5));
 }
 
+TEST_F(ViewerGpu, PlanetaryPickFindsTheGroundPointOnTheBody) {
+  // The Moon (LOLA LDEM 4 px/deg, a sphere) and the Earth (ETOPO 20', the WGS84 ellipsoid) in
+  // planetary mode, 200 km up. Straight down, the centre pixel of an odd-sized image is the
+  // nadir: it picks the camera's lon/lat (1e-3 deg, 30 m on the Moon). At pitch -45, every 10th
+  // pixel's picked point, put back on the terrain at its elevation and projected with the frame's
+  // matrices, lands on that pixel (0.2 px; measured 0.02: the ring mesh is not the bilinear surface exactly).
+  struct Site {
+    const char* path;
+    double lon, lat;
+  };
+  for (const Site& b : {Site{"moon/LDEM_4.LBL", 20.0, 10.0}, Site{"earth/etopo20.tif", -30.0, 40.0}}) {
+    SCOPED_TRACE(b.path);
+    auto dem = test::readDemLonLat(test::dataPath(b.path));
+    ASSERT_TRUE(dem) << dem.message();
+    ViewerOptions options;
+    options.width = 101;
+    options.height = 81;
+    options.circles = 128;
+    options.planetary = true;
+    auto viewer = Viewer::create(*dem, options);
+    ASSERT_TRUE(viewer) << viewer.message();
+    auto& v = **viewer;
+    ASSERT_TRUE(v.handle(GoToCommand{b.lon, b.lat, 2e5}));
+    ASSERT_TRUE(v.handle(LookCommand{30.0, -90.0}));
+    ASSERT_TRUE(v.frame(0.0));
+    const auto nadir = v.pick(50.5, 40.5);
+    ASSERT_TRUE(nadir);
+    EXPECT_NEAR(nadir->x, b.lon, 1e-3);
+    EXPECT_NEAR(nadir->y, b.lat, 1e-3);
+
+    ASSERT_TRUE(v.handle(LookCommand{30.0, -45.0}));
+    ASSERT_TRUE(v.frame(0.0));
+    const auto& pose = v.camera().pose();
+    const auto f = render::terrain::frameGeometry(v.scene(), pose, v.shading(), 101, 81);
+    const gis::LocalFrame enuFrame({pose.lon, pose.lat, pose.heightM}, dem->georef.body);
+    double worst = 0;
+    int picked = 0;
+    for (int y = 5; y < 81; y += 10) {
+      for (int x = 5; x < 101; x += 10) {
+        const auto at = v.pick(x + 0.5, y + 0.5);
+        if (!at) continue;
+        ++picked;
+        const double elev = v.scene().heightAt(at->x, at->y);
+        const gis::Enu e = enuFrame.toEnu(gis::LonLat{at->x, at->y, elev});
+        const glm::dvec4 clip = f.viewProj() * glm::dvec4(e.e, e.n, e.u, 1.0);
+        const glm::dvec2 px((clip.x / clip.w + 1) * 0.5 * 101, (1 - clip.y / clip.w) * 0.5 * 81);
+        const double err = glm::length(px - glm::dvec2(x + 0.5, y + 0.5));
+        worst = std::max(worst, err);
+        EXPECT_LT(err, 0.2) << x << " " << y;
+      }
+    }
+    EXPECT_GT(picked, 60);  // looking down at 45 degrees from 200 km: the ground fills the view
+    std::printf("[ planetary pick %s ] %d pixels, worst reprojection %.3f px\n", b.path, picked, worst);
+
+    // A mouse tool works there: raise under the centre pixel changes the cell it picks.
+    const auto centre = v.pick(50.5, 40.5);
+    ASSERT_TRUE(centre);
+    const glm::dvec2 cell = v.editor().cellOf(centre->x, centre->y);
+    const float before = v.scene().heights().at(int(cell.x), int(cell.y));
+    ASSERT_TRUE(v.handle(ToolCommand{"raise"}));
+    ASSERT_TRUE(v.handle(BrushCommand{100000.0, 100.0}));
+    ASSERT_TRUE(v.handle(MouseMoveCommand{50.5, 40.5}));
+    ASSERT_TRUE(v.handle(MouseButtonCommand{MouseButtonCommand::kLeft, true}));
+    ASSERT_TRUE(v.handle(MouseButtonCommand{MouseButtonCommand::kLeft, false}));
+    EXPECT_GT(v.scene().heights().at(int(cell.x), int(cell.y)) - before, 50.0f);
+    EXPECT_EQ(v.editor().undoDepth(), 1u);
+  }
+}
+
 TEST_F(ViewerGpu, ErosionInTheRegionMovesTheSurfaceWithTheLayers) {
   // A 30 m-cell slope falling 3 m a cell to the south; a 40 x 40 region fed by a spring at its top.
   ViewerOptions options;
@@ -332,6 +406,109 @@ TEST_F(ViewerGpu, ErosionInTheRegionMovesTheSurfaceWithTheLayers) {
   }
   EXPECT_NEAR(surfaceChange, layerChange, 1e-2);
   EXPECT_GT(maxCut, 1e-3) << "the spring's water eroded nothing";
+  // The water and the suspended sediment reach the scene (a GPU-to-GPU copy of the state): the
+  // region's fields, bit for bit, zero outside.
+  ASSERT_NE(v.scene().waterStateTexture(), nullptr);
+  auto checkDrawn = [&](bool wantSediment) {
+    const auto drawn = v.scene().waterStateTexture()->read<float>();
+    ASSERT_EQ(drawn.size(), size_t(64 * 64 * 4));
+    const auto depth = v.region()->sim->readWaterDepth();
+    const auto suspended = v.region()->sim->readSuspended();
+    double carried = 0;
+    for (int y = 0; y < 64; ++y) {
+      for (int x = 0; x < 64; ++x) {
+        const bool inRegion = x >= 12 && x < 52 && y >= 12 && y < 52;
+        const size_t i = (size_t(y) * 64 + size_t(x)) * 4;
+        ASSERT_EQ(drawn[i], inRegion ? depth.at(x - 12, y - 12) : 0.0f) << x << " " << y;
+        ASSERT_EQ(drawn[i + 1], inRegion ? suspended.at(x - 12, y - 12) : 0.0f) << x << " " << y;
+        carried += drawn[i + 1];
+      }
+    }
+    if (wantSediment) {
+      EXPECT_GT(carried, 1e-3) << "no sediment in suspension";
+    } else {
+      EXPECT_EQ(carried, 0.0);
+    }
+  };
+  checkDrawn(true);
+  // Erosion off: the sim carries none, and the tint goes.
+  ASSERT_TRUE(v.handle(SimCommand{SimCommand::kErosionOff}));
+  ASSERT_TRUE(v.handle(SimCommand{SimCommand::kStep, 1}));
+  checkDrawn(false);
+}
+
+TEST_F(ViewerGpu, SuspendedSedimentTintsTheWaterWhereItIs) {
+  // Flat ground at 500 m under 1 m of water everywhere; 0.05 m of sediment in suspension over
+  // the western half. Seen from straight above, the normal is up, so each pixel is the shading
+  // formula of terrain.frag evaluated by hand: ground tint c0 lit by 0.25 + 0.75 sun_z, water
+  // mixed in by 0.55 + 0.45 k (k = 1 - exp(-h / waterDepthScaleM)), and the western water moved
+  // towards siltColour by 1 - exp(-(s / h) / siltConcentration). Tolerance 2/255 (8-bit rounding).
+  const int n = 64;
+  auto scene = TerrainScene::create(planarDem(n, n, [](int, int) { return 500.0f; }));
+  ASSERT_TRUE(scene) << scene.message();
+  ASSERT_TRUE(scene->setWaterDepth(gis::Grid<float>(n, n, 1.0f)));
+  gis::Grid<float> sediment(n, n, 0.0f);
+  for (int y = 0; y < n; ++y) {
+    for (int x = 0; x < n / 2; ++x) sediment.at(x, y) = 0.05f;
+  }
+  auto renderer = render::terrain::RingRenderer::create({.circles = 64});
+  ASSERT_TRUE(renderer) << renderer.message();
+  auto target = render::terrain::OffscreenTarget::create(64, 64);
+  ASSERT_TRUE(target) << target.message();
+  render::terrain::Shading shading;
+  const render::terrain::CameraPose camera{500960.0, 3999040.0, 2000.0, 0.0, -90.0, 45.0};  // over the centre
+
+  auto expected = [&](double concentration) {
+    const glm::dvec3 sun = glm::normalize(glm::dvec3(shading.sunDir));
+    const glm::dvec3 ground = glm::dvec3(0.22, 0.42, 0.20) * (0.25 + 0.75 * std::max(sun.z, 0.0));
+    const double k = 1 - std::exp(-1.0 / shading.waterDepthScaleM);
+    glm::dvec3 water = glm::mix(glm::dvec3(0.25, 0.62, 0.70), glm::dvec3(0.02, 0.10, 0.32), k);
+    water = glm::mix(water, glm::dvec3(shading.siltColour), 1 - std::exp(-concentration / shading.siltConcentration));
+    return glm::mix(ground, water * (0.6 + 0.4 * std::max(sun.z, 0.0)), 0.55 + 0.45 * k) * 255.0;
+  };
+  auto pixel = [&](const std::vector<uint8_t>& px, int x, int y) {
+    const size_t i = (size_t(y) * 64 + size_t(x)) * 4;
+    return glm::dvec3(px[i], px[i + 1], px[i + 2]);
+  };
+  // Without a sediment field: clear water everywhere.
+  ASSERT_TRUE((*renderer)->draw(*scene, camera, shading, *target));
+  const auto clear = target->colour();
+  ASSERT_TRUE(scene->setSuspendedSediment(sediment));
+  ASSERT_TRUE((*renderer)->draw(*scene, camera, shading, *target));
+  const auto tinted = target->colour();
+  // The view spans about 1660 m (55 cells) across: image columns 4..20 are west of the
+  // boundary by 8 cells or more, columns 44..60 east of it.
+  const glm::dvec3 clearWant = expected(0.0), siltWant = expected(0.05);
+  for (int y = 4; y < 60; y += 4) {
+    for (int x = 4; x <= 20; x += 4) {
+      for (int ch = 0; ch < 3; ++ch) {
+        EXPECT_NEAR(pixel(tinted, x, y)[ch], siltWant[ch], 2.0) << x << " " << y << " channel " << ch;
+        EXPECT_NEAR(pixel(clear, x, y)[ch], clearWant[ch], 2.0) << x << " " << y << " channel " << ch;
+      }
+    }
+    for (int x = 44; x <= 60; x += 4) {
+      for (int ch = 0; ch < 3; ++ch) {
+        EXPECT_NEAR(pixel(tinted, x, y)[ch], clearWant[ch], 2.0) << x << " " << y << " channel " << ch;
+        EXPECT_EQ(pixel(tinted, x, y)[ch], pixel(clear, x, y)[ch]) << x << " " << y << " channel " << ch;
+      }
+    }
+  }
+  // The same fields as a simulation state buffer (h, s, hu, hv per cell) copied GPU-to-GPU into
+  // a fresh scene: the same image, pixel for pixel.
+  auto stateScene = TerrainScene::create(planarDem(n, n, [](int, int) { return 500.0f; }));
+  ASSERT_TRUE(stateScene) << stateScene.message();
+  std::vector<float> state(size_t(n) * size_t(n) * 4, 0.0f);
+  for (size_t i = 0; i < size_t(n) * size_t(n); ++i) {
+    state[4 * i] = 1.0f;
+    state[4 * i + 1] = sediment.data[i];
+  }
+  const auto stateBuffer = render::gl::Buffer::from(std::span<const float>(state));
+  stateScene->copyWaterState(stateBuffer, 0, 0, n, n);
+  ASSERT_TRUE((*renderer)->draw(*stateScene, camera, shading, *target));
+  EXPECT_EQ(target->colour(), tinted);
+  // The tint is visible: the silty water is at least 20 levels away from the clear in some channel.
+  const glm::dvec3 diff = glm::abs(siltWant - clearWant);
+  EXPECT_GT(std::max({diff.x, diff.y, diff.z}), 20.0);
 }
 
 TEST_F(ViewerGpu, FlightSpeedFollowsHeightAboveGround) {

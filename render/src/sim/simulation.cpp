@@ -384,6 +384,8 @@ std::vector<gis::Grid<float>> Simulation::readLayers() const {
   return out;
 }
 
+const gl::Buffer& Simulation::stateBuffer() const { return impl_->cur(); }
+
 gis::Grid<float> Simulation::readSuspended() const {
   const auto st = impl_->readState();
   gis::Grid<float> g(impl_->p.width, impl_->p.height);

@@ -70,6 +70,10 @@ Status setCommonUniforms(const gl::Program& p, const TerrainScene& scene, const 
                               float(1.0 / (c[5] * h * kDeg))));
   p.set("uHasWater", scene.waterTexture() ? 1 : 0);
   p.set("uHasLayers", scene.layerTexture() ? 1 : 0);
+  p.set("uHasSediment", scene.sedimentTexture() && scene.waterTexture() ? 1 : 0);
+  p.set("uHasWaterState", scene.waterStateTexture() ? 1 : 0);
+  p.set("uSiltColour", shading.siltColour);
+  p.set("uSiltConcentration", shading.siltConcentration);
   p.set("uHasSea", shading.seaLevelM ? 1 : 0);
   p.set("uSeaLevelM", shading.seaLevelM.value_or(0.0f));
   p.set("uWaterDepthScaleM", shading.waterDepthScaleM);
@@ -88,6 +92,8 @@ Status setCommonUniforms(const gl::Program& p, const TerrainScene& scene, const 
   p.set("uFogM", shading.fogM);
   if (scene.waterTexture()) scene.waterTexture()->bind(1);
   if (scene.layerTexture()) scene.layerTexture()->bind(2);
+  if (scene.sedimentTexture()) scene.sedimentTexture()->bind(5);
+  if (scene.waterStateTexture()) scene.waterStateTexture()->bind(6);
   StreamedElevation* s = scene.streamed();
   p.set("uStreamed", s ? 1 : 0);
   if (!s) {
@@ -187,6 +193,44 @@ Status TerrainScene::setWaterDepth(const gis::Grid<float>& depthM) {
   water_.upload(depthM.data.data());
   water_.generateMipmap();
   return {};
+}
+
+Status TerrainScene::setSuspendedSediment(const gis::Grid<float>& sedimentM) {
+  if (streamed_) return fail("render: suspended sediment is drawn on whole-DEM scenes only (this one is streamed)");
+  if (sedimentM.width != width() || sedimentM.height != height()) {
+    return fail("render: suspended sediment grid " + std::to_string(sedimentM.width) + "x" +
+                std::to_string(sedimentM.height) + " differs from the DEM's " + std::to_string(width()) + "x" +
+                std::to_string(height()));
+  }
+  sediment_ = gl::Texture::create2D(gl::kR32F, width(), height(), 0);
+  sediment_.upload(sedimentM.data.data());
+  sediment_.generateMipmap();
+  return {};
+}
+
+void TerrainScene::copyWaterState(const gl::Buffer& state, int x, int y, int w, int h) {
+  STRATA_CHECK(!streamed_ && x >= 0 && y >= 0 && w > 0 && h > 0 && x + w <= width() && y + h <= height() &&
+               state.size() >= size_t(w) * size_t(h) * 16)
+      << "copyWaterState: streamed scene, window outside the grid, or a buffer too small";
+  if (!waterState_) {
+    waterState_ = gl::Texture::create2D(gl::kRGBA32F, width(), height(), 0);
+    clearWaterState();
+  }
+  // The buffer was written by compute shaders: make those writes visible to the unpack.
+  glMemoryBarrier(GL_PIXEL_BUFFER_BARRIER_BIT);
+  glBindBuffer(GL_PIXEL_UNPACK_BUFFER, state.id());
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+  glTextureSubImage2D(waterState_.id(), 0, x, y, w, h, GL_RGBA, GL_FLOAT, nullptr);
+  glBindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
+  waterState_.generateMipmap();
+}
+
+void TerrainScene::clearWaterState() {
+  if (!waterState_) return;
+  const float zero[4] = {0, 0, 0, 0};
+  glClearTexImage(waterState_.id(), 0, GL_RGBA, GL_FLOAT, zero);
+  waterState_.generateMipmap();
 }
 
 void TerrainScene::writeHeights(int x, int y, const gis::Grid<float>& patch) {

@@ -5,6 +5,7 @@
 #include <numbers>
 
 #include <strata/gis/dem_io.hpp>
+#include <strata/gis/geodesy.hpp>
 #include <strata/render/image_io.hpp>
 #include <strata/render/viewer/viewer.hpp>
 
@@ -68,7 +69,7 @@ Status Viewer::resize(int width, int height) {
 std::optional<glm::dvec2> Viewer::pick(double x, double y) const {
   const int w = target_->width(), h = target_->height();
   const int px = int(std::floor(x)), py = int(std::floor(y));
-  if (scene_.planetary() || px < 0 || py < 0 || px >= w || py >= h) return std::nullopt;
+  if (px < 0 || py < 0 || px >= w || py >= h) return std::nullopt;
   const float d = target_->depthAt(px, py);
   if (!(d > 0)) return std::nullopt;
   const auto f = render::terrain::frameGeometry(scene_, camera_->pose(), options_.shading, w, h);
@@ -80,9 +81,21 @@ std::optional<glm::dvec2> Viewer::pick(double x, double y) const {
   eye /= eye.w;
   const glm::dvec3 eyeDir = glm::dvec3(eye) / -eye.z * dist;  // on the plane z_eye = -dist
   const glm::dvec3 enu = glm::dvec3(glm::inverse(f.view) * glm::dvec4(eyeDir, 0.0));
+  const auto& c = scene_.georef().transform.c;
+  if (scene_.planetary()) {
+    // The frame is east-north-up at the viewer, with up the ellipsoid normal at its nadir
+    // (render::terrain::positionAt): the point's geodetic lon/lat is the terrain's, as the
+    // exaggerated elevation is along the same normal.
+    const auto& pose = camera_->pose();
+    const gis::LocalFrame frame({pose.lon, pose.lat, pose.heightM}, scene_.georef().body);
+    const gis::LonLat p = frame.fromEnu({enu.x, enu.y, enu.z});
+    if (!std::isfinite(p.lonDeg) || !std::isfinite(p.latDeg)) return std::nullopt;
+    // The longitude in the turn nearest the DEM's centre (a global DEM may run 0..360).
+    const double centre = c[0] + 0.5 * c[1] * scene_.width();
+    return glm::dvec2(p.lonDeg - 360.0 * std::round((p.lonDeg - centre) / 360.0), p.latDeg);
+  }
   const glm::dvec2 uv = f.uvCam + f.uvPerMetre * glm::dvec2(enu.x, enu.y);
   if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) return std::nullopt;
-  const auto& c = scene_.georef().transform.c;
   return glm::dvec2(c[0] + c[1] * uv.x * scene_.width(), c[3] + c[5] * uv.y * scene_.height());
 }
 
@@ -318,6 +331,7 @@ Status Viewer::startRegion(double lon0, double lat0, double lon1, double lat1) {
   if (x1 - x0 < 4 || y1 - y0 < 4) return fail("region: needs at least 4x4 cells inside the terrain");
   region_.emplace();
   region_->rect = {x0, y0, x1 - x0, y1 - y0};
+  scene_.clearWaterState();  // the previous region's water
   STRATA_TRY_STATUS(rebuildSimulation(gis::Grid<float>(x1 - x0, y1 - y0, 0.0f)));
   return showWater();
 }
@@ -435,13 +449,11 @@ Status Viewer::stepSimulation(int steps) {
 }
 
 Status Viewer::showWater() {
-  // A CPU round trip (read the region's depth, paste it into the scene's grid, upload): simple,
-  // and at viewer region sizes a few ms on llvmpipe (docs/viewer.md).
-  const auto depth = region_->sim->readWaterDepth();
-  gis::Grid<float> full(scene_.width(), scene_.height(), 0.0f);
+  // A GPU-to-GPU copy of the region's state (h, s, hu, hv) into the scene's water-state texture:
+  // the depth is drawn as water, the suspended sediment (non-zero with erosion on) as silt.
   const auto& r = region_->rect;
-  for (int y = 0; y < r.h; ++y) std::copy_n(&depth.data[size_t(y) * size_t(r.w)], r.w, &full.at(r.x, r.y + y));
-  return scene_.setWaterDepth(full);
+  scene_.copyWaterState(region_->sim->stateBuffer(), r.x, r.y, r.w, r.h);
+  return {};
 }
 
 Status Viewer::frame(double dtS) {

@@ -10,6 +10,7 @@
 
 #include <strata/core/result.hpp>
 #include <strata/gis/raster.hpp>
+#include <strata/render/gl/objects.hpp>
 #include <strata/terrain/sim/cpu_simulation.hpp>
 #include <strata/terrain/sim/sim_params.hpp>
 
@@ -56,6 +57,9 @@ class Simulation {
   gis::Grid<float> readSuspended() const;            ///< suspended sediment (m of material)
   gis::Grid<float> readBed() const;                  ///< bed elevation above datumM() (m)
   double datumM() const;                             ///< the datum elevations are stored against (m)
+  /// The current state on the GPU: 4 floats per cell (h, s, hu, hv), row-major. Valid until the
+  /// next step (the state ping-pongs); for GPU-side copies such as drawing the water.
+  const gl::Buffer& stateBuffer() const;
   /// Volumes since the start (reads the state back; summed in double on the CPU).
   SimStats stats() const;
   const SimParams& params() const;

@@ -45,8 +45,10 @@ struct Shading {
   glm::vec4 sky{0.62f, 0.74f, 0.88f, 1.0f};                         ///< background and haze colour
   float fogM = 0;                                                   ///< haze distance (m); 0: none
   std::optional<float> seaLevelM;                                   ///< water wherever the terrain is below (m)
-  float waterDepthScaleM = 20;  ///< depth at which water is 1/e of the way to deep blue (m)
-  float layerOpaqueM = 0.5f;    ///< thickness at which a layer hides 1/e of what is below (m)
+  float waterDepthScaleM = 20;                ///< depth at which water is 1/e of the way to deep blue (m)
+  glm::vec3 siltColour{0.62f, 0.50f, 0.32f};  ///< water colour at high suspended-sediment concentration
+  float siltConcentration = 0.01f;  ///< concentration s / h at which water is 1 - 1/e of the way to siltColour
+  float layerOpaqueM = 0.5f;        ///< thickness at which a layer hides 1/e of what is below (m)
   std::array<glm::vec3, 4> layerColours{glm::vec3(0.76f, 0.70f, 0.50f), glm::vec3(0.45f, 0.35f, 0.25f),
                                         glm::vec3(0.30f, 0.45f, 0.20f), glm::vec3(0.9f, 0.9f, 0.95f)};
 };
@@ -74,6 +76,16 @@ class TerrainScene {
 
   /// Water depth (m) over the terrain, same grid as the DEM.
   Status setWaterDepth(const gis::Grid<float>& depthM);
+  /// Suspended sediment (m of material per cell area), same grid as the DEM: tints the water
+  /// drawn from setWaterDepth by the concentration s / h (Shading::siltColour, siltConcentration).
+  Status setSuspendedSediment(const gis::Grid<float>& sedimentM);
+  /// Water depth and suspended sediment straight from a simulation's state buffer (4 floats per
+  /// cell: h, s, hu, hv, row-major, as render::sim::Simulation::stateBuffer) for the `w` x `h`
+  /// cells at (x, y): a GPU-to-GPU copy into an rgba32f texture, no read-back. Cells outside keep
+  /// what they had (zero at first; clearWaterState zeroes them). Drawn as setWaterDepth and
+  /// setSuspendedSediment are.
+  void copyWaterState(const gl::Buffer& state, int x, int y, int w, int h);
+  void clearWaterState();
   /// Thicknesses (m) of up to four material layers (bottom first), same grid as the DEM;
   /// drawn with Shading::layerColours.
   Status setMaterialLayers(const std::vector<gis::Grid<float>>& thicknessM);
@@ -112,13 +124,15 @@ class TerrainScene {
   const gl::Texture& heightTexture() const { return height_; }
   const gl::Texture* waterTexture() const { return water_ ? &water_ : nullptr; }
   const gl::Texture* layerTexture() const { return layers_ ? &layers_ : nullptr; }
+  const gl::Texture* sedimentTexture() const { return sediment_ ? &sediment_ : nullptr; }
+  const gl::Texture* waterStateTexture() const { return waterState_ ? &waterState_ : nullptr; }
 
  private:
   gis::Georef georef_;
   gis::Grid<float> heights_;
   bool planetary_ = false;
   float minM_ = 0, maxM_ = 0;
-  gl::Texture height_, water_, layers_;
+  gl::Texture height_, water_, layers_, sediment_, waterState_;
   std::shared_ptr<StreamedElevation> streamed_;
 };
 

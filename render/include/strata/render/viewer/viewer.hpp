@@ -62,7 +62,7 @@ class Viewer {
   Status resize(int width, int height);
 
   /// The map position (lon/lat or easting/northing) under window pixel (x, y), y from the top;
-  /// nullopt for sky (or, in planetary mode, always: picking is planar only).
+  /// nullopt for sky. Planetary mode: geodetic lon/lat on the body's ellipsoid.
   std::optional<glm::dvec2> pick(double x, double y) const;
   std::vector<std::string> hudLines() const;
   /// The last frame's timings (ms): CPU work of frame() (camera, brush, simulation, draw
