@@ -23,6 +23,8 @@
 #include <filesystem>
 #include <map>
 #include <memory>
+#include <optional>
+#include <thread>
 
 #include <strata/render/gl/objects.hpp>
 #include <strata/render/terrain/screen_error.hpp>
@@ -158,7 +160,9 @@ BENCHMARK(BM_RingCpuPerFrame)->ArgName("dem")->Arg(512)->Arg(2048)->Unit(benchma
 
 // The synthetic DEM of size^2 cells as a tile store (tiles of 256 cells, 2^5..2^8), streamed
 // with windows of 512 texels in pages of 64 and a 64 MiB GPU budget.
-std::unique_ptr<TerrainScene> streamedSynthetic(int size, int uploadPages, size_t gpuBudget = size_t(64) << 20) {
+std::unique_ptr<TerrainScene> streamedSynthetic(int size, int uploadPages, size_t gpuBudget = size_t(64) << 20,
+                                                bool waitForDisk = true, double loadDelayMs = 0) {
+  strata::bench::glContext();  // also when no whole-DEM benchmark ran first
   const auto dir = std::filesystem::temp_directory_path() / ("strata_bench_stream_" + std::to_string(size));
   if (!std::filesystem::exists(dir / "manifest.toml")) {
     std::filesystem::remove_all(dir);
@@ -182,14 +186,17 @@ std::unique_ptr<TerrainScene> streamedSynthetic(int size, int uploadPages, size_
       std::exit(1);
     }
   }
-  auto store = strata::terrain::TileStore::open(dir, {.budgetBytes = size_t(256) << 20, .prefetch = false});
+  auto store = strata::terrain::TileStore::open(
+      dir, {.budgetBytes = size_t(256) << 20, .prefetch = false, .loadDelayMs = loadDelayMs});
   if (!store) {
     std::fprintf(stderr, "%s\n", store.message().c_str());
     std::exit(1);
   }
-  auto scene = TerrainScene::createStreamed(
-      std::move(store).value(),
-      {.clipSize = 512, .pageSize = 64, .uploadPagesPerFrame = uploadPages, .gpuBudgetBytes = gpuBudget});
+  auto scene = TerrainScene::createStreamed(std::move(store).value(), {.clipSize = 512,
+                                                                       .pageSize = 64,
+                                                                       .uploadPagesPerFrame = uploadPages,
+                                                                       .gpuBudgetBytes = gpuBudget,
+                                                                       .waitForDisk = waitForDisk});
   if (!scene) {
     std::fprintf(stderr, "%s\n", scene.message().c_str());
     std::exit(1);
@@ -284,6 +291,63 @@ BENCHMARK(BM_StreamRefill)
     ->UseManualTime()
     ->Unit(benchmark::kMillisecond)
     ->MinTime(0.3);
+
+// A move of one page with a COLD RAM cache (cleared before each move; the 4 MiB GPU budget
+// keeps no spare page either), so every entering page needs a tile decode: update() + glFinish
+// with waitForDisk (range(0) = 1: the frame decodes) or without (0: the store's loader decodes,
+// the frame copies what is ready). Untimed after each move, the loader is let catch up so that
+// every move starts from full windows; catch_up_ms is that wait (asynchronous mode). range(1):
+// milliseconds added to every tile decode (0: this machine's disk and page cache; 10: a slow
+// disk or network store).
+void BM_StreamColdRefill(benchmark::State& state) {
+  const bool wait = state.range(0) != 0;
+  auto scene = streamedSynthetic(2048, 1000, size_t(4) << 20, wait, double(state.range(1)));
+  auto* st = scene->streamed();
+  glm::dvec2 cell(512, 1024);
+  auto settle = [&]() -> strata::Status {
+    while (st->stats().pending > 0) {
+      STRATA_TRY_STATUS(st->update(cell));
+      if (st->stats().pending > 0) std::this_thread::sleep_for(std::chrono::microseconds(200));
+    }
+    return {};
+  };
+  if (auto r = settle(); !r) return state.SkipWithError(r.message().c_str());
+  glFinish();
+  const auto before = st->stats();
+  const auto loads0 = st->store().cacheStats();
+  double catchUpMs = 0, waiting = 0;
+  int step = 0;
+  for (auto _ : state) {
+    st->store().clearCache();
+    cell.x += ((step++ / 16) % 2 ? -64.0 : 64.0);
+    const auto c0 = std::chrono::steady_clock::now();
+    (void)st->update(cell);
+    glFinish();
+    const auto c1 = std::chrono::steady_clock::now();
+    state.SetIterationTime(std::chrono::duration<double>(c1 - c0).count());
+    waiting += st->stats().lastFramePagesWaiting;
+    if (auto r = settle(); !r) return state.SkipWithError(r.message().c_str());
+    catchUpMs += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - c1).count();
+  }
+  const auto after = st->stats();
+  const auto loads1 = st->store().cacheStats();
+  const double n = double(state.iterations());
+  state.SetLabel(wait ? "blocking" : "async");
+  state.counters["pages/move"] = double(after.pagesCopied - before.pagesCopied) / n;
+  state.counters["deferred/move"] = waiting / n;
+  state.counters["caller_decodes/move"] = double(loads1.syncLoads - loads0.syncLoads) / n;
+  state.counters["loader_decodes/move"] = double(loads1.requestLoads - loads0.requestLoads) / n;
+  state.counters["catch_up_ms"] = catchUpMs / n;
+}
+BENCHMARK(BM_StreamColdRefill)
+    ->ArgNames({"wait", "delay_ms"})
+    ->Args({1, 0})
+    ->Args({0, 0})
+    ->Args({1, 10})
+    ->Args({0, 10})
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(32);  // two sweeps of the stretch (a fixed count: the untimed catch-up dominates)
 
 }  // namespace
 int main(int argc, char** argv) { return strata::bench::benchGlMain(argc, argv); }

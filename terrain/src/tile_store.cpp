@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <bit>
 #include <cerrno>
+#include <chrono>
 #include <cmath>
 #include <condition_variable>
 #include <cstring>
@@ -18,6 +19,7 @@
 #include <sstream>
 #include <thread>
 #include <unordered_map>
+#include <unordered_set>
 
 #include <strata/core/files.hpp>
 #include <strata/core/log.hpp>
@@ -101,7 +103,11 @@ struct CacheKeyHash {
   }
 };
 
-// LRU of decoded tile levels under a byte budget. Thread-safe (the prefetcher inserts).
+// Who decoded a tile: a blocking read on the caller's thread, the neighbour prefetcher, or the
+// background loader serving tryReadWindow's requests.
+enum class LoadSource { Sync, Prefetch, Request };
+
+// LRU of decoded tile levels under a byte budget. Thread-safe (the loader thread inserts).
 class TileCache {
  public:
   explicit TileCache(size_t budget) : budget_(budget) {}
@@ -125,7 +131,8 @@ class TileCache {
     std::lock_guard lock(m_);
     return map_.count(k) != 0;
   }
-  void insert(const CacheKey& k, DecodedPtr tile, bool prefetched) {
+  void insert(const CacheKey& k, DecodedPtr tile, LoadSource source) {
+    const bool prefetched = source == LoadSource::Prefetch;
     std::lock_guard lock(m_);
     if (auto it = map_.find(k); it != map_.end()) {
       bytes_ -= it->second->tile->bytes;
@@ -133,6 +140,8 @@ class TileCache {
       map_.erase(it);
     }
     if (prefetched) ++stats_.prefetchLoads;
+    if (source == LoadSource::Sync) ++stats_.syncLoads;
+    if (source == LoadSource::Request) ++stats_.requestLoads;
     bytes_ += tile->bytes;
     lru_.push_front({k, std::move(tile), prefetched});
     map_[k] = lru_.begin();
@@ -205,7 +214,8 @@ Result<std::vector<char>> readTileBytes(const fs::path& dir, const TileRef& ref)
 }
 
 Result<DecodedPtr> loadTileLevel(const fs::path& dir, const std::vector<std::string>& fieldNames, const TileRef& ref,
-                                 int mip) {
+                                 int mip, double delayMs) {
+  if (delayMs > 0) std::this_thread::sleep_for(std::chrono::duration<double, std::milli>(delayMs));
   STRATA_TRY(auto bytes, readTileBytes(dir, ref));
   STRATA_TRY(auto fields, detail::decodeTileExrLevel(ref.file, bytes, fieldNames, mip));
   auto d = std::make_shared<Decoded>();
@@ -261,14 +271,23 @@ struct TileStore::Impl {
   CacheOptions cacheOptions;
   TileCache cache;
 
-  // Neighbour prefetch: one background thread decoding queued tile levels into the cache.
+  // The background loader: one thread decoding tile levels into the cache, requests (from
+  // tryReadWindow) first, then neighbour prefetches. Locking: the thread reads only `dir`,
+  // `fieldNames`, `cacheOptions` (never written after construction), the TileRef copied into
+  // its job and `cache` (its own mutex); `requests`, `requested`, `failed`, `queue`, `stopping`
+  // and `worker` are guarded by queueMutex. The manifest (`man`) is touched by the user's
+  // thread only.
   struct Job {
     TileRef ref;
     int mip = 0;
+    CacheKey key() const { return {ref.tx, ref.ty, ref.generation, mip}; }
   };
-  std::mutex queueMutex;
+  mutable std::mutex queueMutex;
   std::condition_variable queueCv;
-  std::deque<Job> queue;
+  std::deque<Job> requests;                                        // tryReadWindow's, in order
+  std::unordered_set<CacheKey, CacheKeyHash> requested;            // queued or being decoded
+  std::unordered_map<CacheKey, std::string, CacheKeyHash> failed;  // requests that failed, why
+  std::deque<Job> queue;                                           // neighbour prefetches
   bool stopping = false;
   std::thread worker;
 
@@ -294,23 +313,62 @@ struct TileStore::Impl {
     const auto& r = rec(tx, ty);
     return {tx, ty, r.generation, r.file, r.crc32, r.bytes};
   }
+  Result<DecodedPtr> load(const TileRef& r, int mip) const {
+    return loadTileLevel(dir, fieldNames, r, mip, cacheOptions.loadDelayMs);
+  }
 
   void workerLoop() {
     for (;;) {
       Job job;
+      bool isRequest = false;
       {
         std::unique_lock lock(queueMutex);
-        queueCv.wait(lock, [&] { return stopping || !queue.empty(); });
+        queueCv.wait(lock, [&] { return stopping || !requests.empty() || !queue.empty(); });
         if (stopping) return;
-        job = std::move(queue.front());
-        queue.pop_front();
+        isRequest = !requests.empty();
+        auto& from = isRequest ? requests : queue;
+        job = std::move(from.front());
+        from.pop_front();
       }
-      const CacheKey key{job.ref.tx, job.ref.ty, job.ref.generation, job.mip};
-      if (cache.contains(key)) continue;
-      // A failed prefetch (corrupt tile, file superseded by a commit) is not reported here: the
-      // demand read of that tile reports it.
-      if (auto d = loadTileLevel(dir, fieldNames, job.ref, job.mip)) cache.insert(key, std::move(*d), true);
+      const CacheKey key = job.key();
+      if (!cache.contains(key)) {
+        auto d = load(job.ref, job.mip);
+        if (d) {
+          cache.insert(key, std::move(*d), isRequest ? LoadSource::Request : LoadSource::Prefetch);
+        } else if (isRequest) {
+          std::lock_guard lock(queueMutex);
+          failed[key] = d.message();
+        }
+        // A failed prefetch (corrupt tile, file superseded by a commit) is not reported: the
+        // demand read of that tile reports it.
+      }
+      if (isRequest) {
+        // Erased after the insert: a reader that finds the key neither cached nor requested
+        // asks again, at worst decoding a tile twice, never waiting for one nobody loads.
+        std::lock_guard lock(queueMutex);
+        requested.erase(key);
+      }
     }
+  }
+  // Precondition: queueMutex held.
+  void startWorker() {
+    if (!worker.joinable()) worker = std::thread([this] { workerLoop(); });
+  }
+
+  // Asks the loader for level `mip` of tile (tx, ty) unless it is already asked for; fails with
+  // the loader's message if an earlier request of it failed.
+  Status request(int tx, int ty, int mip) {
+    Job job{ref(tx, ty), mip};
+    const CacheKey key = job.key();
+    {
+      std::lock_guard lock(queueMutex);
+      if (auto it = failed.find(key); it != failed.end()) return fail(it->second);
+      if (!requested.insert(key).second) return {};
+      requests.push_back(std::move(job));
+      startWorker();
+    }
+    queueCv.notify_one();
+    return {};
   }
 
   void prefetchAround(int tx, int ty, int need) {
@@ -333,25 +391,32 @@ struct TileStore::Impl {
       for (auto& j : jobs) queue.push_back(std::move(j));
       // Old requests are for where the reader was, not where it is: keep the queue short.
       while (queue.size() > 32) queue.pop_front();
-      if (!worker.joinable()) worker = std::thread([this] { workerLoop(); });
+      startWorker();
     }
     queueCv.notify_one();
   }
 
   // The level of tile (tx, ty) closest to resolution 2^need from above (its finest when coarser).
-  Result<DecodedPtr> get(int tx, int ty, int need, bool prefetch) {
+  // With `missing` set (tryReadWindow), a tile level not in RAM is requested instead of read:
+  // *missing becomes true and the result is null.
+  Result<DecodedPtr> get(int tx, int ty, int need, bool prefetch, bool* missing = nullptr) {
     const auto& r = rec(tx, ty);
     const int mip = std::max(0, r.exp - need);
     const CacheKey key{tx, ty, r.generation, mip};
     if (auto hit = cache.lookup(key)) return hit;
-    STRATA_TRY(DecodedPtr d, loadTileLevel(dir, fieldNames, ref(tx, ty), mip));
-    cache.insert(key, d, false);
+    if (missing) {
+      STRATA_TRY_STATUS(request(tx, ty, mip));
+      *missing = true;
+      return DecodedPtr();
+    }
+    STRATA_TRY(DecodedPtr d, load(ref(tx, ty), mip));
+    cache.insert(key, d, LoadSource::Sync);
     if (prefetch && cacheOptions.prefetch) prefetchAround(tx, ty, need);
     return d;
   }
 
   // Copies rows [sy, sy+h) x cols [sx, sx+w) of level `lod` (inside the level grid) into dst at (dx, dy).
-  Status readRect(int field, int lod, int sx, int sy, int w, int h, Grid<float>& dst, int dx, int dy) {
+  Status readRect(int field, int lod, int sx, int sy, int w, int h, Grid<float>& dst, int dx, int dy, bool* missing) {
     const int tileCells = footprint >> lod;
     const int need = maxExp() - lod;
     for (int ty = sy / tileCells; ty <= (sy + h - 1) / tileCells; ++ty) {
@@ -366,7 +431,8 @@ struct TileStore::Impl {
           continue;
         }
         const int rep = r.exp >= need ? 1 : 1 << (need - r.exp);  // piecewise-constant upsampling
-        STRATA_TRY(DecodedPtr d, get(tx, ty, need, true));
+        STRATA_TRY(DecodedPtr d, get(tx, ty, need, true, missing));
+        if (!d) continue;  // requested: the read is not complete anyway
         const auto& g = d->fields[size_t(field)];
         for (int y = y0; y < y1; ++y) {
           const float* src = &g.data[g.index(0, (y - ty * tileCells) / rep)];
@@ -575,7 +641,28 @@ std::pair<float, float> TileStore::globalRange(int field) const {
   return {impl_->man.rangeLo[size_t(field)], impl_->man.rangeHi[size_t(field)]};
 }
 
-Result<Grid<float>> TileStore::readWindow(int field, Window w, int lod) {
+Result<Grid<float>> TileStore::readWindow(int field, Window w, int lod) { return read(field, w, lod, nullptr); }
+
+Result<std::optional<Grid<float>>> TileStore::tryReadWindow(int field, Window w, int lod) {
+  bool missing = false;
+  STRATA_TRY(auto g, read(field, w, lod, &missing));
+  if (missing) return std::optional<Grid<float>>();
+  return std::optional<Grid<float>>(std::move(g));
+}
+
+void TileStore::clearRequests() {
+  auto& I = *impl_;
+  std::lock_guard lock(I.queueMutex);
+  for (const auto& j : I.requests) I.requested.erase(j.key());
+  I.requests.clear();
+}
+
+int TileStore::requestsPending() const {
+  std::lock_guard lock(impl_->queueMutex);
+  return int(impl_->requested.size());
+}
+
+Result<Grid<float>> TileStore::read(int field, Window w, int lod, bool* missing) {
   auto& I = *impl_;
   if (field < 0 || size_t(field) >= I.nf()) return fail(I.dir.string() + ": no field " + std::to_string(field));
   if (lod < 0 || lod > maxLod()) {
@@ -588,7 +675,7 @@ Result<Grid<float>> TileStore::readWindow(int field, Window w, int lod) {
     const int x0 = std::max(0, w.x), y0 = std::max(0, w.y);
     const int x1 = std::min(lw, w.x + w.width), y1 = std::min(lh, w.y + w.height);
     if (x0 < x1 && y0 < y1)
-      STRATA_TRY_STATUS(I.readRect(field, lod, x0, y0, x1 - x0, y1 - y0, out, x0 - w.x, y0 - w.y));
+      STRATA_TRY_STATUS(I.readRect(field, lod, x0, y0, x1 - x0, y1 - y0, out, x0 - w.x, y0 - w.y, missing));
     return out;
   }
   // Global: three bands of rows. Rows above the north pole (y < 0) continue down the meridian
@@ -613,7 +700,7 @@ Result<Grid<float>> TileStore::readWindow(int field, Window w, int lod) {
     for (int i = 0; i < w.width;) {
       const int sx = (((w.x + i + shift) % lw) + lw) % lw;
       const int len = std::min(w.width - i, lw - sx);
-      STRATA_TRY_STATUS(I.readRect(field, lod, sx, s0, len, rows, tmp, i, 0));
+      STRATA_TRY_STATUS(I.readRect(field, lod, sx, s0, len, rows, tmp, i, 0, missing));
       i += len;
     }
     for (int j = b.outY0; j < b.outY1; ++j) {

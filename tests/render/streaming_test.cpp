@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -417,6 +418,106 @@ TEST_F(GlTest, ZeroUploadBudgetDrawsFromCoarserLevelsAndThenConverges) {
       << "\nframes_to_converge " << frames << "\ncoarse_only_vs_full elev_mean_m " << coarseOnly.elevMeanM
       << " elev_max_m " << coarseOnly.elevMaxM << "\nconverged_vs_full max_channel " << converged.maxChannel
       << " elev_max_m " << converged.elevMaxM << "\ngpu_bytes " << s->stats().gpuBytes << " budget " << budget << "\n";
+}
+
+double msSince(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+TEST_F(GlTest, ALateTileNeverStallsAFrameAndTheRenderConverges) {
+  // Every tile decode sleeps kDelayMs (a slow disk). With waitForDisk off, draw() decodes
+  // nothing on its own thread: pages whose tiles are not in RAM are requested from the store's
+  // loader and coarser levels stand in; once the loader has caught up the render is exactly the
+  // one with everything resident. The same scene with waitForDisk on waits for every decode.
+  constexpr double kDelayMs = 100;
+  auto slowStore = [&] {
+    auto s =
+        TileStore::open(canyonStore(), {.budgetBytes = size_t(16) << 20, .prefetch = false, .loadDelayMs = kDelayMs});
+    STRATA_CHECK(bool(s)) << s.message();
+    return std::move(s).value();
+  };
+  StreamParams params{.clipSize = 128, .pageSize = 32, .uploadPagesPerFrame = 1000, .waitForDisk = false};
+  auto scene = TerrainScene::createStreamed(slowStore(), params);
+  ASSERT_TRUE(scene) << scene.message();
+  auto full = TerrainScene::createStreamed(openStore(), {.clipSize = 128, .pageSize = 32, .uploadPagesPerFrame = 1000});
+  ASSERT_TRUE(full) << full.message();
+  auto ring = RingRenderer::create({.circles = 96, .rangeM = 30000});
+  ASSERT_TRUE(ring) << ring.message();
+  const int w = 160, h = 100;
+  auto target = OffscreenTarget::create(w, h), ref = OffscreenTarget::create(w, h);
+  ASSERT_TRUE(target && ref);
+  Shading magenta;
+  magenta.sky = {1, 0, 1, 1};
+  const auto& c = scene->georef().transform.c;
+  CameraPose cam{.lon = c[0] + 256 * c[1], .lat = c[3] + 256 * c[5], .heightM = 0, .headingDeg = 200, .pitchDeg = -25};
+  cam.heightM = full->heightAt(cam.lon, cam.lat) + 300;
+  // Warm-up (programs compiled, both targets drawn once), then a frame with nothing to load.
+  ASSERT_TRUE((*ring)->draw(*full, cam, magenta, *target));
+  auto t0 = std::chrono::steady_clock::now();
+  ASSERT_TRUE((*ring)->draw(*full, cam, magenta, *ref));
+  const double residentMs = msSince(t0);
+
+  // A cold RAM cache: every page of the windows needs a decode.
+  auto* s = scene->streamed();
+  s->store().clearCache();
+  s->store().resetCacheStats();
+  t0 = std::chrono::steady_clock::now();
+  ASSERT_TRUE((*ring)->draw(*scene, cam, magenta, *target));
+  const double firstMs = msSince(t0);
+  EXPECT_EQ(s->store().cacheStats().syncLoads, 0u);
+  EXPECT_EQ(s->stats().lastFramePagesCopied, 0);
+  const int total = s->stats().pending;
+  EXPECT_EQ(s->stats().lastFramePagesWaiting, total);
+  EXPECT_GT(total, 0);
+  EXPECT_GT(s->store().requestsPending(), 0);
+  // The cold frame costs less than ONE decode more than a frame with everything resident (the
+  // margin absorbs llvmpipe's frame-time noise on a loaded machine; measured: within ~10 ms),
+  // where the blocking frame below costs kDelayMs per tile level it decodes (5 here).
+  EXPECT_LT(firstMs, residentMs + kDelayMs);
+  EXPECT_GT(expectNoHole(*scene, cam, *target, 0.95 * 30000), long(w * h / 3));
+
+  // Frames go on while the loader works: none decodes, none has a hole.
+  int frames = 1;
+  double worstMs = firstMs;
+  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  while (s->stats().pending > 0 && std::chrono::steady_clock::now() < until) {
+    t0 = std::chrono::steady_clock::now();
+    ASSERT_TRUE((*ring)->draw(*scene, cam, magenta, *target));
+    worstMs = std::max(worstMs, msSince(t0));
+    ++frames;
+    expectNoHole(*scene, cam, *target, 0.95 * 30000);
+  }
+  ASSERT_EQ(s->stats().pending, 0) << "the loader did not catch up in 30 s";
+  const auto st = s->store().cacheStats();
+  EXPECT_EQ(st.syncLoads, 0u);
+  EXPECT_GT(st.requestLoads, 0u);
+  const Diff converged = compare(*target, *ref, 0);
+  EXPECT_EQ(converged.maxChannel, 0);
+  EXPECT_EQ(converged.elevMaxM, 0.0);
+
+  // The blocking mode on the same cold cache: one frame, full resolution, waiting for each decode.
+  params.waitForDisk = true;
+  auto blocking = TerrainScene::createStreamed(slowStore(), params);
+  ASSERT_TRUE(blocking) << blocking.message();
+  blocking->streamed()->store().clearCache();
+  blocking->streamed()->store().resetCacheStats();
+  t0 = std::chrono::steady_clock::now();
+  ASSERT_TRUE((*ring)->draw(*blocking, cam, magenta, *target));
+  const double blockingMs = msSince(t0);
+  const uint64_t decodes = blocking->streamed()->store().cacheStats().syncLoads;
+  EXPECT_EQ(blocking->streamed()->stats().pending, 0);
+  EXPECT_EQ(decodes, st.requestLoads);  // the same tile levels, decoded on the caller's thread
+  EXPECT_GE(blockingMs, double(decodes) * kDelayMs);
+  EXPECT_GE(decodes, 2u);  // so that the contrast with the asynchronous frame is at least 2 decodes
+  const Diff same = compare(*target, *ref, 0);
+  EXPECT_EQ(same.maxChannel, 0);
+  EXPECT_EQ(same.elevMaxM, 0.0);
+  std::ofstream(test::outputDir("render") / "streaming_async.txt")
+      << "# cold RAM cache, every tile decode delayed " << kDelayMs
+      << " ms; Grand Canyon store, N=128, P=32, ring 160x100\nresident_frame_ms " << residentMs
+      << "\npages_pending_at_start " << total << "\nasync_first_frame_ms " << firstMs << "\nasync_worst_frame_ms "
+      << worstMs << "\nasync_frames_to_converge " << frames << "\ntile_levels_decoded_by_loader " << st.requestLoads
+      << "\nblocking_first_frame_ms " << blockingMs << "\nblocking_decodes_on_caller " << decodes << "\n";
 }
 
 // ETOPO20 (1080 x 540 cells of 20 arc-minutes) as a global store: tiles of 128 cells, 2^4..2^7.

@@ -306,7 +306,7 @@ TEST_F(ViewerGpu, PlanetaryPickFindsTheGroundPointOnTheBody) {
   };
   for (const Site& b : {Site{"moon/LDEM_4.LBL", 20.0, 10.0}, Site{"earth/etopo20.tif", -30.0, 40.0}}) {
     SCOPED_TRACE(b.path);
-    auto dem = test::readDemLonLat(test::dataPath(b.path));
+    auto dem = gis::readDemLonLat(test::dataPath(b.path));
     ASSERT_TRUE(dem) << dem.message();
     ViewerOptions options;
     options.width = 101;

@@ -407,6 +407,68 @@ TEST(TileCache, PrefetchesTheNeighboursOfAMiss) {
   EXPECT_EQ(st.hits, 9u);  // the 8 prefetched neighbours and the centre tile read first
 }
 
+// Waits (5 s at most: ample for a few small tiles on a loaded machine) until `store` has no
+// request left.
+void waitForLoader(TileStore& store) {
+  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+  while (store.requestsPending() > 0 && std::chrono::steady_clock::now() < until) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+}
+
+TEST(TileCache, TryReadWindowNeverReadsAFileOnTheCallersThread) {
+  const auto dir = test::tempDir("store");
+  SyntheticScene s = smallScene();
+  s.roughFraction = 1.0f;
+  ingestScene(dir, 3 * kFootprint, 2 * kFootprint, s);
+  // Every decode sleeps 50 ms: a caller that waited for one would take at least that long.
+  const double delayMs = 50;
+  auto store = TileStore::open(dir, {.budgetBytes = size_t(64) << 20, .prefetch = false, .loadDelayMs = delayMs});
+  ASSERT_TRUE(store);
+  const Window w{kFootprint / 2, kFootprint / 2, 2 * kFootprint, kFootprint};  // over 3 x 2 tiles
+  const auto t0 = std::chrono::steady_clock::now();
+  auto first = store->tryReadWindow(0, w, 0);
+  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  ASSERT_TRUE(first) << first.message();
+  EXPECT_FALSE(first->has_value());
+  EXPECT_LT(ms, delayMs);                  // no decode on this thread (measured: well under 1 ms)
+  EXPECT_EQ(store->requestsPending(), 6);  // every missing tile level is asked for at once
+  // Asking again while the loader works queues nothing twice.
+  ASSERT_TRUE(store->tryReadWindow(0, w, 0));
+  EXPECT_LE(store->requestsPending(), 6);
+  waitForLoader(*store);
+  ASSERT_EQ(store->requestsPending(), 0);
+  auto ready = store->tryReadWindow(0, w, 0);
+  ASSERT_TRUE(ready && ready->has_value());
+  auto blocking = store->readWindow(0, w, 0);
+  ASSERT_TRUE(blocking);
+  EXPECT_EQ((*ready)->data, blocking->data);
+  const auto st = store->cacheStats();
+  EXPECT_EQ(st.syncLoads, 0u);     // nothing decoded on the caller's thread
+  EXPECT_EQ(st.requestLoads, 6u);  // each tile level decoded once, by the loader
+  // clearRequests drops what the loader has not started.
+  store->clearCache();
+  ASSERT_TRUE(store->tryReadWindow(0, {0, 0, 3 * kFootprint, 2 * kFootprint}, 0));
+  store->clearRequests();
+  EXPECT_LE(store->requestsPending(), 1);  // at most the one being decoded
+}
+
+TEST(TileStore, TryReadWindowReportsACorruptTileOnceTheLoaderFoundIt) {
+  const auto dir = test::tempDir("store");
+  auto store = ingestScene(dir, 2 * kFootprint, kFootprint, smallScene());
+  const auto file = dir / store.tile(1, 0).file;
+  fs::resize_file(file, fs::file_size(file) / 2);
+  auto reopened = TileStore::open(dir, {.prefetch = false});
+  ASSERT_TRUE(reopened);
+  auto first = reopened->tryReadWindow(0, {kFootprint, 0, 4, 4}, 0);
+  ASSERT_TRUE(first) << first.message();
+  EXPECT_FALSE(first->has_value());
+  waitForLoader(*reopened);
+  auto bad = reopened->tryReadWindow(0, {kFootprint, 0, 4, 4}, 0);
+  ASSERT_FALSE(bad);
+  EXPECT_NE(bad.message().find(store.tile(1, 0).file), std::string::npos) << bad.message();
+}
+
 // Cell values of field 0 over the whole store.
 std::vector<float> allCells(TileStore& s) {
   auto g = s.readWindow(0, {0, 0, s.width(), s.height()}, 0);

@@ -32,15 +32,23 @@ Result<GpuTileCache> GpuTileCache::create(strata::terrain::TileStore& store, con
   return c;
 }
 
-Result<int> GpuTileCache::acquire(const PageKey& key) {
+Result<int> GpuTileCache::acquire(const PageKey& key, bool wait) {
   if (auto it = map_.find(key); it != map_.end()) {
     ++stats_.hits;
     lru_.splice(lru_.begin(), lru_, it->second.pos);
     return it->second.layer;
   }
-  ++stats_.misses;
   const int p = options_.pageSize;
-  STRATA_TRY(auto grid, store_->readWindow(key.field, {key.x * p, key.y * p, p, p}, key.lod));
+  const strata::terrain::Window window{key.x * p, key.y * p, p, p};
+  gis::Grid<float> grid;
+  if (wait) {
+    STRATA_TRY(grid, store_->readWindow(key.field, window, key.lod));
+  } else {
+    STRATA_TRY(auto ready, store_->tryReadWindow(key.field, window, key.lod));
+    if (!ready) return -1;  // requested; counted as a miss when it is uploaded
+    grid = std::move(*ready);
+  }
+  ++stats_.misses;
   STRATA_CHECK(grid.width == p && grid.height == p) << "readWindow returned " << grid.width << "x" << grid.height;
   if (options_.noDataFill) {
     for (float& v : grid.data) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <string>
 
 #include <strata/core/check.hpp>
@@ -165,17 +166,28 @@ Status StreamedElevation::update(glm::dvec2 cell) {
     if (a.level != b.level) return a.level > b.level;
     return distance(a) < distance(b);
   });
-  const int count = std::min(int(pending_.size()), params_.uploadPagesPerFrame);
-  for (int i = 0; i < count; ++i) {
-    const Pending q = pending_[size_t(i)];
-    STRATA_TRY(const int layer, cache_->acquire({field_, q.px, q.py, q.level}));
+  // Requests of earlier frames are for where the viewer was: ask again, in this frame's order.
+  if (!params_.waitForDisk) store_->clearRequests();
+  int count = 0;
+  size_t next = 0;
+  std::vector<Pending> waiting;
+  for (; next < pending_.size() && count < params_.uploadPagesPerFrame; ++next) {
+    const Pending q = pending_[next];
+    STRATA_TRY(const int layer, cache_->acquire({field_, q.px, q.py, q.level}, params_.waitForDisk));
+    if (layer < 0) {  // its tiles are being decoded: a coarser level stands in meanwhile
+      waiting.push_back(q);
+      continue;
+    }
     const int k = slots();
     glCopyImageSubData(cache_->pages().id(), GL_TEXTURE_2D_ARRAY, 0, 0, 0, layer, clip_.id(), GL_TEXTURE_2D_ARRAY, 0,
                        wrap(q.px, k) * p, wrap(q.py, k) * p, q.level, p, p, 1);
     flagsCpu_[flagIndex(q.level, q.px, q.py)] = 1u;
     flagsDirty_ = true;
+    ++count;
   }
-  pending_.erase(pending_.begin(), pending_.begin() + count);
+  stats_.lastFramePagesWaiting = int(waiting.size());
+  waiting.insert(waiting.end(), pending_.begin() + std::ptrdiff_t(next), pending_.end());
+  pending_ = std::move(waiting);
   stats_.pagesCopied += uint64_t(count);
   stats_.lastFramePagesCopied = count;
   if (flagsDirty_) {
@@ -188,7 +200,14 @@ Status StreamedElevation::update(glm::dvec2 cell) {
 }
 
 std::array<float, 4> StreamedElevation::cellQuad(int i, int j) {
-  auto read = store_->readWindow(field_, {i, j, 2, 2}, 0);
+  // Without waitForDisk a tile not in RAM yet is requested, and the coarse level answers
+  // meanwhile (draw() asks for the ground under the viewer every frame).
+  std::optional<gis::Grid<float>> read;
+  if (params_.waitForDisk) {
+    if (auto r = store_->readWindow(field_, {i, j, 2, 2}, 0)) read = std::move(*r);
+  } else if (auto r = store_->tryReadWindow(field_, {i, j, 2, 2}, 0)) {
+    read = std::move(*r);
+  }
   std::array<float, 4> q{};
   if (read) {
     for (size_t k = 0; k < 4; ++k) q[k] = std::isnan(read->data[k]) ? minM_ : read->data[k];

@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -75,6 +76,7 @@ struct TileRecord {
 struct CacheOptions {
   size_t budgetBytes = size_t(256) << 20;  ///< decoded tiles kept in RAM (bytes)
   bool prefetch = true;                    ///< load the 8 neighbours of a missed tile in the background
+  double loadDelayMs = 0;                  ///< added to every tile decode (a slow disk, for tests and benchmarks)
 };
 
 /// Demand lookups of the decoded-tile cache since open (or resetCacheStats()).
@@ -82,6 +84,8 @@ struct CacheStats {
   uint64_t hits = 0, misses = 0;
   uint64_t prefetchLoads = 0;  ///< tiles decoded by the prefetcher
   uint64_t prefetchHits = 0;   ///< demand hits on a tile the prefetcher loaded
+  uint64_t syncLoads = 0;      ///< tiles decoded by readWindow on the calling thread (a wait for the disk)
+  uint64_t requestLoads = 0;   ///< tiles decoded by the background loader for tryReadWindow
   uint64_t evictions = 0;
   size_t bytes = 0;  ///< decoded bytes held now
   double hitRate() const { return hits + misses ? double(hits) / double(hits + misses) : 0.0; }
@@ -138,6 +142,16 @@ class TileStore {
   /// covers. Planar: cells outside the grid are NaN. Global: x wraps at the seam and rows beyond
   /// a pole continue on the other side of it. Fails naming the tile file when a tile is corrupt.
   Result<gis::Grid<float>> readWindow(int field, Window window, int lod = 0);
+  /// readWindow without waiting for the disk: the window if every tile level it needs is decoded
+  /// in RAM, else nullopt, after asking the background loader for each missing one. Requests are
+  /// served in order, before neighbour prefetches, one at a time, and decode into the RAM cache
+  /// (a later call reads them, unless the cache evicted them meanwhile). Fails like readWindow on
+  /// bad arguments, and naming the tile once the loader found it corrupt.
+  Result<std::optional<gis::Grid<float>>> tryReadWindow(int field, Window window, int lod = 0);
+  /// Drops the loader's requests that it has not started (the reader moved on; it asks again).
+  void clearRequests();
+  /// Tile levels requested and not yet decoded (queued or being decoded).
+  int requestsPending() const;
   /// Writes base-grid cells at (x, y) of field `field` (inside the grid). The affected tiles are
   /// re-evaluated and rewritten (as new files); if the global range moves, every tile whose
   /// metric changes is resampled. Nothing is visible to other openers before commit().
@@ -173,6 +187,8 @@ class TileStore {
  private:
   struct Impl;
   explicit TileStore(std::unique_ptr<Impl> impl);
+  // readWindow (missing null) or tryReadWindow (missing set when a tile level was requested).
+  Result<gis::Grid<float>> read(int field, Window window, int lod, bool* missing);
   std::unique_ptr<Impl> impl_;
 };
 

@@ -2,7 +2,8 @@
 // The GPU side of the terrain store's caches: square pages of one field at one level of detail,
 // resident in one r32f 2D texture array (one page per layer), with an LRU over the pages and a
 // byte budget. Pages are uploaded from strata::terrain::TileStore::readWindow, i.e. from the
-// store's RAM cache (which decodes a tile file on its own miss); nothing here reads the disk.
+// store's RAM cache (which decodes a tile file on its own miss), or without waiting through
+// tryReadWindow (whose background loader decodes it); nothing here reads the disk.
 // docs/render-rings.md, "Streaming".
 //
 // Pages: page (x, y) of level `lod` holds the level-lod cells [x P, x P + P) x [y P, y P + P)
@@ -55,8 +56,10 @@ class GpuTileCache {
 
   /// The layer holding `key`, uploading the page on a miss (evicting the least recently used
   /// page when full). A hit or an upload makes the page the most recently used. Fails (naming
-  /// the tile) when the store cannot read it.
-  Result<int> acquire(const PageKey& key);
+  /// the tile) when the store cannot read it. `wait` false: never waits for the disk; a page
+  /// whose tiles are not decoded in RAM yet is requested from the store's background loader
+  /// (TileStore::tryReadWindow) and -1 returned.
+  Result<int> acquire(const PageKey& key, bool wait = true);
   /// The layer holding `key` if resident, else -1; changes neither the LRU order nor the stats.
   int find(const PageKey& key) const;
 

@@ -35,15 +35,20 @@ struct StreamParams {
   int uploadPagesPerFrame = 16;              ///< pages copied into the stack per frame at most (0: none)
   size_t gpuBudgetBytes = size_t(96) << 20;  ///< stack + coarse level + page flags + GPU tile cache (bytes)
   std::string field = "bedrock";             ///< the store field drawn as elevation (m)
+  /// true: a page whose tiles are not decoded in the store's RAM cache is read from disk in the
+  /// frame (offline renders: every frame copies its full budget). false: it is requested from
+  /// the store's background loader and copied on a later frame; a frame never waits for the disk.
+  bool waitForDisk = true;
 };
 
 /// What streaming did since creation.
 struct StreamStats {
-  uint64_t frames = 0;           ///< update() calls
-  uint64_t pagesCopied = 0;      ///< pages copied from the GPU tile cache into the stack
-  int lastFramePagesCopied = 0;  ///< in the latest update()
-  int pending = 0;               ///< pages of the current windows not resident yet
-  size_t gpuBytes = 0;           ///< all GPU storage of the streamed elevation (<= budget)
+  uint64_t frames = 0;            ///< update() calls
+  uint64_t pagesCopied = 0;       ///< pages copied from the GPU tile cache into the stack
+  int lastFramePagesCopied = 0;   ///< in the latest update()
+  int lastFramePagesWaiting = 0;  ///< pages passed over in the latest update(): tiles not in RAM yet (requested)
+  int pending = 0;                ///< pages of the current windows not resident yet
+  size_t gpuBytes = 0;            ///< all GPU storage of the streamed elevation (<= budget)
   size_t gpuBudgetBytes = 0;
   GpuCacheStats cache;  ///< the GPU tile cache's own counters
 };
@@ -60,7 +65,9 @@ class StreamedElevation {
 
   /// Centres the windows on the viewer at base-grid position `cell` (cells from the grid's
   /// top-left corner) and copies up to the per-frame budget of the pages still missing, coarse
-  /// levels first, then nearest first. Never does more than the budget: the rest waits.
+  /// levels first, then nearest first. Never does more than the budget: the rest waits. Without
+  /// waitForDisk a page whose tiles are not decoded yet is requested and passed over (the next
+  /// one takes its place in the budget), so update() never decodes a tile file.
   Status update(glm::dvec2 cell);
   void setUploadPagesPerFrame(int pages) { params_.uploadPagesPerFrame = pages; }
 
@@ -84,7 +91,8 @@ class StreamedElevation {
   float minElevationM() const { return minM_; }
   float maxElevationM() const { return maxM_; }
   /// The four base-grid samples (i, j), (i+1, j), (i, j+1), (i+1, j+1), NaN filled with the
-  /// minimum, through the store's RAM cache (the coarse level's samples if a tile cannot be read).
+  /// minimum, through the store's RAM cache (the coarse level's samples if a tile cannot be read,
+  /// or, without waitForDisk, while its tile is being decoded).
   std::array<float, 4> cellQuad(int i, int j);
 
   StreamStats stats() const;
