@@ -29,7 +29,7 @@ packages=(
   # images, float fields, tiled storage
   libopenimageio-dev openimageio-tools libopenexr-dev
   # GL 4.5 through EGL (Mesa llvmpipe without a GPU), windows through GLFW (X11 -> Xvfb in tests)
-  libegl-dev libegl-mesa0 libgl1-mesa-dri libepoxy-dev libglfw3-dev libglm-dev xvfb
+  libegl-dev libegl-mesa0 libgl1-mesa-dri libepoxy-dev libglfw3-dev libglm-dev xvfb xauth
   # the viewer's HUD font (stb_easy_font.h: a header-only vector font, no font file)
   libstb-dev
   # command line, scenario files
