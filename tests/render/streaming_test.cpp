@@ -369,6 +369,33 @@ long expectNoHole(const TerrainScene& scene, const CameraPose& cam, const Offscr
   return checked;
 }
 
+// The oblique view of the convergence tests: a 96-circle ring whose disc reaches 30 km from the
+// DEM's centre (inside the 90 x 111 km grid in every direction), two 160 x 100 targets (the
+// streamed render and the reference), a magenta sky, and a camera 300 m above cell (256, 256) of
+// `heights` looking SSW.
+struct ObliqueRig {
+  static constexpr int kW = 160, kH = 100;
+  std::unique_ptr<RingRenderer> ring;
+  OffscreenTarget target, ref;
+  Shading magenta;
+  CameraPose cam;
+};
+
+void makeObliqueRig(const TerrainScene& heights, ObliqueRig& rig) {
+  auto ring = RingRenderer::create({.circles = 96, .rangeM = 30000});
+  ASSERT_TRUE(ring) << ring.message();
+  rig.ring = std::move(ring).value();
+  auto target = OffscreenTarget::create(ObliqueRig::kW, ObliqueRig::kH);
+  auto ref = OffscreenTarget::create(ObliqueRig::kW, ObliqueRig::kH);
+  ASSERT_TRUE(target && ref);
+  rig.target = std::move(target).value();
+  rig.ref = std::move(ref).value();
+  rig.magenta.sky = {1, 0, 1, 1};
+  const auto& c = heights.georef().transform.c;
+  rig.cam = {.lon = c[0] + 256 * c[1], .lat = c[3] + 256 * c[5], .heightM = 0, .headingDeg = 200, .pitchDeg = -25};
+  rig.cam.heightM = heights.heightAt(rig.cam.lon, rig.cam.lat) + 300;
+}
+
 TEST_F(GlTest, ZeroUploadBudgetDrawsFromCoarserLevelsAndThenConverges) {
   const size_t budget = size_t(1) << 20;
   const StreamParams params{.clipSize = 128, .pageSize = 32, .uploadPagesPerFrame = 0, .gpuBudgetBytes = budget};
@@ -376,26 +403,19 @@ TEST_F(GlTest, ZeroUploadBudgetDrawsFromCoarserLevelsAndThenConverges) {
   ASSERT_TRUE(scene) << scene.message();
   auto full = TerrainScene::createStreamed(openStore(), {.clipSize = 128, .pageSize = 32, .uploadPagesPerFrame = 1000});
   ASSERT_TRUE(full) << full.message();
-  // The disc reaches 30 km from the DEM's centre: inside the 90 x 111 km grid in every direction.
-  auto ring = RingRenderer::create({.circles = 96, .rangeM = 30000});
-  ASSERT_TRUE(ring) << ring.message();
-  const int w = 160, h = 100;
-  auto target = OffscreenTarget::create(w, h), ref = OffscreenTarget::create(w, h);
-  ASSERT_TRUE(target && ref);
-  Shading magenta;
-  magenta.sky = {1, 0, 1, 1};
-  const auto& c = scene->georef().transform.c;
-  CameraPose cam{.lon = c[0] + 256 * c[1], .lat = c[3] + 256 * c[5], .heightM = 0, .headingDeg = 200, .pitchDeg = -25};
-  cam.heightM = scene->heightAt(cam.lon, cam.lat) + 300;
-  ASSERT_TRUE((*ring)->draw(*scene, cam, magenta, *target));
+  ObliqueRig rig;
+  ASSERT_NO_FATAL_FAILURE(makeObliqueRig(*scene, rig));
+  auto& [ring, target, ref, magenta, cam] = rig;
+  const int w = ObliqueRig::kW, h = ObliqueRig::kH;
+  ASSERT_TRUE(ring->draw(*scene, cam, magenta, target));
   auto* s = scene->streamed();
   EXPECT_EQ(s->stats().pagesCopied, 0u);
   const int total = s->stats().pending;
   EXPECT_GT(total, 0);
   // A third of the image must be terrain, and none of it is a hole.
-  EXPECT_GT(expectNoHole(*scene, cam, *target, 0.95 * 30000), long(w * h / 3));
-  ASSERT_TRUE((*ring)->draw(*full, cam, magenta, *ref));
-  const Diff coarseOnly = compare(*target, *ref, 0);
+  EXPECT_GT(expectNoHole(*scene, cam, target, 0.95 * 30000), long(w * h / 3));
+  ASSERT_TRUE(ring->draw(*full, cam, magenta, ref));
+  const Diff coarseOnly = compare(target, ref, 0);
   EXPECT_GT(coarseOnly.elevMaxM, 0.0);  // the coarse stand-in is not the full render
 
   // Four pages a frame: the stack fills in ceil(total / 4) frames, every one of them complete,
@@ -403,14 +423,14 @@ TEST_F(GlTest, ZeroUploadBudgetDrawsFromCoarserLevelsAndThenConverges) {
   s->setUploadPagesPerFrame(4);
   int frames = 0;
   while (s->stats().pending > 0 && frames < 100) {
-    ASSERT_TRUE((*ring)->draw(*scene, cam, magenta, *target));
+    ASSERT_TRUE(ring->draw(*scene, cam, magenta, target));
     ++frames;
     EXPECT_LE(s->stats().lastFramePagesCopied, 4);
     EXPECT_LE(s->stats().gpuBytes, budget);
-    expectNoHole(*scene, cam, *target, 0.95 * 30000);
+    expectNoHole(*scene, cam, target, 0.95 * 30000);
   }
   EXPECT_EQ(frames, (total + 3) / 4);
-  const Diff converged = compare(*target, *ref, 0);
+  const Diff converged = compare(target, ref, 0);
   EXPECT_EQ(converged.maxChannel, 0);
   EXPECT_EQ(converged.elevMaxM, 0.0);
   std::ofstream(test::outputDir("render") / "streaming_budget.txt")
@@ -441,20 +461,14 @@ TEST_F(GlTest, ALateTileNeverStallsAFrameAndTheRenderConverges) {
   ASSERT_TRUE(scene) << scene.message();
   auto full = TerrainScene::createStreamed(openStore(), {.clipSize = 128, .pageSize = 32, .uploadPagesPerFrame = 1000});
   ASSERT_TRUE(full) << full.message();
-  auto ring = RingRenderer::create({.circles = 96, .rangeM = 30000});
-  ASSERT_TRUE(ring) << ring.message();
-  const int w = 160, h = 100;
-  auto target = OffscreenTarget::create(w, h), ref = OffscreenTarget::create(w, h);
-  ASSERT_TRUE(target && ref);
-  Shading magenta;
-  magenta.sky = {1, 0, 1, 1};
-  const auto& c = scene->georef().transform.c;
-  CameraPose cam{.lon = c[0] + 256 * c[1], .lat = c[3] + 256 * c[5], .heightM = 0, .headingDeg = 200, .pitchDeg = -25};
-  cam.heightM = full->heightAt(cam.lon, cam.lat) + 300;
+  ObliqueRig rig;
+  ASSERT_NO_FATAL_FAILURE(makeObliqueRig(*full, rig));
+  auto& [ring, target, ref, magenta, cam] = rig;
+  const int w = ObliqueRig::kW, h = ObliqueRig::kH;
   // Warm-up (programs compiled, both targets drawn once), then a frame with nothing to load.
-  ASSERT_TRUE((*ring)->draw(*full, cam, magenta, *target));
+  ASSERT_TRUE(ring->draw(*full, cam, magenta, target));
   auto t0 = std::chrono::steady_clock::now();
-  ASSERT_TRUE((*ring)->draw(*full, cam, magenta, *ref));
+  ASSERT_TRUE(ring->draw(*full, cam, magenta, ref));
   const double residentMs = msSince(t0);
 
   // A cold RAM cache: every page of the windows needs a decode.
@@ -462,7 +476,7 @@ TEST_F(GlTest, ALateTileNeverStallsAFrameAndTheRenderConverges) {
   s->store().clearCache();
   s->store().resetCacheStats();
   t0 = std::chrono::steady_clock::now();
-  ASSERT_TRUE((*ring)->draw(*scene, cam, magenta, *target));
+  ASSERT_TRUE(ring->draw(*scene, cam, magenta, target));
   const double firstMs = msSince(t0);
   EXPECT_EQ(s->store().cacheStats().syncLoads, 0u);
   EXPECT_EQ(s->stats().lastFramePagesCopied, 0);
@@ -474,7 +488,7 @@ TEST_F(GlTest, ALateTileNeverStallsAFrameAndTheRenderConverges) {
   // margin absorbs llvmpipe's frame-time noise on a loaded machine; measured: within ~10 ms),
   // where the blocking frame below costs kDelayMs per tile level it decodes (5 here).
   EXPECT_LT(firstMs, residentMs + kDelayMs);
-  EXPECT_GT(expectNoHole(*scene, cam, *target, 0.95 * 30000), long(w * h / 3));
+  EXPECT_GT(expectNoHole(*scene, cam, target, 0.95 * 30000), long(w * h / 3));
 
   // Frames go on while the loader works: none decodes, none has a hole.
   int frames = 1;
@@ -482,16 +496,16 @@ TEST_F(GlTest, ALateTileNeverStallsAFrameAndTheRenderConverges) {
   const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(30);
   while (s->stats().pending > 0 && std::chrono::steady_clock::now() < until) {
     t0 = std::chrono::steady_clock::now();
-    ASSERT_TRUE((*ring)->draw(*scene, cam, magenta, *target));
+    ASSERT_TRUE(ring->draw(*scene, cam, magenta, target));
     worstMs = std::max(worstMs, msSince(t0));
     ++frames;
-    expectNoHole(*scene, cam, *target, 0.95 * 30000);
+    expectNoHole(*scene, cam, target, 0.95 * 30000);
   }
   ASSERT_EQ(s->stats().pending, 0) << "the loader did not catch up in 30 s";
   const auto st = s->store().cacheStats();
   EXPECT_EQ(st.syncLoads, 0u);
   EXPECT_GT(st.requestLoads, 0u);
-  const Diff converged = compare(*target, *ref, 0);
+  const Diff converged = compare(target, ref, 0);
   EXPECT_EQ(converged.maxChannel, 0);
   EXPECT_EQ(converged.elevMaxM, 0.0);
 
@@ -502,14 +516,14 @@ TEST_F(GlTest, ALateTileNeverStallsAFrameAndTheRenderConverges) {
   blocking->streamed()->store().clearCache();
   blocking->streamed()->store().resetCacheStats();
   t0 = std::chrono::steady_clock::now();
-  ASSERT_TRUE((*ring)->draw(*blocking, cam, magenta, *target));
+  ASSERT_TRUE(ring->draw(*blocking, cam, magenta, target));
   const double blockingMs = msSince(t0);
   const uint64_t decodes = blocking->streamed()->store().cacheStats().syncLoads;
   EXPECT_EQ(blocking->streamed()->stats().pending, 0);
   EXPECT_EQ(decodes, st.requestLoads);  // the same tile levels, decoded on the caller's thread
   EXPECT_GE(blockingMs, double(decodes) * kDelayMs);
   EXPECT_GE(decodes, 2u);  // so that the contrast with the asynchronous frame is at least 2 decodes
-  const Diff same = compare(*target, *ref, 0);
+  const Diff same = compare(target, ref, 0);
   EXPECT_EQ(same.maxChannel, 0);
   EXPECT_EQ(same.elevMaxM, 0.0);
   std::ofstream(test::outputDir("render") / "streaming_async.txt")
