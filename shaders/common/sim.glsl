@@ -32,7 +32,7 @@ struct SimParams {
   float thermalRate;
   float wetTalusScale;
   float maxErosionPerStepM;
-  float pad1;
+  int slopeLimiter;  // SlopeLimiter: 0 minmod, 1 MC (W21)
 };
 
 struct SimMaterial {

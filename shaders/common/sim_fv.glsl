@@ -7,7 +7,13 @@ struct Side {
   float h, eta, un, ut;  // depth, surface, normal and tangential velocity at a face
 };
 
-float minmod(float a, float b) { return a * b <= 0.0 ? 0.0 : (abs(a) < abs(b) ? a : b); }
+// W21 slopes from the backward and forward differences a, b (0 at an extremum): minmod, the
+// smaller one, or van Leer's monotonised central (MC), sign * min(2|a|, 2|b|, |a + b| / 2).
+float limitedSlope(float a, float b) {
+  if (a * b <= 0.0) return 0.0;
+  if (P.slopeLimiter == 1) return sign(a) * min(min(2.0 * abs(a), 2.0 * abs(b)), 0.5 * abs(a + b));
+  return abs(a) < abs(b) ? a : b;
+}
 
 Side primOf(int which, ivec2 c, int dir) {
   const int i = cellOf(c);
@@ -16,17 +22,17 @@ Side primOf(int which, ivec2 c, int dir) {
   return dir < 2 ? Side(s.x, bed[i] + s.x, u, v) : Side(s.x, bed[i] + s.x, v, u);
 }
 
-// W21: cell c's value at its face dir (W, E, N, S): minmod slopes along the face normal.
+// W21: cell c's value at its face dir (W, E, N, S): limited slopes along the face normal.
 Side faceSide(int which, ivec2 c, int dir) {
   Side m0 = primOf(which, c, dir);
   const ivec2 a = dir < 2 ? ivec2(1, 0) : ivec2(0, 1);
   if (!insideGrid(c - a) || !insideGrid(c + a)) return m0;
   const Side m = primOf(which, c - a, dir), pp = primOf(which, c + a, dir);
   const float half_ = (dir == 1 || dir == 3) ? 0.5 : -0.5;
-  m0.h += half_ * minmod(m0.h - m.h, pp.h - m0.h);
-  m0.eta += half_ * minmod(m0.eta - m.eta, pp.eta - m0.eta);
-  m0.un += half_ * minmod(m0.un - m.un, pp.un - m0.un);
-  m0.ut += half_ * minmod(m0.ut - m.ut, pp.ut - m0.ut);
+  m0.h += half_ * limitedSlope(m0.h - m.h, pp.h - m0.h);
+  m0.eta += half_ * limitedSlope(m0.eta - m.eta, pp.eta - m0.eta);
+  m0.un += half_ * limitedSlope(m0.un - m.un, pp.un - m0.un);
+  m0.ut += half_ * limitedSlope(m0.ut - m.ut, pp.ut - m0.ut);
   return m0;
 }
 

@@ -300,7 +300,7 @@ Status readRegion(const Reader& r, const toml::table& root, Scenario& s) {
 Status readModel(const Reader& r, const toml::table& root, Scenario& s) {
   const auto* t = root["model"].as_table();
   if (!t) return {};
-  STRATA_TRY_STATUS(r.onlyKeys(*t, "model", {"kind", "manning_n", "cfl", "max_step", "boundary"}));
+  STRATA_TRY_STATUS(r.onlyKeys(*t, "model", {"kind", "manning_n", "cfl", "max_step", "slopes", "boundary"}));
   if (const auto* k = t->get("kind")) {
     STRATA_TRY(auto v, r.string(*k, "model.kind"));
     if (v == "flood") {
@@ -327,6 +327,12 @@ Status readModel(const Reader& r, const toml::table& root, Scenario& s) {
   if (const auto* m = t->get("max_step")) {
     STRATA_TRY(s.model.maxStepS, r.quantity(*m, "model.max_step", "time"));
     if (s.model.maxStepS <= 0) return r.error(*m, "model.max_step", "must be positive");
+  }
+  if (const auto* l = t->get("slopes")) {
+    STRATA_TRY(auto v, r.string(*l, "model.slopes"));
+    if (v != "minmod" && v != "mc")
+      return r.error(*l, "model.slopes", "expected \"minmod\" or \"mc\", got \"" + v + "\"");
+    s.model.sharpSlopes = v == "mc";
   }
   if (const auto* b = t->get("boundary")) {
     auto parse = [&](const toml::node& n, const std::string& key) -> Result<Boundary> {

@@ -353,6 +353,7 @@ Result<ScenarioDomain> buildDomain(const Scenario& s) {
   // capped, by default at 2 s (docs/scenario.md).
   p.maxDtS = float(s.model.maxStepS);
   p.manningN = float(s.model.manningN);
+  p.slopeLimiter = int32_t(s.model.sharpSlopes ? sim::SlopeLimiter::kMonotonizedCentral : sim::SlopeLimiter::kMinmod);
   const uint32_t bits[4] = {sim::kEdgeWest, sim::kEdgeEast, sim::kEdgeSouth, sim::kEdgeNorth};
   p.openEdges = 0;
   for (int e = 0; e < 4; ++e) {

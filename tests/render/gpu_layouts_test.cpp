@@ -123,7 +123,7 @@ TEST(GpuLayouts, SimParamsMatchesGlsl) {
                                            STRATA_FIELD(SimParams, thermalRate),
                                            STRATA_FIELD(SimParams, wetTalusScale),
                                            STRATA_FIELD(SimParams, maxErosionPerStepM),
-                                           STRATA_FIELD(SimParams, pad1)});
+                                           STRATA_FIELD(SimParams, slopeLimiter)});
 }
 
 TEST(GpuLayouts, SimMaterialSourceAndLevelEntryMatchGlsl) {

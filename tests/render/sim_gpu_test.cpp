@@ -177,6 +177,9 @@ TEST_F(GlTest, SimFloodAgreesWithCpuReference) {
     for (int x = 0; x < 32; ++x) in.waterDepthM.at(x, y) = x < 10 ? 2.0f : 0.0f;
   }
   expectAgreement(in, floodParams(), 150, 1e-4, 1e-6, nullptr);
+  auto mc = floodParams();  // the other slope limiter (W21)
+  mc.slopeLimiter = int32_t(strata::terrain::sim::SlopeLimiter::kMonotonizedCentral);
+  expectAgreement(in, mc, 150, 1e-4, 1e-6, nullptr);
 }
 
 TEST_F(GlTest, SimFloodLongStepAgreesWithCpuAndKeepsBalance) {

@@ -118,8 +118,19 @@ INSTANTIATE_TEST_SUITE_P(
                 "/data/runs/gc.toml:6: key 'terrain.layer[0].thickness': negative thickness"},
         BadCase{"TOML syntax error", "manning_n = 0.035", "manning_n = = 0.035",
                 "/data/runs/gc.toml:11: Error while parsing value: could not determine value type"},
+        BadCase{"unknown slope limiter", "manning_n = 0.035", "manning_n = 0.035\nslopes = \"superbee\"",
+                "/data/runs/gc.toml:12: key 'model.slopes': expected \"minmod\" or \"mc\", got \"superbee\""},
         BadCase{"terrain change without erosion", "[time]", "[outputs]\nmaps = [\"terrain_change\"]\n[time]",
                 "/data/runs/gc.toml: outputs.maps asks for terrain_change but erosion is not enabled"}));
+
+TEST(Scenario, SlopeLimiterIsMinmodUnlessAskedForMc) {
+  auto s = parse(kGood);
+  ASSERT_TRUE(s) << s.message();
+  EXPECT_FALSE(s->model.sharpSlopes);
+  s = parse(replaced(kGood, "manning_n = 0.035", "manning_n = 0.035\nslopes = \"mc\""));
+  ASSERT_TRUE(s) << s.message();
+  EXPECT_TRUE(s->model.sharpSlopes);
+}
 
 TEST(Scenario, NeedsASource) {
   std::string text = kGood;

@@ -78,7 +78,14 @@ void kahanAdd(float* acc, float v) {
   acc[0] = t;
 }
 
+// W21 slopes from the backward and forward differences a, b (0 at an extremum): minmod, the
+// smaller one; van Leer's monotonised central (MC), sign * min(2|a|, 2|b|, |a + b| / 2).
 float minmod(float a, float b) { return a * b <= 0.0f ? 0.0f : (std::abs(a) < std::abs(b) ? a : b); }
+float mcSlope(float a, float b) {
+  return a * b <= 0.0f
+             ? 0.0f
+             : std::copysign(std::min(std::min(2.0f * std::abs(a), 2.0f * std::abs(b)), 0.5f * std::abs(a + b)), a);
+}
 
 }  // namespace
 
@@ -417,8 +424,9 @@ void CpuSimulation::pipeUpdatePass() {
   }
 }
 
-// W21: the value of cell (x, y) of stage `st` at its face `dir` (W, E, N, S): MUSCL, minmod
-// slopes of depth, surface and velocities along the face normal (first order next to an edge).
+// W21: the value of cell (x, y) of stage `st` at its face `dir` (W, E, N, S): MUSCL, minmod or
+// MC slopes (SimParams::slopeLimiter) of depth, surface and velocities along the face normal (first order next to an
+// edge).
 CpuSimulation::Side CpuSimulation::faceSide(const std::vector<float>& st, int x, int y, int dir) const {
   const float dry = p_.dryDepthM;
   auto prim = [&](int cx, int cy) {
@@ -433,10 +441,11 @@ CpuSimulation::Side CpuSimulation::faceSide(const std::vector<float>& st, int x,
   if (mx < 0 || my < 0 || px >= p_.width || py >= p_.height) return c;
   const Side m = prim(mx, my), p = prim(px, py);
   const float half = (dir == 1 || dir == 3) ? 0.5f : -0.5f;
-  c.h += half * minmod(c.h - m.h, p.h - c.h);
-  c.eta += half * minmod(c.eta - m.eta, p.eta - c.eta);
-  c.un += half * minmod(c.un - m.un, p.un - c.un);
-  c.ut += half * minmod(c.ut - m.ut, p.ut - c.ut);
+  const auto slope = p_.slopeLimiter == int32_t(SlopeLimiter::kMonotonizedCentral) ? mcSlope : minmod;
+  c.h += half * slope(c.h - m.h, p.h - c.h);
+  c.eta += half * slope(c.eta - m.eta, p.eta - c.eta);
+  c.un += half * slope(c.un - m.un, p.un - c.un);
+  c.ut += half * slope(c.ut - m.ut, p.ut - c.ut);
   return c;
 }
 

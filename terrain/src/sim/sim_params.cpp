@@ -133,6 +133,10 @@ Status validateParams(const SimParams& params) {
       params.waterModel != int32_t(WaterModel::kFiniteVolume)) {
     return fail("sim params: waterModel " + std::to_string(params.waterModel) + " is not 0 (pipes) or 1 (flood)");
   }
+  if (params.slopeLimiter != int32_t(SlopeLimiter::kMinmod) &&
+      params.slopeLimiter != int32_t(SlopeLimiter::kMonotonizedCentral)) {
+    return fail("sim params: slopeLimiter " + std::to_string(params.slopeLimiter) + " is not 0 (minmod) or 1 (MC)");
+  }
   if (params.waterModel == int32_t(WaterModel::kFiniteVolume) && !(params.cflAlpha > 0 && params.cflAlpha <= 0.5f)) {
     return fail("sim params: flood mode needs cflAlpha in (0, 0.5] (positivity of the finite-volume scheme)");
   }

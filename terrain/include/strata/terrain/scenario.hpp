@@ -91,9 +91,10 @@ struct Scenario {
 
   struct {
     WaterModel kind = WaterModel::Flood;
-    double manningN = 0.035;  ///< s/m^(1/3)
-    double cfl = 0.45;        ///< flood mode needs <= 0.5 (positivity of the finite-volume scheme)
-    double maxStepS = 30.0;   ///< cap on the adaptive step (s); see docs/scenario.md
+    double manningN = 0.035;   ///< s/m^(1/3)
+    double cfl = 0.45;         ///< flood mode needs <= 0.5 (positivity of the finite-volume scheme)
+    double maxStepS = 30.0;    ///< cap on the adaptive step (s); see docs/scenario.md
+    bool sharpSlopes = false;  ///< flood mode: MC slopes instead of minmod (W21); see docs/sim-water.md
     std::array<Boundary, 4> boundaries{Boundary::Open, Boundary::Open, Boundary::Open, Boundary::Open};  ///< W E S N
   } model;
 

@@ -25,6 +25,12 @@ enum class WaterModel : int32_t {
   kFiniteVolume = 1,  ///< flood mode: Godunov finite volumes, HLL + hydrostatic reconstruction (W13-W24)
 };
 
+/// Flood mode's slope limiter (W21), SimParams::slopeLimiter.
+enum class SlopeLimiter : int32_t {
+  kMinmod = 0,  ///< the smaller one-sided slope: the most diffusive, robust on steep real terrain (the default)
+  kMonotonizedCentral = 1,  ///< van Leer's MC: sharper fronts and smooth flow (Ritter front lag as dx^0.5, not dx^0.3)
+};
+
 /// Bits of SimParams::openEdges: an open edge lets water flow out freely (and counts it);
 /// a closed one is a wall.
 enum EdgeBits : uint32_t { kEdgeWest = 1u, kEdgeEast = 2u, kEdgeNorth = 4u, kEdgeSouth = 8u };
@@ -58,7 +64,7 @@ struct SimParams {
   float thermalRate = 0.5f;           ///< fraction of the talus excess moved per step, in (0,1] (E7)
   float wetTalusScale = 0.5f;         ///< talus tangent multiplier for banks touching water (E8)
   float maxErosionPerStepM = 0.01f;   ///< cap on material moved by E2/E4 in one step (m)
-  float pad1 = 0.0f;
+  int32_t slopeLimiter = int32_t(SlopeLimiter::kMinmod);  ///< flood mode's W21 slopes (SlopeLimiter)
 };
 static_assert(sizeof(SimParams) == 112);
 static_assert(offsetof(SimParams, dyM) == 32);
