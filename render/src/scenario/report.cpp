@@ -126,7 +126,10 @@ Status writeReport(const fs::path& runDir, const ReportInput& in) {
       std::string("| model | ") +
       (s.model.kind == strata::terrain::WaterModel::Flood ? "flood mode (finite-volume shallow water, Manning friction)"
                                                           : "virtual pipes") +
-      ", Manning n = " + fmt("%.3f", s.model.manningN) + " s/m^(1/3), CFL " + fmt("%.2f", s.model.cfl) + " |\n";
+      ", Manning n = " + fmt("%.3f", s.model.manningN) + " s/m^(1/3), CFL " + fmt("%.2f", s.model.cfl) +
+      (s.model.kind == strata::terrain::WaterModel::Flood ? (s.model.sharpSlopes ? ", MC slopes" : ", minmod slopes")
+                                                          : "") +
+      " |\n";
   const char* edges[4] = {"west", "east", "south", "north"};
   std::string bounds;
   for (int e = 0; e < 4; ++e) {
