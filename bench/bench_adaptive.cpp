@@ -3,7 +3,7 @@
 // wall ms per step (host transfers included), relative L1 of depth and wet-area agreement
 // (h > 0.1 m) against the full-resolution run, water-balance error over the inflow, and the
 // fraction of cell updates (tile interiors, and with the halos the GPU also computes). Runs: full resolution (one
-// Simulation), the same tiles all at level 0 (TiledSimulation: the cost of tiling alone), adaptive with the default
+// Simulation), the same tiles all at level 0 (TiledSolver: the cost of tiling alone), adaptive with the default
 // options, adaptive "coarse" (no look-ahead, speed and depth references 0.5), and "coarse" without refluxing (to
 // measure what the flux matching buys).
 //   build/bench/strata_bench_adaptive [n steps tile [notiled]]   (defaults 256 300 64)
@@ -16,16 +16,16 @@
 #include <functional>
 #include <string>
 
-#include <strata/render/gl/context.hpp>
-#include <strata/render/sim/adaptive_simulation.hpp>
-#include <strata/render/sim/simulation.hpp>
-#include <strata/render/sim/tiled_simulation.hpp>
+#include <strata/gl/context.hpp>
+#include <strata/sim/adaptive_solver.hpp>
+#include <strata/sim/gl_solver.hpp>
+#include <strata/sim/tiled_solver.hpp>
 
 #include "canyon_flood.hpp"
 
 namespace {
 using namespace strata;
-using namespace strata::render::sim;
+using namespace strata::sim;
 
 struct Outcome {
   gis::Grid<float> depth;
@@ -71,7 +71,7 @@ void report(const char* name, const Outcome& o, const Outcome& full, const std::
 int main(int argc, char** argv) {
   const int n = argc > 1 ? std::atoi(argv[1]) : 256, steps = argc > 2 ? std::atoi(argv[2]) : 300,
             tile = argc > 3 ? std::atoi(argv[3]) : 64;
-  auto ctx = render::gl::HeadlessContext::create({.debugOutput = false});
+  auto ctx = gl::HeadlessContext::create({.debugOutput = false});
   if (!ctx) {
     std::fprintf(stderr, "%s\n", ctx.message().c_str());
     return 1;
@@ -86,13 +86,13 @@ int main(int argc, char** argv) {
   }
   std::printf("{\"grid\": %d, \"steps\": %d, \"tile\": %d, \"renderer\": \"%s\"}\n", n, steps, tile,
               ctx->info().renderer.c_str());
-  auto full = Simulation::create(scene->input, scene->params);
+  auto full = GlSolver::create(scene->input, scene->params);
   if (!full || !full->addSource(scene->spring)) return 1;
   const auto ref = runIt(
       *full, steps, [] { return 1.0; }, [] { return 1.0; });
   report("full", ref, ref, scene->input.rowDxM, scene->input.dyM);
   if (argc <= 4 || std::string(argv[4]) != "notiled") {
-    auto tiled = TiledSimulation::create(scene->input, scene->params, TileOptions{tile, tile, 8});
+    auto tiled = TiledSolver::create(scene->input, scene->params, TileOptions{tile, tile, 8}, glSolverFactory());
     if (!tiled || !tiled->addSource(scene->spring)) return 1;
     report("tiled_level0",
            runIt(
@@ -114,7 +114,7 @@ int main(int argc, char** argv) {
   noReflux.reflux = false;
   for (auto [name, o] : {std::pair{"adaptive_default", def}, std::pair{"adaptive_coarse", coarse},
                          std::pair{"adaptive_coarse_no_reflux", noReflux}}) {
-    auto a = AdaptiveSimulation::create(scene->input, scene->params, o);
+    auto a = AdaptiveSolver::create(scene->input, scene->params, o, glSolverFactory());
     if (!a) {
       std::fprintf(stderr, "%s\n", a.message().c_str());
       return 1;

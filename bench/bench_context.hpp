@@ -10,25 +10,25 @@
 #include <cstdlib>
 #include <optional>
 
-#include <strata/render/gl/context.hpp>
+#include <strata/gl/context.hpp>
 
 namespace strata::bench {
 
-inline render::gl::HeadlessContext& glContext() {
-  static std::optional<render::gl::HeadlessContext> c = [] {
-    auto r = render::gl::HeadlessContext::create({.debugOutput = false});
+inline gl::HeadlessContext& sharedContext() {
+  static std::optional<gl::HeadlessContext> c = [] {
+    auto r = gl::HeadlessContext::create({.debugOutput = false});
     if (!r) {
       std::fprintf(stderr, "%s\n", r.message().c_str());
       std::exit(1);
     }
-    return std::optional<render::gl::HeadlessContext>(std::move(r).value());
+    return std::optional<gl::HeadlessContext>(std::move(r).value());
   }();
   return *c;
 }
 
 inline int benchGlMain(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
-  const auto& i = glContext().info();
+  const auto& i = sharedContext().info();
   benchmark::AddCustomContext("gl_renderer", i.renderer);
   benchmark::AddCustomContext("gl_version", i.version);
   benchmark::RunSpecifiedBenchmarks();

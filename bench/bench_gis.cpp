@@ -36,7 +36,7 @@ BENCHMARK(BM_ReadWhole)->Unit(benchmark::kMillisecond);
 void BM_ReadWindow256(benchmark::State& state) {
   const std::string path = data("rainier/mt_rainier_90m.tif");
   ReadOptions o;
-  o.window = PixelWindow{512, 512, 256, 256};
+  o.window = CellRect{512, 512, 256, 256};
   for (auto _ : state) benchmark::DoNotOptimize(orExit(readDem(path, o)));
   state.SetItemsProcessed(state.iterations() * 256 * 256);
 }

@@ -5,24 +5,23 @@
 
 #include "bench_context.hpp"
 
-#include <epoxy/gl.h>
-
-#include <strata/render/gl/objects.hpp>
-#include <strata/render/gpu_layouts.hpp>
+#include <strata/gl/objects.hpp>
+#include <strata/gl/state.hpp>
+#include "grid_params.hpp"
 
 namespace {
-using namespace strata::render;
+using namespace strata;
 
 // Device-to-device copy: bytes read + bytes written per second.
 void BM_BufferCopy(benchmark::State& state) {
-  strata::bench::glContext();
+  strata::bench::sharedContext();
   const size_t bytes = size_t(state.range(0)) << 20;
   gl::Buffer a(bytes), b(bytes);
   a.fill(0x3f800000u);
   for (auto _ : state) {
     gl::GpuTimer t;
     t.begin();
-    glCopyNamedBufferSubData(a.id(), b.id(), 0, 0, GLsizeiptr(bytes));
+    a.copyTo(b, bytes);
     t.end();
     state.SetIterationTime(t.milliseconds() * 1e-3);
   }
@@ -31,27 +30,28 @@ void BM_BufferCopy(benchmark::State& state) {
 BENCHMARK(BM_BufferCopy)->Arg(64)->Arg(256)->UseManualTime()->Unit(benchmark::kMillisecond);
 
 void BM_LaplacianStencil(benchmark::State& state) {
-  strata::bench::glContext();
+  strata::bench::sharedContext();
   const int n = int(state.range(0));
-  auto src = gl::Texture::create2D(gl::kR32F, n, n), dst = gl::Texture::create2D(gl::kR32F, n, n);
+  auto src = gl::Texture::create2D(gl::TextureFormat::kR32F, n, n),
+       dst = gl::Texture::create2D(gl::TextureFormat::kR32F, n, n);
   std::vector<float> zeros(size_t(n) * size_t(n), 1.0f);
   src.upload(zeros.data());
-  GridParams g;
+  test::GridParams g;
   g.size = {n, n};
   gl::Buffer params(sizeof g, &g);
-  auto prog = gl::Program::compute("test/laplacian.comp");
+  auto prog = gl::Program::compute("tests/gl/shaders/laplacian.comp");
   if (!prog) {
     state.SkipWithError(prog.message().c_str());
     return;
   }
-  src.bindImage(0, GL_READ_ONLY);
-  dst.bindImage(1, GL_WRITE_ONLY);
-  params.bindBase(GL_SHADER_STORAGE_BUFFER, 2);
+  src.bindImage(0, gl::Access::kRead);
+  dst.bindImage(1, gl::Access::kWrite);
+  params.bindStorage(2);
   for (auto _ : state) {
     gl::GpuTimer t;
     t.begin();
     prog->dispatchCovering(n, n);
-    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+    gl::memoryBarrier(gl::Barrier::kImageAccess);
     t.end();
     state.SetIterationTime(t.milliseconds() * 1e-3);
   }

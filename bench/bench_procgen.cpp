@@ -6,17 +6,15 @@
 
 #include "bench_context.hpp"
 
-#include <epoxy/gl.h>
-
 #include <chrono>
 #include <cmath>
 
-#include <strata/render/procgen/generator.hpp>
-#include <strata/render/procgen/wavelet_gpu.hpp>
-#include <strata/terrain/procgen/wavelet.hpp>
+#include <strata/procgen/generator.hpp>
+#include <strata/procgen/wavelet.hpp>
+#include <strata/procgen/wavelet_gpu.hpp>
 
 namespace {
-using namespace strata::render;
+using namespace strata;
 constexpr int kLevels = 6;
 
 strata::gis::Grid<float> field(int n) {
@@ -27,8 +25,8 @@ strata::gis::Grid<float> field(int n) {
   return g;
 }
 
-void BM_WaveletGpu(benchmark::State& state, bool inverse, strata::terrain::procgen::Wavelet kind) {
-  strata::bench::glContext();
+void BM_WaveletGpu(benchmark::State& state, bool inverse, strata::procgen::Wavelet kind) {
+  strata::bench::sharedContext();
   const int n = int(state.range(0));
   auto wavelet = procgen::WaveletGpu::create();
   if (!wavelet) {
@@ -49,7 +47,7 @@ void BM_WaveletGpu(benchmark::State& state, bool inverse, strata::terrain::procg
     state.SetIterationTime(t.milliseconds() * 1e-3);
   }
 }
-using strata::terrain::procgen::Wavelet;
+using strata::procgen::Wavelet;
 void BM_Cdf53ForwardGpu(benchmark::State& s) { BM_WaveletGpu(s, false, Wavelet::Cdf53); }
 void BM_Cdf53InverseGpu(benchmark::State& s) { BM_WaveletGpu(s, true, Wavelet::Cdf53); }
 void BM_Cdf97ForwardGpu(benchmark::State& s) { BM_WaveletGpu(s, false, Wavelet::Cdf97); }
@@ -62,7 +60,7 @@ BENCHMARK(BM_Cdf97InverseGpu)->Arg(512)->Arg(1024)->Arg(2048)->UseManualTime()->
 // The CPU reference, single-threaded: the baseline of the GPU figures above.
 void BM_WaveletForwardCpu(benchmark::State& state, Wavelet kind) {
   const auto g = field(int(state.range(0)));
-  for (auto _ : state) benchmark::DoNotOptimize(strata::terrain::procgen::forwardTransform(g, kLevels, kind));
+  for (auto _ : state) benchmark::DoNotOptimize(strata::procgen::forwardTransform(g, kLevels, kind));
 }
 void BM_Cdf53ForwardCpu(benchmark::State& s) { BM_WaveletForwardCpu(s, Wavelet::Cdf53); }
 void BM_Cdf97ForwardCpu(benchmark::State& s) { BM_WaveletForwardCpu(s, Wavelet::Cdf97); }
@@ -72,7 +70,7 @@ BENCHMARK(BM_Cdf97ForwardCpu)->Arg(512)->Arg(1024)->Arg(2048)->Unit(benchmark::k
 // A whole run of seed example 1 (height form) and of a level-form script with histogram
 // matching against a DEM (the CPU sort per band included), wall time.
 void BM_Generate(benchmark::State& state, const char* glsl, bool withDem) {
-  strata::bench::glContext();
+  strata::bench::sharedContext();
   const int n = int(state.range(0));
   procgen::GenerateOptions o;
   o.width = o.height = n;

@@ -26,17 +26,18 @@
 #include <optional>
 #include <thread>
 
-#include <strata/render/gl/objects.hpp>
-#include <strata/render/terrain/screen_error.hpp>
-#include <strata/render/terrain/sliding_grid.hpp>
-#include <strata/render/terrain/synthetic_dem.hpp>
-#include <strata/render/terrain/terrain_renderer.hpp>
+#include <strata/gl/objects.hpp>
+#include <strata/gl/state.hpp>
+#include <strata/render/screen_error.hpp>
+#include <strata/render/sliding_grid.hpp>
+#include <strata/render/synthetic_dem.hpp>
+#include <strata/render/terrain_renderer.hpp>
 #include <strata/terrain/ingest.hpp>
 #include <strata/terrain/tile_store.hpp>
 
 namespace {
+using namespace strata;
 using namespace strata::render;
-using namespace strata::render::terrain;
 
 // Synthetic DEM of size^2 cells of 30 m, cached; the camera 1500 m above its south-centre,
 // looking north 20 degrees down.
@@ -49,7 +50,7 @@ Setup& synthetic(int size) {
   static std::map<int, Setup> cache;
   auto it = cache.find(size);
   if (it != cache.end()) return it->second;
-  strata::bench::glContext();
+  strata::bench::sharedContext();
   auto scene = TerrainScene::create(syntheticDem(size, 30.0, 400.0, 1));
   if (!scene) {
     std::fprintf(stderr, "%s\n", scene.message().c_str());
@@ -76,7 +77,7 @@ void runFrames(benchmark::State& state, TerrainRenderer& renderer, const Terrain
     state.SkipWithError(s.message().c_str());
     return;
   }
-  glFinish();
+  gl::finish();
   double submitMs = 0, timerMs = 0;
   for (auto _ : state) {
     gl::GpuTimer t;
@@ -85,7 +86,7 @@ void runFrames(benchmark::State& state, TerrainRenderer& renderer, const Terrain
     (void)renderer.draw(scene, camera, shading, *target);
     t.end();
     const auto c1 = std::chrono::steady_clock::now();
-    glFinish();
+    gl::finish();
     const auto c2 = std::chrono::steady_clock::now();
     submitMs += std::chrono::duration<double, std::milli>(c1 - c0).count();
     timerMs += t.milliseconds();
@@ -162,7 +163,7 @@ BENCHMARK(BM_RingCpuPerFrame)->ArgName("dem")->Arg(512)->Arg(2048)->Unit(benchma
 // with windows of 512 texels in pages of 64 and a 64 MiB GPU budget.
 std::unique_ptr<TerrainScene> streamedSynthetic(int size, int uploadPages, size_t gpuBudget = size_t(64) << 20,
                                                 bool waitForDisk = true, double loadDelayMs = 0) {
-  strata::bench::glContext();  // also when no whole-DEM benchmark ran first
+  strata::bench::sharedContext();  // also when no whole-DEM benchmark ran first
   const auto dir = std::filesystem::temp_directory_path() / ("strata_bench_stream_" + std::to_string(size));
   if (!std::filesystem::exists(dir / "manifest.toml")) {
     std::filesystem::remove_all(dir);
@@ -225,7 +226,7 @@ void BM_StreamedVsWhole(benchmark::State& state) {
     if (auto r = (*ring)->draw(scene, cam, shading, *target); !r) return state.SkipWithError(r.message().c_str());
     if (!streamed || scene.streamed()->stats().pending == 0) break;
   }
-  glFinish();
+  gl::finish();
   double submitMs = 0, timerMs = 0;
   uint64_t copied0 = streamed ? scene.streamed()->stats().pagesCopied : 0;
   for (auto _ : state) {
@@ -236,7 +237,7 @@ void BM_StreamedVsWhole(benchmark::State& state) {
     (void)(*ring)->draw(scene, cam, shading, *target);
     t.end();
     const auto c1 = std::chrono::steady_clock::now();
-    glFinish();
+    gl::finish();
     const auto c2 = std::chrono::steady_clock::now();
     submitMs += std::chrono::duration<double, std::milli>(c1 - c0).count();
     timerMs += t.milliseconds();
@@ -269,14 +270,14 @@ void BM_StreamRefill(benchmark::State& state) {
   auto* st = scene->streamed();
   glm::dvec2 cell(512, 1024);
   if (auto r = st->update(cell); !r) return state.SkipWithError(r.message().c_str());
-  glFinish();
+  gl::finish();
   const auto before = st->stats();
   int step = 0;
   for (auto _ : state) {
     cell.x += ((step++ / 16) % 2 ? -64.0 : 64.0);
     const auto c0 = std::chrono::steady_clock::now();
     (void)st->update(cell);
-    glFinish();
+    gl::finish();
     state.SetIterationTime(std::chrono::duration<double>(std::chrono::steady_clock::now() - c0).count());
   }
   const auto after = st->stats();
@@ -312,7 +313,7 @@ void BM_StreamColdRefill(benchmark::State& state) {
     return {};
   };
   if (auto r = settle(); !r) return state.SkipWithError(r.message().c_str());
-  glFinish();
+  gl::finish();
   const auto before = st->stats();
   const auto loads0 = st->store().cacheStats();
   double catchUpMs = 0, waiting = 0;
@@ -322,7 +323,7 @@ void BM_StreamColdRefill(benchmark::State& state) {
     cell.x += ((step++ / 16) % 2 ? -64.0 : 64.0);
     const auto c0 = std::chrono::steady_clock::now();
     (void)st->update(cell);
-    glFinish();
+    gl::finish();
     const auto c1 = std::chrono::steady_clock::now();
     state.SetIterationTime(std::chrono::duration<double>(c1 - c0).count());
     waiting += st->stats().lastFramePagesWaiting;

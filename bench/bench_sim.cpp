@@ -1,28 +1,128 @@
-// GPU simulation step cost (render::sim::Simulation), timed with GPU timer queries: ms per
-// step, cell updates per second, and the bytes each step moves per cell (what the kernels read
-// and write once per cell, counting neighbour reads as cache hits), for the virtual-pipe water
-// model alone and with erosion + thermal weathering on four layers, and for flood mode.
+// Simulation step cost side by side in one run: the CPU backend (sim::CpuSolver) with 1 and 2
+// OpenMP threads, and the GL backend (sim::GlSolver) on whatever GL the machine has (Mesa
+// llvmpipe without a GPU), at 256^2 to 2048^2, for the virtual-pipe model, pipes + erosion +
+// thermal weathering on four layers, and flood mode. Before the benchmarks the program measures
+// the machine's floors with the same threads and instruction set the CPU kernels use: memory
+// bandwidth (a STREAM triad, a[i] = b[i] + s c[i] on 64 MB arrays) and peak float throughput
+// (independent multiply + add chains; the kernels do not contract into FMA). Each benchmark
+// reports ms per step, cell updates per second, the bytes and flops one cell costs per step
+// (counted from the code, below) and its time as a multiple of the bandwidth floor
+// (bytes x cells / bandwidth) and of the compute floor (flops x cells / peak).
 //   build/bench/strata_bench_sim [--benchmark_filter=...]
 // Figures go to docs/benchmarks.md.
 #include <benchmark/benchmark.h>
+#include <omp.h>
 
-#include "bench_context.hpp"
-
+#include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
 
-#include <strata/render/gl/objects.hpp>
-#include <strata/render/sim/simulation.hpp>
+#include <strata/gl/context.hpp>
+#include <strata/gl/state.hpp>
+#include <strata/sim/cpu_solver.hpp>
+#include <strata/sim/gl_solver.hpp>
 #include <strata/terrain/material.hpp>
 
 namespace {
 using namespace strata;
-namespace ts = strata::terrain::sim;
+namespace ts = strata::sim;
 
-// Bytes per cell per step, summed over the kernels (see the kernel headers for what each reads
-// and writes): sources 40, pipe_flux 56, pipe_update 56; erode 76, thermal_flux 40,
-// thermal_apply 56; flood: fv_face 2 x 48, fv_update 2 x 56 (+ sediment, accumulators, the
-// corrector's 4 B of W25 limits), fv_limit 52 (own faces, state, limit), wave speed 16.
-constexpr double kPipeBytes = 152, kErosionBytes = 152 + 172, kFloodBytes = 40 + 96 + 140 + 52 + 16;
+// What one interior cell costs per step on the CPU backend, counted from sim/src/cpu_*.cpp:
+// bytes are the arrays a pass streams through memory (a neighbour's value read again by the next
+// cell or row is a cache hit; the face pass's per-thread scratch rows stay in cache), flops are
+// the adds, subtracts, multiplies, divides, square roots, minima and maxima of the cell's
+// arithmetic (compares and selects not counted).
+//  - sources (W11): h, two evaporation sums in and out: 24 B; 8 flops.
+//  - pipe_flux (W1, W2): h, bed, 4 outflows in, 4 outflows out: 40 B; 15 per pipe + K: 68 flops.
+//  - pipe_update (W3, W4): h, s, 4 outflows in, the state out: 40 B; 30 flops (+ 75 flops of
+//    sediment fractions when erosion is on).
+//  - with erosion: tilt (E0) 8 B, 10 flops; erode (E1-E4, E6) h, s, hu, hv, tilt, 4 layers, base
+//    in, s, 4 layers, bed out: 64 B, 42 flops; thermal_flux (E7, E8) h, bed, 4 layers in, 4
+//    outflows out: 40 B, 45 flops (thermal_apply runs only where material moves: nowhere on this
+//    gentle terrain).
+//  - flood mode: sources 24 B / 8; each face pass (W13-W17, W21, W23): h, hu, hv, bed in (19 B
+//    with the 3 extra rows of each 16-row run), 2 faces x 4 fluxes and the 2 bed-source terms out
+//    (40 B), the corrector's also reading the old ones (40 B): 59 B / 236 flops and 99 B / 246
+//    flops (primitives 3, sides 72, HLL 2 x 68, bed source 25); updates (W18, W24): faces 32 B,
+//    state 16 B, sources 8 B in, 16 B out: 72 B / 56 flops, the corrector 4 B of limits more and
+//    W25 and W19 (one std::pow) 76 B / 76 flops; fv_limit (W25) 16 B / 15; the wave speed (W10)
+//    12 B / 10.
+struct Work {
+  double bytes, flops;
+};
+constexpr Work kPipes{24 + 40 + 40, 8 + 68 + 30};
+constexpr Work kErosion{kPipes.bytes + 8 + 64 + 40, kPipes.flops + 75 + 10 + 42 + 45};
+constexpr Work kFlood{24 + 59 + 72 + 99 + 16 + 76 + 12, 8 + 236 + 56 + 246 + 15 + 76 + 10};
+
+// ---------------------------------------------------------------------------------------------
+// The machine's floors (measured once, before the benchmarks)
+
+// The STREAM triad over [0, n), built for the instruction sets the CPU kernels are.
+[[gnu::target_clones("default", "arch=x86-64-v3")]] void triad(double* a, const double* b, const double* c, double s,
+                                                               long n, int threads) {
+#pragma omp parallel for schedule(static) num_threads(threads)
+  for (long i = 0; i < n; ++i) a[i] = b[i] + s * c[i];
+}
+
+// `iterations` rounds of 12 independent chains of 8-float vectors, each a multiply then an add
+// (the kernels do not contract into FMA: this file is built with -ffp-contract=off too), enough
+// chains to cover the latency; returns a value so nothing is optimised away.
+using Vec8 = float __attribute__((vector_size(32)));
+[[gnu::target_clones("default", "arch=x86-64-v3")]] float chains(long iterations, float m, float c) {
+  const Vec8 vm = {m, m, m, m, m, m, m, m}, vc = {c, c, c, c, c, c, c, c};
+  Vec8 a0 = vc, a1 = vc + 1, a2 = vc + 2, a3 = vc + 3, a4 = vc + 4, a5 = vc + 5, a6 = vc + 6, a7 = vc + 7, a8 = vc + 8,
+       a9 = vc + 9, a10 = vc + 10, a11 = vc + 11;
+  for (long it = 0; it < iterations; ++it) {
+    a0 = a0 * vm + vc, a1 = a1 * vm + vc, a2 = a2 * vm + vc, a3 = a3 * vm + vc, a4 = a4 * vm + vc, a5 = a5 * vm + vc;
+    a6 = a6 * vm + vc, a7 = a7 * vm + vc, a8 = a8 * vm + vc, a9 = a9 * vm + vc, a10 = a10 * vm + vc,
+    a11 = a11 * vm + vc;
+  }
+  const Vec8 sum = a0 + a1 + a2 + a3 + a4 + a5 + a6 + a7 + a8 + a9 + a10 + a11;
+  return sum[0] + sum[1] + sum[2] + sum[3] + sum[4] + sum[5] + sum[6] + sum[7];
+}
+constexpr double kChainFlops = 12 * 8 * 2;  // per iteration
+
+struct Floors {
+  double bandwidthGBs[3] = {0, 0, 0};  // by thread count (1, 2)
+  double peakGflops[3] = {0, 0, 0};
+};
+Floors gFloors;
+
+double bestOf(int runs, const std::function<void()>& f) {
+  double best = 1e30;
+  for (int r = 0; r < runs; ++r) {
+    const auto t0 = std::chrono::steady_clock::now();
+    f();
+    best = std::min(best, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  }
+  return best;
+}
+
+void measureFloors() {
+  const long n = 1L << 23;  // 64 MB per array, far beyond the caches
+  std::vector<double> a(size_t(n), 0.0), b(size_t(n), 1.0), c(size_t(n), 2.0);
+  for (int threads : {1, 2}) {
+    triad(a.data(), b.data(), c.data(), 3.0, n, threads);  // first touch
+    const double s = bestOf(5, [&] { triad(a.data(), b.data(), c.data(), 3.0, n, threads); });
+    gFloors.bandwidthGBs[threads] = 3.0 * 8.0 * double(n) / s / 1e9;
+    const long iterations = 10000000;
+    float results[2] = {0.0f, 0.0f};
+    const double t = bestOf(3, [&] {
+#pragma omp parallel num_threads(threads)
+      results[omp_get_thread_num()] = chains(iterations, 0.999999f, 1e-7f);
+    });
+    if (results[0] == 12345.0f) std::printf("\n");  // keeps the chains
+    gFloors.peakGflops[threads] = kChainFlops * double(iterations) * threads / t / 1e9;
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// The benchmarks
 
 // A rolling 4-layer terrain with water in its hollows, n x n cells of 10 m.
 ts::SimInput terrainOf(int n) {
@@ -45,89 +145,163 @@ ts::SimInput terrainOf(int n) {
   return in;
 }
 
-// `levelEdge`: the whole west column held at a fixed level (W26) 1 m above the datum.
-void run(benchmark::State& state, ts::SimParams p, double bytesPerCell, bool levelEdge = false) {
-  strata::bench::glContext();
+ts::SimParams pipes() {
+  ts::SimParams p;
+  p.maxDtS = 0.2f;
+  p.pipeAreaM2 = 100.0f;
+  p.rainMmPerHour = 10.0f;
+  return p;
+}
+ts::SimParams erosion() {
+  ts::SimParams p = pipes();
+  p.erosionEnabled = true;
+  p.thermalEnabled = true;
+  p.capacityK = 0.05f;
+  p.erosionRate = 0.5f;
+  p.depositionRate = 0.3f;
+  return p;
+}
+ts::SimParams flood() {
+  ts::SimParams p;
+  p.waterModel = ts::WaterModel::kFiniteVolume;
+  p.maxDtS = 5.0f;
+  p.cflAlpha = 0.45f;
+  p.manningN = 0.03f;
+  return p;
+}
+
+std::optional<gl::HeadlessContext> gContext;
+
+// threads 0: the GL backend; else the CPU backend with that many threads, every cell every step
+// unless `skip` (then dry blocks are skipped, and cell updates still count every cell).
+void run(benchmark::State& state, const ts::SimParams& p, Work work, int threads, bool skip) {
   const int n = int(state.range(0));
   const auto input = terrainOf(n);
-  auto sim = render::sim::Simulation::create(input, p);
+  std::unique_ptr<ts::Solver> sim;
+  if (threads == 0) {
+    if (!gContext) {
+      state.SkipWithError("no GL context");
+      return;
+    }
+    auto s = ts::GlSolver::create(input, p);
+    if (s) sim = std::make_unique<ts::GlSolver>(std::move(s).value());
+  } else {
+    auto s = ts::CpuSolver::create(input, p, ts::CpuOptions{threads, skip});
+    if (s) sim = std::make_unique<ts::CpuSolver>(std::move(s).value());
+  }
+  if (!sim) {
+    state.SkipWithError("the solver could not be created");
+    return;
+  }
+  auto finish = [&] {
+    if (threads == 0) gl::finish();
+  };
+  sim->step(2);  // warm up: first dispatches compile, pages are touched
+  finish();
+  const int steps = n >= 1024 ? 1 : 4;
+  double seconds = 0;
+  for (auto _ : state) {
+    const auto t0 = std::chrono::steady_clock::now();
+    sim->step(steps);
+    finish();
+    const double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    seconds += t;
+    state.SetIterationTime(t / steps);
+  }
+  const double cells = double(n) * n, perStep = seconds / (double(state.iterations()) * steps);
+  const int floorThreads = threads == 1 ? 1 : 2;  // llvmpipe runs on both cores
+  const double bwFloor = work.bytes * cells / (gFloors.bandwidthGBs[floorThreads] * 1e9);
+  const double flopFloor = work.flops * cells / (gFloors.peakGflops[floorThreads] * 1e9);
+  state.counters["cells/s"] = benchmark::Counter(cells * double(state.iterations()), benchmark::Counter::kIsRate);
+  state.counters["B/cell"] = work.bytes;
+  state.counters["flop/cell"] = work.flops;
+  state.counters["x_bw_floor"] = perStep / bwFloor;
+  state.counters["x_flop_floor"] = perStep / flopFloor;
+}
+
+// A halo exchange's share of GL work: read an 8-cell strip down the east side of an n x n grid
+// (state, flux, four layers: kBlockHalo) and write it back on the west side, as a block on a rank
+// does for each neighbour every step. Wall time (host transfers, not GPU time).
+void glHaloStrip(benchmark::State& state) {
+  if (!gContext) {
+    state.SkipWithError("no GL context");
+    return;
+  }
+  const int n = int(state.range(0));
+  auto sim = ts::GlSolver::create(terrainOf(n), ts::SimParams{});
   if (!sim) {
     state.SkipWithError(sim.message().c_str());
     return;
   }
-  if (levelEdge) {
-    ts::LevelBoundary level;
-    for (int y = 0; y < n; ++y) level.cells.push_back({0, y});
-    level.stageM = {{0.0, input.datumM + 1.0}};
-    if (auto st = sim->addLevel(level); !st) state.SkipWithError(st.message().c_str());
-  }
-  sim->step(2);  // warm up: first dispatches compile and page in
-  const int stepsPerIteration = n >= 1024 ? 1 : 4;
   for (auto _ : state) {
-    render::gl::GpuTimer t;
-    t.begin();
-    sim->step(stepsPerIteration);
-    t.end();
-    state.SetIterationTime(t.milliseconds() * 1e-3 / stepsPerIteration);
+    ts::CellBlock b = sim->readBlock(n - 16, 0, 8, n, ts::kBlockHalo);
+    b.x0 = 0;
+    sim->writeBlock(b);
   }
-  const double cells = double(n) * n;
-  state.counters["cells/s"] = benchmark::Counter(cells * double(state.iterations()), benchmark::Counter::kIsRate);
-  state.counters["B/cell/step"] = bytesPerCell;
-  state.counters["gpu_MB"] = double(sim->gpuBytes()) / 1e6;
-  state.SetBytesProcessed(int64_t(double(state.iterations()) * cells * bytesPerCell));
+  state.counters["bytes_per_strip"] = double(n) * 8 * (16 + 16 + 16);
 }
 
-void BM_SimPipes(benchmark::State& state) {
-  ts::SimParams p;
-  p.maxDtS = 0.2f;
-  p.pipeAreaM2 = 100.0f;
-  p.rainMmPerHour = 10.0f;
-  run(state, p, kPipeBytes);
+void registerAll() {
+  struct Model {
+    const char* name;
+    ts::SimParams params;
+    Work work;
+  };
+  const Model models[] = {
+      {"pipes", pipes(), kPipes}, {"pipes_erosion_thermal_4layers", erosion(), kErosion}, {"flood", flood(), kFlood}};
+  struct Variant {
+    const char* name;
+    int threads;
+    bool skip;
+  };
+  const Variant variants[] = {{"cpu_1thread", 1, false}, {"cpu_2threads", 2, false}, {"gl", 0, false}};
+  for (const auto& m : models) {
+    for (const auto& v : variants) {
+      const std::string name = std::string(m.name) + "/" + v.name;
+      benchmark::RegisterBenchmark(name.c_str(),
+                                   [m, v](benchmark::State& s) { run(s, m.params, m.work, v.threads, v.skip); })
+          ->Arg(256)
+          ->Arg(512)
+          ->Arg(1024)
+          ->Arg(2048)
+          ->UseManualTime()
+          ->Unit(benchmark::kMillisecond);
+    }
+  }
+  // Flood mode skipping the dry blocks of this terrain (the production setting): the cell updates
+  // still count every cell.
+  benchmark::RegisterBenchmark("flood/cpu_2threads_skipping_dry_blocks",
+                               [](benchmark::State& s) { run(s, flood(), kFlood, 2, true); })
+      ->Arg(256)
+      ->Arg(512)
+      ->Arg(1024)
+      ->Arg(2048)
+      ->UseManualTime()
+      ->Unit(benchmark::kMillisecond);
+  benchmark::RegisterBenchmark("gl_halo_strip", glHaloStrip)->Arg(512)->Arg(2048)->Unit(benchmark::kMillisecond);
 }
-
-void BM_SimPipesErosion4Layers(benchmark::State& state) {
-  ts::SimParams p;
-  p.maxDtS = 0.2f;
-  p.pipeAreaM2 = 100.0f;
-  p.rainMmPerHour = 10.0f;
-  p.erosionEnabled = 1;
-  p.thermalEnabled = 1;
-  p.capacityK = 0.05f;
-  p.erosionRate = 0.5f;
-  p.depositionRate = 0.3f;
-  run(state, p, kErosionBytes);
-}
-
-void BM_SimFlood(benchmark::State& state) {
-  ts::SimParams p;
-  p.waterModel = int32_t(ts::WaterModel::kFiniteVolume);
-  p.maxDtS = 5.0f;
-  p.cflAlpha = 0.45f;
-  p.manningN = 0.03f;
-  run(state, p, kFloodBytes);
-}
-
-// BM_SimFlood with a fixed level on its west edge: the level pass's cost, side by side.
-void BM_SimFloodLevelEdge(benchmark::State& state) {
-  ts::SimParams p;
-  p.waterModel = int32_t(ts::WaterModel::kFiniteVolume);
-  p.maxDtS = 5.0f;
-  p.cflAlpha = 0.45f;
-  p.manningN = 0.03f;
-  run(state, p, kFloodBytes, true);
-}
-
-BENCHMARK(BM_SimPipes)->Arg(256)->Arg(512)->Arg(1024)->Arg(2048)->UseManualTime()->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_SimPipesErosion4Layers)
-    ->Arg(256)
-    ->Arg(512)
-    ->Arg(1024)
-    ->Arg(2048)
-    ->UseManualTime()
-    ->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_SimFlood)->Arg(256)->Arg(512)->Arg(1024)->Arg(2048)->UseManualTime()->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_SimFloodLevelEdge)->Arg(256)->Arg(512)->Arg(1024)->UseManualTime()->Unit(benchmark::kMillisecond);
 
 }  // namespace
 
-int main(int argc, char** argv) { return strata::bench::benchGlMain(argc, argv); }
+int main(int argc, char** argv) {
+  benchmark::Initialize(&argc, argv);
+  measureFloors();
+  char text[160];
+  std::snprintf(text, sizeof text, "%.1f GB/s (1 thread), %.1f GB/s (2 threads)", gFloors.bandwidthGBs[1],
+                gFloors.bandwidthGBs[2]);
+  benchmark::AddCustomContext("stream_triad", text);
+  std::snprintf(text, sizeof text, "%.1f GFLOP/s (1 thread), %.1f GFLOP/s (2 threads)", gFloors.peakGflops[1],
+                gFloors.peakGflops[2]);
+  benchmark::AddCustomContext("peak_mul_add", text);
+  auto ctx = gl::HeadlessContext::create({.debugOutput = false});
+  if (ctx) {
+    gContext.emplace(std::move(ctx).value());
+    benchmark::AddCustomContext("gl_renderer", gContext->info().renderer);
+  } else {
+    benchmark::AddCustomContext("gl_renderer", "none: " + ctx.message());
+  }
+  registerAll();
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

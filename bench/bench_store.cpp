@@ -2,6 +2,13 @@
 // timing does not fit a one-shot multi-GiB ingest).
 //
 //   build/bench/strata_bench_store [--size 32768] [--dir /tmp/strata-bench-store] [--no-gdal]
+//   build/bench/strata_bench_store --striped 16384 [--dir DIR]
+//
+// --striped N: the ingest benchmark. A real-relief N x N striped GeoTIFF (Mount Rainier's
+// SRTM tile resampled by gdalwarp -r cubic, float32, DEFLATE, one row a strip) is made in DIR;
+// then, one after the other on that file, `strata ingest` with its defaults and
+// `gdal_translate -co TILED=YES` + `gdaladdo -r average`, each a child process whose wall time
+// and peak RSS (wait4) are reported.
 //
 // 1. Ingest of a synthetic size x size float32 DEM generated on the fly (the streaming
 //    check): seconds, MB/s of input, peak RSS of the process (getrusage) right after it.
@@ -13,7 +20,9 @@
 //    512 x 512 windows through the store's cache (hit rate, prefetch) against the same walk
 //    through GDAL's block cache.
 #include <fcntl.h>
+#include <spawn.h>
 #include <sys/resource.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <gdal_priv.h>
@@ -22,6 +31,7 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -61,6 +71,84 @@ gis::Georef benchGeoref(int n) {
   std::exit(1);
 }
 
+// A child process started with an argument vector (no shell), its output to `log`: exit status,
+// wall seconds and peak resident set (MiB, from wait4).
+struct ChildRun {
+  int status = -1;
+  double seconds = 0, peakRssMiB = 0;
+};
+ChildRun run(const std::vector<std::string>& args, const fs::path& log) {
+  std::vector<char*> argv;
+  for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t fa;
+  posix_spawn_file_actions_init(&fa);
+  posix_spawn_file_actions_addopen(&fa, 1, log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
+  posix_spawn_file_actions_adddup2(&fa, 1, 2);
+  ChildRun r;
+  pid_t pid = 0;
+  const auto t0 = Clock::now();
+  const int rc = posix_spawnp(&pid, argv[0], &fa, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&fa);
+  if (rc != 0) die(args[0] + ": cannot start: " + std::strerror(rc));
+  int status = 0;
+  rusage u{};
+  wait4(pid, &status, 0, &u);
+  r.seconds = since(t0);
+  r.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.peakRssMiB = double(u.ru_maxrss) / 1024.0;
+  if (r.status != 0) die(args[0] + " failed (see " + log.string() + ")");
+  return r;
+}
+
+// --striped N: strata ingest against gdal_translate + gdaladdo on one real-relief striped GeoTIFF.
+int stripedBenchmark(int n, const fs::path& dir) {
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path log = dir / "tools.log", input = dir / "striped.tif", tiled = dir / "tiled.tif";
+  const std::string size = std::to_string(n);
+  std::fprintf(stderr, "making %s (%d x %d, striped)\n", input.c_str(), n, n);
+  run({"gdalwarp", "-q", "-ts", size, size, "-r", "cubic", "-ot", "Float32", "-co", "COMPRESS=DEFLATE", "-co",
+       "PREDICTOR=3", "-co", "TILED=NO", "-co", "BIGTIFF=YES", STRATA_DATA_DIR "/rainier/mt_rainier_90m.tif",
+       input.string()},
+      log);
+  GDALAllRegister();
+  auto* probe = static_cast<GDALDataset*>(GDALOpen(input.c_str(), GA_ReadOnly));
+  if (!probe) die(input.string() + ": cannot open");
+  int bx = 0, by = 0;
+  probe->GetRasterBand(1)->GetBlockSize(&bx, &by);
+  GDALClose(probe);
+  const double inputMB = double(fs::file_size(input)) / 1e6;
+  ::sync();
+  std::fprintf(stderr, "strata ingest\n");
+  const auto ours = run({STRATA_CLI, "ingest", (dir / "store").string(), "--dem", input.string()}, log);
+  auto store = TileStore::open(dir / "store", {.budgetBytes = size_t(16) << 20, .prefetch = false});
+  if (!store) die(store.message());
+  const auto fp = store->footprintStats();
+  const auto err = store->errorSummary(0);
+  ::sync();
+  std::fprintf(stderr, "gdal_translate + gdaladdo\n");
+  const auto translate = run({"gdal_translate", "-q", "-co", "TILED=YES", "-co", "COMPRESS=DEFLATE", "-co",
+                              "PREDICTOR=3", "-co", "BIGTIFF=YES", input.string(), tiled.string()},
+                             log);
+  const auto addo = run(
+      {"gdaladdo", "-q", "-r", "average", tiled.string(), "2", "4", "8", "16", "32", "64", "128", "256", "512", "1024"},
+      log);
+  const double gdalSeconds = translate.seconds + addo.seconds;
+  const double gdalRss = std::max(translate.peakRssMiB, addo.peakRssMiB);
+  std::printf(
+      "{\"size\": %d, \"input\": {\"file_mb\": %.1f, \"block\": [%d, %d]},\n"
+      " \"strata_ingest\": {\"seconds\": %.1f, \"peak_rss_mib\": %.1f, \"file_mb\": %.1f, \"saved_fraction\": %.4f, "
+      "\"max_error_m\": %.4g, \"rms_error_m\": %.4g},\n"
+      " \"gdal\": {\"translate_seconds\": %.1f, \"translate_peak_rss_mib\": %.1f, \"gdaladdo_seconds\": %.1f, "
+      "\"gdaladdo_peak_rss_mib\": %.1f, \"seconds\": %.1f, \"peak_rss_mib\": %.1f, \"file_mb\": %.1f},\n"
+      " \"strata_over_gdal\": {\"time\": %.2f, \"peak_rss\": %.3f}}\n",
+      n, inputMB, bx, by, ours.seconds, ours.peakRssMiB, double(fp.fileBytes) / 1e6, fp.savedFraction(), err.maxM,
+      err.rmsM, translate.seconds, translate.peakRssMiB, addo.seconds, addo.peakRssMiB, gdalSeconds, gdalRss,
+      double(fs::file_size(tiled)) / 1e6, ours.seconds / gdalSeconds, ours.peakRssMiB / gdalRss);
+  return 0;
+}
+
 double percentile(std::vector<double> v, double p) {
   std::sort(v.begin(), v.end());
   return v[size_t(p * double(v.size() - 1))];
@@ -95,9 +183,12 @@ int main(int argc, char** argv) {
   int n = 32768;
   fs::path dir = fs::temp_directory_path() / "strata-bench-store";
   bool gdal = true;
+  int striped = 0;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
-    if (a == "--size" && i + 1 < argc) {
+    if (a == "--striped" && i + 1 < argc) {
+      striped = std::atoi(argv[++i]);
+    } else if (a == "--size" && i + 1 < argc) {
       n = std::atoi(argv[++i]);
     } else if (a == "--dir" && i + 1 < argc) {
       dir = argv[++i];
@@ -108,8 +199,12 @@ int main(int argc, char** argv) {
       std::printf("{\"rough_tiles_checked\": %d, \"mismatching_cells\": %ld}\n", tiles, bad);
       return bad ? 1 : 0;
     } else {
-      die("unknown argument '" + a + "' (use --size N, --dir DIR, --no-gdal, or --check STORE)");
+      die("unknown argument '" + a + "' (use --size N, --dir DIR, --no-gdal, --striped N, or --check STORE)");
     }
+  }
+  if (striped) {
+    if (striped < 1024 || striped > 65536) die("--striped: 1024..65536");
+    return stripedBenchmark(striped, dir);
   }
   if (n < 1024 || n % 1024) die("--size must be a multiple of 1024");
   fs::remove_all(dir);
@@ -172,24 +267,21 @@ int main(int argc, char** argv) {
     }
     return g;
   };
-  std::system("sync");
+  ::sync();
   t0 = Clock::now();
   auto ours = ingest(dir / "raw.store", benchGeoref(n), {{{"bedrock", LayerKind::Bedrock, ""}, rawReader}}, opts);
   if (!ours) die(ours.message());
   const double oursSeconds = since(t0);
-  std::system("sync");
+  ::sync();
   const fs::path tif = dir / "dem_tiled.tif";
-  const std::string translate =
-      "gdal_translate -q -of GTiff -co TILED=YES -co BLOCKXSIZE=256 -co BLOCKYSIZE=256 "
-      "-co COMPRESS=DEFLATE -co PREDICTOR=3 -co BIGTIFF=YES " +
-      vrt.string() + " " + tif.string();
-  const std::string addo = "gdaladdo -q -r average " + tif.string() + " 2 4 8 16 32 64 128 256 512 1024";
-  t0 = Clock::now();
-  if (std::system(translate.c_str()) != 0) die("gdal_translate failed: " + translate);
-  const double translateSeconds = since(t0);
-  t0 = Clock::now();
-  if (std::system(addo.c_str()) != 0) die("gdaladdo failed: " + addo);
-  const double addoSeconds = since(t0);
+  const auto translate =
+      run({"gdal_translate", "-q", "-of", "GTiff", "-co", "TILED=YES", "-co", "BLOCKXSIZE=256", "-co", "BLOCKYSIZE=256",
+           "-co", "COMPRESS=DEFLATE", "-co", "PREDICTOR=3", "-co", "BIGTIFF=YES", vrt.string(), tif.string()},
+          dir / "tools.log");
+  const auto addo = run(
+      {"gdaladdo", "-q", "-r", "average", tif.string(), "2", "4", "8", "16", "32", "64", "128", "256", "512", "1024"},
+      dir / "tools.log");
+  const double translateSeconds = translate.seconds, addoSeconds = addo.seconds;
   const double gdalSeconds = translateSeconds + addoSeconds;
   std::printf(
       ",\n \"raw_ingest\": {\"ours_seconds\": %.2f, \"ours_mb_per_s\": %.1f, \"gdal_translate_seconds\": %.2f, "

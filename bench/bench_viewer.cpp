@@ -8,16 +8,17 @@
 #include <string>
 
 #include <strata/gis/dem_io.hpp>
-#include <strata/render/gl/context.hpp>
-#include <strata/render/viewer/viewer.hpp>
+#include <strata/gl/context.hpp>
+#include <strata/gl/state.hpp>
+#include <strata/viewer/viewer.hpp>
 
 using namespace strata;
-using namespace strata::render::viewer;
+using namespace strata::viewer;
 
 int main(int argc, char** argv) {
   const std::string demPath = argc > 1 ? argv[1] : std::string(STRATA_DATA_DIR) + "/grand_canyon/grand_canyon_512.tif";
   const int frames = argc > 2 ? std::atoi(argv[2]) : 60;
-  auto ctx = render::gl::HeadlessContext::create({.debugOutput = false});
+  auto ctx = gl::HeadlessContext::create({.debugOutput = false});
   if (!ctx) {
     std::fprintf(stderr, "%s\n", ctx.message().c_str());
     return 1;
@@ -79,11 +80,11 @@ int main(int argc, char** argv) {
     const auto& r = v.region()->rect;
     auto& scene = v.scene();
     auto timeMs = [&](auto&& body) {
-      glFinish();
+      gl::finish();
       const auto t = std::chrono::steady_clock::now();
       for (int i = 0; i < frames; ++i) {
         body();
-        glFinish();
+        gl::finish();
       }
       return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count() / frames;
     };
@@ -91,15 +92,16 @@ int main(int argc, char** argv) {
       for (int field = 0; field < 2; ++field) {
         const auto g = field == 0 ? sm.readWaterDepth() : sm.readSuspended();
         gis::Grid<float> full(scene.width(), scene.height(), 0.0f);
-        for (int y = 0; y < r.h; ++y) std::copy_n(&g.data[size_t(y) * size_t(r.w)], r.w, &full.at(r.x, r.y + y));
+        for (int y = 0; y < r.height; ++y)
+          std::copy_n(&g.data[size_t(y) * size_t(r.width)], r.width, &full.at(r.x, r.y + y));
         (void)(field == 0 ? scene.setWaterDepth(full) : scene.setSuspendedSediment(full));
       }
     });
-    const double gpuCopy = timeMs([&] { scene.copyWaterState(sm.stateBuffer(), r.x, r.y, r.w, r.h); });
+    const double gpuCopy = timeMs([&] { scene.copyWaterState(sm.stateBuffer(), r.x, r.y, r.width, r.height); });
     std::printf(
         "{\"config\": \"water-display\", \"renderer\": \"%s\", \"scene\": \"%dx%d\", \"region\": \"%dx%d\", "
         "\"cpu_roundtrip_ms\": %.3f, \"gpu_copy_ms\": %.3f}\n",
-        ctx->info().renderer.c_str(), scene.width(), scene.height(), r.w, r.h, roundTrip, gpuCopy);
+        ctx->info().renderer.c_str(), scene.width(), scene.height(), r.width, r.height, roundTrip, gpuCopy);
   }
   return 0;
 }

@@ -45,3 +45,16 @@ endif()
 if(STRATA_BUILD_BENCH)
   find_package(benchmark CONFIG REQUIRED)
 endif()
+
+# OpenMP (GCC's libgomp): the CPU solver's threads.
+find_package(OpenMP REQUIRED COMPONENTS CXX)
+
+# MPI (Open MPI on Debian) for distributed runs: MPI::MPI_CXX (the C API from C++); mpirun is
+# MPIEXEC_EXECUTABLE, which the multi-rank tests run under.
+find_package(MPI REQUIRED COMPONENTS CXX)
+# Open MPI refuses more ranks than cores unless told to oversubscribe (tests run 4 ranks on 2).
+set(STRATA_MPIEXEC_FLAGS ${MPIEXEC_PREFLAGS})
+execute_process(COMMAND ${MPIEXEC_EXECUTABLE} --version OUTPUT_VARIABLE _mpiexec_version ERROR_QUIET)
+if(_mpiexec_version MATCHES "Open MPI|OpenRTE")
+  list(APPEND STRATA_MPIEXEC_FLAGS --oversubscribe)
+endif()

@@ -1,29 +1,42 @@
 #!/usr/bin/env bash
-# Fuzzes the DEM reading path (tests/gis/fuzz/read_dem_fuzz.cpp) with libFuzzer under
-# AddressSanitizer + UndefinedBehaviorSanitizer, for a bounded time.
+# Fuzzes Strata's readers of untrusted input with libFuzzer under AddressSanitizer +
+# UndefinedBehaviorSanitizer, for a bounded time per target:
+#   dem       the DEM reading path (tests/gis/fuzz/read_dem_fuzz.cpp)
+#   manifest  the tile store's manifest reader (tests/terrain/fuzz/manifest_fuzz.cpp)
+#   scenario  the scenario parser, TOML included (tests/scenario/fuzz/parse_scenario_fuzz.cpp)
 #
-#   scripts/fuzz.sh [SECONDS]        default 120
+#   scripts/fuzz.sh [SECONDS] [TARGET...]    default 120 s each, every target
 #
-# Its own build in build-fuzz/ (clang++ -fsanitize=fuzzer,address,undefined over core/ and gis/
-# sources; GDAL is the system library, not instrumented). Seeds are small valid TIFFs made with
-# gdal_translate from the shared DEMs and generated rasters; crashes land in build-fuzz/crashes/.
+# Its own build in build-fuzz/ (clang++ -fsanitize=fuzzer,address,undefined over the sources a
+# target needs; GDAL is the system's; toml++ with its assertions on (no NDEBUG), so an input
+# reaching one of toml++ 3.3.0's defects aborts instead of passing unnoticed). Each target starts
+# from its seeds and its regression inputs (every input that once crashed, run first, so a
+# regression fails at once); crashes land in build-fuzz/crashes/<target>/ and make the script
+# fail. CI runs `scripts/fuzz.sh 30`.
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 seconds=${1:-120}
+shift || true
+targets=("$@")
+[ ${#targets[@]} -gt 0 ] || targets=(dem manifest scenario)
 out="$root/build-fuzz"
 data="$root/../shared/data"
-mkdir -p "$out/seeds" "$out/corpus" "$out/crashes"
+common=(-std=c++20 -g -O1 -fsanitize=fuzzer,address,undefined -fno-omit-frame-pointer -I"$root/core/include")
 
-flags=(-std=c++20 -g -O1 -fsanitize=fuzzer,address,undefined -fno-omit-frame-pointer
-       -I"$root/core/include" -I"$root/gis/include" -I"$root/gis/src" $(pkg-config --cflags gdal geographiclib))
-sources=("$root"/core/src/*.cpp "$root"/gis/src/*.cpp "$root/tests/gis/fuzz/read_dem_fuzz.cpp")
-echo "fuzz: building $out/read_dem_fuzz" >&2
-clang++ "${flags[@]}" "${sources[@]}" $(pkg-config --libs gdal geographiclib) -o "$out/read_dem_fuzz"
+export ASAN_OPTIONS=${ASAN_OPTIONS:-"detect_leaks=1:allocator_may_return_null=1"}
+export UBSAN_OPTIONS=${UBSAN_OPTIONS:-"print_stacktrace=1:halt_on_error=1"}
 
-# Seeds: small, valid, and varied (types, layouts, compression, nodata, scale/offset, no georef).
-s="$out/seeds"
-if [ -z "$(ls -A "$s")" ]; then
-  gt=(gdal_translate -q)
+build_dem() {
+  clang++ "${common[@]}" -I"$root/gis/include" -I"$root/gis/src" $(pkg-config --cflags gdal geographiclib) \
+    "$root"/core/src/*.cpp "$root"/gis/src/*.cpp "$root/tests/gis/fuzz/read_dem_fuzz.cpp" \
+    $(pkg-config --libs gdal geographiclib) -o "$out/read_dem_fuzz"
+}
+
+# Small, valid, and varied TIFFs (types, layouts, compression, nodata, scale/offset, no georef).
+seed_dem() {
+  local s=$1
+  [ -z "$(ls -A "$s")" ] || return 0
+  local gt=(gdal_translate -q)
   "${gt[@]}" -srcwin 100 100 16 16 "$data/grand_canyon/grandcanyon_srtm_3857.tif" "$s/int16_3857.tif"
   "${gt[@]}" -srcwin 100 100 16 12 -co TILED=YES -co BLOCKXSIZE=16 -co BLOCKYSIZE=16 -co COMPRESS=DEFLATE \
     "$data/grand_canyon/grand_canyon_512.tif" "$s/float_tiled_deflate.tif"
@@ -38,11 +51,54 @@ if [ -z "$(ls -A "$s")" ]; then
     "$s/cog.tif"
   "${gt[@]}" -srcwin 0 0 8 8 -ot Byte -scale "$data/grand_canyon/grand_canyon_512.tif" "$s/byte.tif"
   rm -f "$s"/*.aux.xml
-fi
+}
 
-echo "fuzz: running for ${seconds}s" >&2
-export ASAN_OPTIONS=${ASAN_OPTIONS:-"detect_leaks=1:allocator_may_return_null=1"}
-export UBSAN_OPTIONS=${UBSAN_OPTIONS:-"print_stacktrace=1:halt_on_error=1"}
-cd "$out"
-./read_dem_fuzz -max_total_time="$seconds" -timeout=20 -rss_limit_mb=2048 -max_len=65536 \
-  -artifact_prefix="$out/crashes/" -print_final_stats=1 "$out/corpus" "$s"
+run_dem() {
+  "$out/read_dem_fuzz" -max_total_time="$seconds" -timeout=20 -rss_limit_mb=2048 -max_len=65536 \
+    -artifact_prefix="$out/crashes/dem/" -print_final_stats=1 "$out/corpus/dem" "$out/seeds/dem"
+}
+
+build_manifest() {
+  # Header-only toml++ without NDEBUG: its assertions and TOML_UNREACHABLE abort.
+  clang++ "${common[@]}" -DTOML_HEADER_ONLY=1 -I"$root/gis/include" -I"$root/terrain/include" -I"$root/terrain/src" \
+    $(pkg-config --cflags gdal) "$root"/core/src/*.cpp "$root/gis/src/body.cpp" "$root/terrain/src/manifest.cpp" \
+    "$root/terrain/src/material.cpp" "$root/terrain/src/layered_terrain.cpp" \
+    "$root/tests/terrain/fuzz/manifest_fuzz.cpp" -o "$out/manifest_fuzz"
+}
+
+seed_manifest() { cp "$root"/tests/terrain/fuzz/seeds/*.toml "$1"/; }
+
+run_manifest() {
+  "$out/manifest_fuzz" -max_total_time="$seconds" -timeout=20 -rss_limit_mb=2048 -max_len=16384 \
+    -artifact_prefix="$out/crashes/manifest/" -print_final_stats=1 "$out/corpus/manifest" "$out/seeds/manifest"
+}
+
+build_scenario() {
+  clang++ "${common[@]}" -I"$root/scenario/include" -I"$root/sim/include" \
+    "$root"/core/src/{check,log,progress,time_series}.cpp "$root/scenario/src/scenario.cpp" \
+    "$root/tests/scenario/fuzz/parse_scenario_fuzz.cpp" -o "$out/parse_scenario_fuzz"
+}
+
+# The shipped scenarios and every example of docs/scenario.md's format.
+seed_scenario() {
+  cp "$root"/scenarios/*.toml "$root"/tests/scenario/fuzz/seeds/*.toml "$1/"
+}
+
+run_scenario() {
+  "$out/parse_scenario_fuzz" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -max_len=8192 \
+    -dict="$root/tests/scenario/fuzz/toml.dict" -artifact_prefix="$out/crashes/scenario/" -print_final_stats=1 \
+    "$out/corpus/scenario" "$out/seeds/scenario" "$root/tests/scenario/fuzz/regressions"
+}
+
+for t in "${targets[@]}"; do
+  case "$t" in
+    dem | manifest | scenario) ;;
+    *) echo "fuzz: unknown target '$t' (dem, manifest, scenario)" >&2; exit 2 ;;
+  esac
+  mkdir -p "$out/seeds/$t" "$out/corpus/$t" "$out/crashes/$t"
+  echo "fuzz: building $t" >&2
+  "build_$t"
+  "seed_$t" "$out/seeds/$t"
+  echo "fuzz: running $t for ${seconds}s" >&2
+  (cd "$out" && "run_$t")
+done

@@ -32,6 +32,8 @@ packages=(
   libegl-dev libegl-mesa0 libgl1-mesa-dri libepoxy-dev libglfw3-dev libglm-dev xvfb xauth
   # the viewer's HUD font (stb_easy_font.h: a header-only vector font, no font file)
   libstb-dev
+  # distributed runs over MPI ranks (Open MPI: mpirun, mpicxx, the library and headers)
+  openmpi-bin libopenmpi-dev
   # command line, scenario files
   libcli11-dev libtomlplusplus-dev
   # tests and benchmarks

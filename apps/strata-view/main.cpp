@@ -1,5 +1,5 @@
 // strata-view: the interactive fly-through viewer. A GLFW window whose events become the same
-// viewer Commands a --script file produces; everything else is in strata::render::viewer.
+// viewer Commands a --script file produces; everything else is in strata::viewer.
 // docs/viewer.md.
 #include <chrono>
 #include <cstdio>
@@ -15,15 +15,15 @@
 
 #include <strata/core/log.hpp>
 #include <strata/gis/dem_io.hpp>
-#include <strata/render/gl/context.hpp>
-#include <strata/render/viewer/store_io.hpp>
-#include <strata/render/viewer/viewer.hpp>
+#include <strata/gl/context.hpp>
 #include <strata/terrain/tile_store.hpp>
+#include <strata/viewer/store_io.hpp>
+#include <strata/viewer/viewer.hpp>
 
 namespace {
 
 using namespace strata;
-using namespace strata::render::viewer;
+using namespace strata::viewer;
 
 struct Args {
   std::string input;
@@ -33,6 +33,7 @@ struct Args {
   bool planetary = false;
   float exaggeration = 1;
   int circles = 256;
+  double rangeM = 0, softMinM = 0;
   std::string palette = "hypsometric";
   int frames = 0;
   double dtS = 1.0 / 30.0;
@@ -91,7 +92,7 @@ int run(const Args& a) {
     }
     script = std::move(*s);
   }
-  auto ctx = render::gl::WindowContext::create(
+  auto ctx = gl::WindowContext::create(
       {.width = w, .height = h, .title = "strata-view " + a.input, .vsync = a.script.empty(), .debugOutput = false});
   if (!ctx) {
     std::fprintf(stderr, "strata-view: %s\n", ctx.message().c_str());
@@ -111,7 +112,7 @@ int run(const Args& a) {
       return 1;
     }
     store.emplace(std::move(*s));
-    terrain::Window win{0, 0, store->width(), store->height()};
+    gis::CellRect win{0, 0, store->width(), store->height()};
     if (a.window.size() == 4) win = {a.window[0], a.window[1], a.window[2], a.window[3]};
     auto l = loadStoreSurface(*store, win);
     if (!l) {
@@ -133,9 +134,11 @@ int run(const Args& a) {
   options.height = fbH;
   options.planetary = a.planetary;
   options.circles = a.circles;
+  options.rangeM = a.rangeM;
+  options.softMinM = a.softMinM;
   options.shading.exaggeration = a.exaggeration;
-  if (a.palette == "rust") options.shading.palette = render::terrain::Palette::Rust;
-  if (a.palette == "grey") options.shading.palette = render::terrain::Palette::Grey;
+  if (a.palette == "rust") options.shading.palette = render::Palette::Rust;
+  if (a.palette == "grey") options.shading.palette = render::Palette::Grey;
   if (a.planetary) options.shading.sky = {0, 0, 0, 1};
   auto viewer = Viewer::create(dem, options);
   if (!viewer) {
@@ -197,7 +200,7 @@ int run(const Args& a) {
       std::fprintf(stderr, "strata-view: frame %d: %s\n", frame, s.message().c_str());
       ++failures;
     }
-    if (auto s = v.present(0, fbW, fbH); !s) {
+    if (auto s = v.present(fbW, fbH); !s) {
       std::fprintf(stderr, "strata-view: frame %d: %s\n", frame, s.message().c_str());
       ++failures;
     }
@@ -232,6 +235,13 @@ int main(int argc, char** argv) {
   app.add_flag("--planetary", a->planetary, "Draw on the body's ellipsoid (geographic DEMs)");
   app.add_option("--exaggeration", a->exaggeration, "Vertical exaggeration");
   app.add_option("--circles", a->circles, "Ring renderer circles (6n^2 triangles)")->check(CLI::Range(8, 2048));
+  app.add_option("--range", a->rangeM,
+                 "View range (m; of arc on a body); default: the DEM's farthest corner, or the horizon over the "
+                 "lowest terrain plus the highest summit's")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--soft-min", a->softMinM,
+                 "Floor of the softened viewer height f(h) = max(5h, this) (m); default: a twelfth of the range")
+      ->check(CLI::NonNegativeNumber);
   app.add_option("--palette", a->palette, "hypsometric, grey or rust")
       ->check(CLI::IsMember({"hypsometric", "grey", "rust"}));
   app.add_option("--script", a->script, "Timed commands (docs/viewer.md); the viewer exits after the last");

@@ -1,10 +1,11 @@
-// strata flood SCENARIO / strata erode SCENARIO: run a what-if scenario on the GPU and write its
+// strata flood SCENARIO / strata erode SCENARIO: run a what-if scenario and write its
 // run folder (maps, series, plots, report). Ctrl-C stops cleanly; --resume continues.
+#include <algorithm>
 #include <cstdio>
 #include <memory>
 
-#include <strata/render/scenario/flood_run.hpp>
-#include <strata/terrain/scenario.hpp>
+#include <strata/scenario/run.hpp>
+#include <strata/scenario/scenario.hpp>
 
 #include "commands.hpp"
 
@@ -12,8 +13,8 @@ namespace strata::app {
 namespace {
 
 struct FloodArgs {
-  std::string scenario, outDir;
-  bool resume = false, noPictures = false, noPlots = false;
+  std::string scenario, outDir, backend;
+  bool resume = false, overwrite = false, noPictures = false, noPlots = false;
 };
 
 void addRunCommand(CLI::App& app, const char* name, const char* help, bool erosion) {
@@ -21,26 +22,44 @@ void addRunCommand(CLI::App& app, const char* name, const char* help, bool erosi
   auto args = std::make_shared<FloodArgs>();
   cmd->add_option("scenario", args->scenario, "Scenario file (TOML, see docs/scenario.md)")->required();
   cmd->add_option("-o,--out", args->outDir, "Run folder (default: runs/<scenario name>)");
-  cmd->add_flag("--resume", args->resume, "Continue an interrupted run from its checkpoint");
+  auto* resume = cmd->add_flag("--resume", args->resume, "Continue an interrupted run from its checkpoint");
+  cmd->add_flag("--overwrite", args->overwrite,
+                "Replace the outputs of an earlier run in the run folder (only the files a run writes)")
+      ->excludes(resume);
+  cmd->add_option("--backend", args->backend,
+                  "auto (GL on a hardware GPU, else the CPU), cpu or gpu; overrides [model] backend");
   cmd->add_flag("--no-pictures", args->noPictures, "Do not render pictures");
   cmd->add_flag("--no-plots", args->noPlots, "Do not draw plots");
   cmd->callback([args, name, erosion] {
-    auto scenario = terrain::loadScenario(args->scenario);
+    auto scenario = scenario::loadScenario(args->scenario);
     if (!scenario) {
       std::fprintf(stderr, "strata %s: %s\n", name, scenario.message().c_str());
       throw CLI::RuntimeError(1);
     }
     if (erosion && !scenario->erosion.enabled) {
       scenario->erosion.enabled = true;
-      scenario->outputs.maps.push_back("terrain_change");
+      for (const auto& m : scenario::erosionOutputMaps()) {
+        auto& maps = scenario->outputs.maps;
+        if (std::find(maps.begin(), maps.end(), m) == maps.end()) maps.push_back(m);
+      }
     }
-    render::scenario::RunOptions opt;
+    scenario::RunOptions opt;
+    opt.command = name;
+    if (!args->backend.empty()) {
+      auto backend = scenario::parseBackend(args->backend);
+      if (!backend) {
+        std::fprintf(stderr, "strata %s: --backend: %s\n", name, backend.message().c_str());
+        throw CLI::RuntimeError(2);
+      }
+      opt.backend = *backend;
+    }
     opt.outDir = args->outDir.empty() ? std::filesystem::path("runs") / scenario->file.stem()
                                       : std::filesystem::path(args->outDir);
     opt.resume = args->resume;
+    opt.overwrite = args->overwrite;
     opt.pictures = !args->noPictures && scenario->outputs.pictures;
     opt.plots = !args->noPlots && scenario->outputs.plots;
-    auto run = render::scenario::runScenario(*scenario, opt);
+    auto run = scenario::runScenario(*scenario, opt);
     if (!run) {
       std::fprintf(stderr, "strata %s: %s\n", name, run.message().c_str());
       throw CLI::RuntimeError(1);

@@ -10,9 +10,9 @@
 #include <strata/core/files.hpp>
 #include <strata/core/log.hpp>
 #include <strata/gis/dem_io.hpp>
-#include <strata/render/gl/context.hpp>
-#include <strata/render/procgen/generator.hpp>
-#include <strata/render/procgen/script_file.hpp>
+#include <strata/gl/context.hpp>
+#include <strata/procgen/generator.hpp>
+#include <strata/procgen/script_file.hpp>
 
 #include "commands.hpp"
 
@@ -21,7 +21,7 @@ namespace {
 
 // A georeferenced layer: float32 GeoTIFF, north-up, origin at the top-left corner.
 Status writeLayerGeoTiff(const std::filesystem::path& target, const gis::Grid<float>& heights,
-                         const render::procgen::OutputGeoref& georef) {
+                         const procgen::OutputGeoref& georef) {
   gis::Raster raster;
   raster.georef.epsg = georef.epsg;
   raster.georef.width = heights.width;
@@ -63,8 +63,8 @@ Status run(const std::string& scriptPath, const std::string& outDir, uint32_t se
   static const std::regex kSize(R"(^(\d{1,5})x(\d{1,5})$)");
   if (!std::regex_match(size, m, kSize)) return fail("--size '" + size + "': expected WxH, e.g. 512x512");
   const int w = std::stoi(m[1]), h = std::stoi(m[2]);
-  STRATA_TRY(auto file, render::procgen::loadScriptFile(scriptPath));
-  render::procgen::GenerateOptions options;
+  STRATA_TRY(auto file, procgen::loadScriptFile(scriptPath));
+  procgen::GenerateOptions options;
   options.width = w;
   options.height = h;
   options.seed = seed;
@@ -77,11 +77,11 @@ Status run(const std::string& scriptPath, const std::string& outDir, uint32_t se
   std::error_code ec;
   std::filesystem::create_directories(outDir, ec);
   if (ec) return fail(outDir + ": cannot create the output folder: " + ec.message());
-  STRATA_TRY(auto ctx, render::gl::HeadlessContext::create({.debugOutput = false}));
+  STRATA_TRY(auto ctx, gl::HeadlessContext::create({.debugOutput = false}));
   for (const auto& layer : file.layers) {
     options.matchDem = layer.matchDem;
     options.matchCoarse = layer.matchCoarse;
-    STRATA_TRY(auto heights, render::procgen::generate(layer.script, options));
+    STRATA_TRY(auto heights, procgen::generate(layer.script, options));
     const auto target = std::filesystem::path(outDir) / (layer.name + (file.georef ? ".tif" : ".exr"));
     if (file.georef) {
       STRATA_TRY_STATUS(writeLayerGeoTiff(target, heights, *file.georef));

@@ -1,7 +1,7 @@
 // strata gpu-info: which GPU (or llvmpipe) Strata's headless context runs on, and its limits.
 #include <cstdio>
 
-#include <strata/render/gl/context.hpp>
+#include <strata/gl/context.hpp>
 
 #include "commands.hpp"
 
@@ -12,13 +12,13 @@ void addGpuInfoCommand(CLI::App& app) {
   auto device = std::make_shared<std::string>("auto");
   cmd->add_option("--device", *device, "EGL device: auto, surfaceless, or an index (env STRATA_EGL_DEVICE)");
   cmd->callback([device] {
-    auto ctx = render::gl::HeadlessContext::create({.device = *device, .debugOutput = false});
+    auto ctx = gl::HeadlessContext::create({.device = *device, .debugOutput = false});
     if (!ctx) {
       std::fprintf(stderr, "strata gpu-info: %s\n", ctx.message().c_str());
       throw CLI::RuntimeError(1);
     }
     const auto& i = ctx->info();
-    const auto l = render::gl::queryContextLimits();
+    const auto l = gl::queryContextLimits();
     std::printf("EGL platform        %s\n", i.platform.c_str());
     if (!i.eglDevice.empty()) std::printf("EGL device          %s\n", i.eglDevice.c_str());
     std::printf("EGL vendor/version  %s / %s\n", i.eglVendor.c_str(), i.eglVersion.c_str());

@@ -1,11 +1,13 @@
 // strata info FILE...: what a DEM is and where it lies (driver, CRS, body, extent, resolution,
-// value range, nodata share).
+// value range, nodata share); for a tile store folder, its summary with the achieved error.
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include <strata/gis/dem_summary.hpp>
+#include <strata/terrain/tile_store.hpp>
 
 #include "commands.hpp"
 
@@ -39,13 +41,49 @@ void printSummary(const gis::DemSummary& s) {
 }  // namespace
 
 void addInfoCommand(CLI::App& app) {
-  auto* cmd = app.add_subcommand("info", "Describe DEMs: driver, CRS, body, extent, resolution, values, nodata");
-  auto files = std::make_shared<std::vector<std::string>>();
-  cmd->add_option("files", *files, "DEM files (any raster GDAL reads)")->required();
-  cmd->callback([files] {
+  auto* cmd = app.add_subcommand(
+      "info", "Describe DEMs (driver, CRS, body, extent, resolution, values, nodata) or tile stores");
+  struct Options {
+    std::vector<std::string> files;
+    std::string assignCrs, assignGeotransform;
+  };
+  auto o = std::make_shared<Options>();
+  cmd->add_option("files", o->files, "DEM files (any raster GDAL reads) or tile store folders")->required();
+  cmd->add_option("--assign-crs", o->assignCrs, "CRS for files that have none (EPSG:n, WKT or PROJ)");
+  cmd->add_option("--assign-geotransform", o->assignGeotransform,
+                  "Geotransform c0,c1,c2,c3,c4,c5 (GDAL's order) for files that have none");
+  cmd->callback([o] {
     bool failed = false;
-    for (const std::string& f : *files) {
-      auto s = gis::summarizeDem(f);
+    std::optional<gis::GeoTransform> assignGt;
+    if (!o->assignGeotransform.empty()) {
+      auto gt = gis::parseGeoTransform(o->assignGeotransform, "--assign-geotransform");
+      if (!gt) {
+        std::fprintf(stderr, "strata info: %s\n", gt.message().c_str());
+        throw CLI::RuntimeError(1);
+      }
+      assignGt = *gt;
+    }
+    for (const std::string& f : o->files) {
+      std::error_code ec;
+      if (std::filesystem::is_directory(f, ec) &&
+          std::filesystem::exists(std::filesystem::path(f) / "manifest.toml", ec)) {
+        auto store = terrain::TileStore::open(f, {.budgetBytes = size_t(16) << 20, .prefetch = false},
+                                              {.allowIncomplete = true});
+        if (!store) {
+          std::fprintf(stderr, "strata info: %s\n", store.message().c_str());
+          failed = true;
+          continue;
+        }
+        std::printf("%s (tile store)\n%s", f.c_str(), terrain::describeStore(*store).c_str());
+        continue;
+      }
+      gis::ReadOptions ro;
+      if (!o->assignCrs.empty() || assignGt) {
+        auto has = gis::georefPresence(f);
+        if (has && !has->crs && !o->assignCrs.empty()) ro.crs = o->assignCrs;
+        if (has && !has->transform && assignGt) ro.transform = assignGt;
+      }
+      auto s = gis::summarizeDem(f, ro);
       if (!s) {
         std::fprintf(stderr, "strata info: %s\n", s.message().c_str());
         failed = true;

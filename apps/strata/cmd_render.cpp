@@ -10,12 +10,12 @@
 #include <vector>
 
 #include <strata/gis/dem_io.hpp>
-#include <strata/render/gl/context.hpp>
+#include <strata/gl/context.hpp>
+#include <strata/render/flight_path.hpp>
 #include <strata/render/image_io.hpp>
-#include <strata/render/terrain/flight_path.hpp>
-#include <strata/render/terrain/sliding_grid.hpp>
-#include <strata/render/terrain/synthetic_dem.hpp>
-#include <strata/render/terrain/terrain_renderer.hpp>
+#include <strata/render/sliding_grid.hpp>
+#include <strata/render/synthetic_dem.hpp>
+#include <strata/render/terrain_renderer.hpp>
 #include <strata/terrain/tile_store.hpp>
 
 #include "commands.hpp"
@@ -23,7 +23,7 @@
 namespace strata::app {
 namespace {
 
-using namespace strata::render::terrain;
+using namespace strata::render;
 
 struct RenderArgs {
   std::string dem;
@@ -34,7 +34,9 @@ struct RenderArgs {
   std::string size = "1280x720";
   std::string renderer = "ring";
   int circles = 256;
+  double rangeM = 0, softMinM = 0, softFactor = 5;
   bool planetary = false;
+  std::string voids = "fill";
   float exaggeration = 1;
   std::optional<float> seaLevel;
   std::string palette = "hypsometric";
@@ -43,6 +45,7 @@ struct RenderArgs {
   int frames = 0;
   int clipSize = 512, pageSize = 64, uploadPages = 64;
   double gpuBudgetMiB = 256;
+  bool overwrite = false;
 };
 
 [[noreturn]] void die(const std::string& message) {
@@ -76,7 +79,9 @@ Result<std::unique_ptr<TerrainRenderer>> makeRenderer(const RenderArgs& a) {
     return std::unique_ptr<TerrainRenderer>(std::move(r));
   }
   if (a.renderer != "ring") return fail("--renderer '" + a.renderer + "': expected ring, sliding or grid");
-  STRATA_TRY(auto r, RingRenderer::create({.circles = a.circles}));
+  STRATA_TRY(auto r,
+             RingRenderer::create(
+                 {.circles = a.circles, .softFactor = a.softFactor, .softMinM = a.softMinM, .rangeM = a.rangeM}));
   return std::unique_ptr<TerrainRenderer>(std::move(r));
 }
 
@@ -116,12 +121,64 @@ void reportStream(const TerrainScene& scene) {
   }
 }
 
+// Every number given on the command line: finite (CLI11 reads "nan" and "inf", and its Range
+// check lets NaN through: --fov nan crashed) and within what the renderer can draw.
+void checkNumbers(const RenderArgs& a) {
+  auto check = [](const char* option, std::optional<double> v, double lo, double hi) {
+    if (!v) return;
+    if (!std::isfinite(*v)) die(std::string(option) + " " + std::to_string(*v) + ": not a finite number");
+    if (*v < lo || *v > hi) {
+      char msg[160];
+      std::snprintf(msg, sizeof msg, "%s %g: expected %g to %g", option, *v, lo, hi);
+      die(msg);
+    }
+  };
+  check("--lon", a.lon, -1e9, 1e9);  // degrees, or metres of a projected CRS
+  check("--lat", a.lat, -1e9, 1e9);
+  check("--height", a.height, -1e8, 1e8);
+  check("--agl", a.agl, -1e8, 1e8);
+  check("--heading", a.heading, -3600, 3600);
+  check("--pitch", a.pitch, -90, 90);
+  check("--fov", a.fov, 1, 170);
+  check("--exaggeration", double(a.exaggeration), 1e-3, 1e3);
+  if (a.seaLevel) check("--sea-level", double(*a.seaLevel), -1e6, 1e6);
+  check("--fog", double(a.fogM), 0, 1e9);
+  check("--gpu-budget", a.gpuBudgetMiB, 1, 1 << 20);
+  if (!a.path.empty() && (a.frames < 2 || a.frames > 1000000)) {
+    die("--frames " + std::to_string(a.frames) + ": a flight path needs 2 to 1000000 frames");
+  }
+}
+
+// The files this render writes must not exist unless --overwrite says to replace them.
+void checkOutputs(const RenderArgs& a) {
+  if (a.overwrite) return;
+  std::vector<std::string> outputs;
+  for (const std::string& pattern : {a.output, a.depthOut, a.elevationOut}) {
+    if (pattern.empty()) continue;
+    if (a.path.empty()) {
+      outputs.push_back(pattern);
+      continue;
+    }
+    for (int i = 0; i < a.frames; ++i) {
+      auto name = frameName(pattern, i);
+      if (!name) die(name.message());
+      outputs.push_back(*name);
+    }
+  }
+  for (const auto& f : outputs) {
+    std::error_code ec;
+    if (std::filesystem::exists(f, ec)) die(f + ": exists (use --overwrite to replace it)");
+  }
+}
+
 void run(const RenderArgs& a) {
   int w = 0, h = 0;
   if (std::sscanf(a.size.c_str(), "%dx%d", &w, &h) != 2 || w < 1 || h < 1 || w > 16384 || h > 16384) {
     die("--size '" + a.size + "': expected WxH, e.g. 1280x720");
   }
   if (a.height && a.agl) die("--height and --agl: give one of them");
+  checkNumbers(a);
+  checkOutputs(a);
   Shading shading;
   shading.exaggeration = a.exaggeration;
   shading.seaLevelM = a.seaLevel;
@@ -134,14 +191,15 @@ void run(const RenderArgs& a) {
     die("--palette '" + a.palette + "': expected hypsometric, grey or rust");
   }
   if (a.planetary) shading.sky = {0, 0, 0, 1};
+  const VoidMode voids = a.voids == "holes" ? VoidMode::kHoles : VoidMode::kFill;
 
-  auto ctx = render::gl::HeadlessContext::create({.debugOutput = false});
+  auto ctx = gl::HeadlessContext::create({.debugOutput = false});
   if (!ctx) die(ctx.message());
   // A folder with a manifest is a tile store: its elevation is streamed around the viewer.
   auto scene = [&]() -> Result<TerrainScene> {
     if (!std::filesystem::is_regular_file(std::filesystem::path(a.dem) / "manifest.toml")) {
       STRATA_TRY(auto dem, loadDem(a.dem, a.planetary));
-      return TerrainScene::create(dem, {.planetary = a.planetary});
+      return TerrainScene::create(dem, {.planetary = a.planetary, .voids = voids});
     }
     STRATA_TRY(auto opened, strata::terrain::TileStore::open(a.dem));
     return TerrainScene::createStreamed(std::move(opened),
@@ -188,7 +246,6 @@ void run(const RenderArgs& a) {
   }
   auto path = FlightPath::load(a.path);
   if (!path) die(path.message());
-  if (a.frames < 2) die("--frames " + std::to_string(a.frames) + ": a flight path needs at least 2 frames");
   for (int i = 0; i < a.frames; ++i) {
     const CameraPose pose = path->at(double(i) / double(a.frames - 1));
     if (auto s = (*renderer)->draw(*scene, pose, shading, *target); !s) die(s.message());
@@ -228,19 +285,35 @@ void addRenderCommand(CLI::App& app) {
   cmd->add_option("--renderer", a->renderer,
                   "ring (concentric rings), sliding (sliding sampling grid) or grid (brute-force full grid)");
   cmd->add_option("--circles", a->circles, "Ring renderer: circles (6n^2 triangles)")->check(CLI::Range(1, 2048));
+  cmd->add_option("--range", a->rangeM,
+                  "Ring renderer: view range (m; of arc on a body); default: the DEM's farthest corner, or the "
+                  "horizon over the lowest terrain plus the highest summit's")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--soft-min", a->softMinM,
+                  "Ring renderer: floor of the softened viewer height f(h) = max(K h, this) (m); default: a twelfth "
+                  "of the view range")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--soft-factor", a->softFactor, "Ring renderer: K in f(h) = max(K h, --soft-min)")
+      ->check(CLI::PositiveNumber);
   cmd->add_flag(
       "--planetary", a->planetary,
       "Draw on the body's ellipsoid (geographic DEMs, or equirectangular ones on a sphere such as LOLA's LDEM)");
+  cmd->add_option("--voids", a->voids,
+                  "No-data cells: fill (from the cells around them, as gdal_fillnodata) or holes (not drawn)")
+      ->check(CLI::IsMember({"fill", "holes"}));
   cmd->add_option("--exaggeration", a->exaggeration, "Vertical exaggeration");
   cmd->add_option("--sea-level", a->seaLevel, "Water wherever the terrain is below this elevation (m)");
   cmd->add_option("--palette", a->palette, "hypsometric, grey or rust");
   cmd->add_option("--fog", a->fogM, "Haze distance (m); 0: none");
   cmd->add_option("--path", a->path, "Keyframe file (lon lat height heading pitch [fov] per line)");
   cmd->add_option("--frames", a->frames, "Frames to render along --path");
-  cmd->add_option("--clip-size", a->clipSize, "Store: texels a side of each streamed level's window");
-  cmd->add_option("--page-size", a->pageSize, "Store: texels a side of a streamed page");
-  cmd->add_option("--upload-pages", a->uploadPages, "Store: pages copied into the stack per frame at most");
+  cmd->add_option("--clip-size", a->clipSize, "Store: texels a side of each streamed level's window")
+      ->check(CLI::Range(16, 16384));
+  cmd->add_option("--page-size", a->pageSize, "Store: texels a side of a streamed page")->check(CLI::Range(8, 4096));
+  cmd->add_option("--upload-pages", a->uploadPages, "Store: pages copied into the stack per frame at most")
+      ->check(CLI::Range(1, 1 << 20));
   cmd->add_option("--gpu-budget", a->gpuBudgetMiB, "Store: GPU memory for the streamed elevation (MiB)");
+  cmd->add_flag("--overwrite", a->overwrite, "Replace output files that exist");
   cmd->callback([a] { run(*a); });
 }
 

@@ -1,7 +1,12 @@
 // strata: the command-line front end.
+#include <csignal>
+
 #include "commands.hpp"
 
 int main(int argc, char** argv) {
+  // Over the file size limit (ulimit -f) a write fails with EFBIG and the message names the file,
+  // instead of the process dying silently of SIGXFSZ.
+  std::signal(SIGXFSZ, SIG_IGN);
   CLI::App app{"Strata: GIS terrain visualisation and what-if erosion and flood simulation on the GPU"};
   app.require_subcommand(1);
   strata::app::addGpuInfoCommand(app);

@@ -42,11 +42,14 @@ Status writeFileAtomic(const std::filesystem::path& target, std::string_view con
   FILE* f = std::fopen(tmp.c_str(), "wb");
   if (!f) return fail(target.string() + ": cannot write: " + std::strerror(errno));
   const bool ok = std::fwrite(content.data(), 1, content.size(), f) == content.size();
+  int err = ok ? 0 : errno;
   const bool closed = std::fclose(f) == 0;
+  if (!closed && err == 0) err = errno;
   if (!ok || !closed) {
     std::error_code ec;
     std::filesystem::remove(tmp, ec);
-    return fail(target.string() + ": cannot write (disk full?)");
+    // ENOSPC: the disk is full; EFBIG: over the file size limit (ulimit -f; SIGXFSZ is ignored).
+    return fail(target.string() + ": cannot write: " + (err ? std::strerror(err) : "disk full?"));
   }
   return commitTemporary(tmp, target);
 }

@@ -13,7 +13,7 @@ render() {
   local name=$1 layer=$2
   shift 2
   "$strata" generate "$root/docs/examples/$name.toml" -o "$out/$name" --seed 7 --size 512x512 >/dev/null
-  "$strata" render "$out/$name/$layer.tif" -o "$root/docs/examples/$name.png" --size 640x360 \
+  "$strata" render "$out/$name/$layer.tif" --overwrite -o "$root/docs/examples/$name.png" --size 640x360 \
     --lon "$1" --lat "$2" --agl "$3" --heading "$4" --pitch "$5"
 }
 render fbm_waves_mountain bedrock 381500 4016000 3000 45 -25

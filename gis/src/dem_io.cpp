@@ -6,8 +6,10 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <numbers>
 #include <optional>
 #include <sstream>
@@ -38,15 +40,19 @@ std::optional<double> metresPerUnit(const std::string& unit) {
 struct Probed {
   DemInfo info;
   DatasetPtr ds;
-  double unitToMetres = 1;
 };
 
 Result<Probed> probe(const std::string& path, const ReadOptions& options) {
-  STRATA_TRY(DatasetPtr ds, detail::openRaster(path));
+  STRATA_TRY(DatasetPtr ds, detail::openRaster(path, options.crs, options.transform));
   Probed p;
   DemInfo& info = p.info;
   info.path = path;
   info.driver = ds->GetDriver() ? ds->GetDriver()->GetDescription() : "unknown";
+  if (info.driver == "VRT" && (options.crs || options.transform)) {
+    // The wrapper that carries an assigned georeference; name the file's own driver.
+    if (auto raw = detail::openRaster(path); raw && (*raw)->GetDriver())
+      info.driver = (*raw)->GetDriver()->GetDescription();
+  }
   info.bandCount = ds->GetRasterCount();
   if (options.band < 1 || options.band > info.bandCount) {
     return fail(path + ": band " + std::to_string(options.band) + " requested, the file has " +
@@ -58,32 +64,22 @@ Result<Probed> probe(const std::string& path, const ReadOptions& options) {
   if (g.width <= 0 || g.height <= 0)
     return fail(path + ": empty raster (" + std::to_string(g.width) + "x" + std::to_string(g.height) + ")");
 
-  if (options.crs.has_value() != options.transform.has_value()) {
-    return fail(path + ": an explicit georeference needs both a CRS and a geotransform");
+  double gt[6];
+  const bool hasTransform = ds->GetGeoTransform(gt) == CE_None;
+  const OGRSpatialReference* srs = ds->GetSpatialRef();
+  if (!hasTransform || !srs) {
+    return fail(path + ": no georeference (" +
+                std::string(!srs && !hasTransform ? "no CRS and no geotransform"
+                            : !srs                ? "no CRS"
+                                                  : "no geotransform") +
+                "); assign one (strata: --assign-crs EPSG:n / --assign-geotransform c0,c1,c2,c3,c4,c5)");
   }
-  if (options.crs) {
-    auto srs = detail::parseCrs(*options.crs);
-    if (!srs) return fail(path + ": " + srs.message());
-    detail::fillCrs(*srs, g);
-    g.transform = *options.transform;
-  } else {
-    double gt[6];
-    const bool hasTransform = ds->GetGeoTransform(gt) == CE_None;
-    const OGRSpatialReference* srs = ds->GetSpatialRef();
-    if (!hasTransform || !srs) {
-      return fail(path + ": no georeference (" +
-                  std::string(!srs && !hasTransform ? "no CRS and no geotransform"
-                              : !srs                ? "no CRS"
-                                                    : "no geotransform") +
-                  "); pass an explicit CRS and geotransform to read it");
-    }
-    if (!srs->IsGeographic() && !srs->IsProjected()) {
-      return fail(path + ": unknown CRS '" + std::string(srs->GetName() ? srs->GetName() : "") +
-                  "' (neither geographic nor projected)");
-    }
-    detail::fillCrs(*srs, g);
-    std::copy(gt, gt + 6, g.transform.c);
+  if (!srs->IsGeographic() && !srs->IsProjected()) {
+    return fail(path + ": unknown CRS '" + std::string(srs->GetName() ? srs->GetName() : "") +
+                "' (neither geographic nor projected)");
   }
+  detail::fillCrs(*srs, g);
+  std::copy(gt, gt + 6, g.transform.c);
   const GeoTransform& t = g.transform;
   if (!(std::isfinite(t.c[0]) && std::isfinite(t.c[1]) && std::isfinite(t.c[2]) && std::isfinite(t.c[3]) &&
         std::isfinite(t.c[4]) && std::isfinite(t.c[5])) ||
@@ -99,6 +95,7 @@ Result<Probed> probe(const std::string& path, const ReadOptions& options) {
   if (GDALDataTypeIsComplex(band->GetRasterDataType())) {
     return fail(path + ": band type " + info.bandType + " is complex, not an elevation");
   }
+  band->GetBlockSize(&info.blockWidth, &info.blockHeight);
   int ok = 0;
   info.scale = band->GetScale(&ok);
   if (!ok) info.scale = 1;
@@ -113,14 +110,169 @@ Result<Probed> probe(const std::string& path, const ReadOptions& options) {
   const std::string unit = band->GetUnitType() ? band->GetUnitType() : "";
   const auto perUnit = metresPerUnit(unit);
   if (!perUnit) return fail(path + ": unsupported vertical unit '" + unit + "' (expected metres or feet)");
-  p.unitToMetres = *perUnit;
+  info.unitToMetres = *perUnit;
   g.verticalUnit = "m";
   info.offsetIsBodyRadius = g.body.isSphere() && info.offset != 0 && std::abs(info.offset - g.body.semiMajorM) < 1.0;
   p.ds = std::move(ds);
   return p;
 }
 
+// A band of whole rows larger than this is not cached (a striped file that wide is read window
+// by window instead): 256 MiB of float32.
+constexpr double kMaxBandBytes = double(256 << 20);
+
 }  // namespace
+
+struct DemFile::Impl {
+  Probed p;
+  ReadOptions options;
+  // Striped files: rows [bandY0, bandY0 + bandRows) of raw values, whole width.
+  std::vector<float> band;
+  int bandY0 = 0, bandRows = 0;
+  int lastY = -1;  // row of the previous window (another: a new row of tiles, flush GDAL's cache)
+
+  bool striped() const { return p.info.blockWidth == p.info.georef.width && p.info.georef.height > p.info.blockHeight; }
+
+  // Raw float32 values of a window inside the raster.
+  Status fetchRaw(const CellRect& w, Grid<float>& out) {
+    const auto& full = p.info.georef;
+    GdalErrorCapture errors;
+    GDALRasterBand* b = p.ds->GetRasterBand(options.band);
+    const bool useBand = striped() && w.width < full.width && double(full.width) * w.height * 4 <= kMaxBandBytes;
+    if (useBand) {
+      if (w.y < bandY0 || w.y + w.height > bandY0 + bandRows) {
+        // A band as tall as the window from its first row: windows of one row of tiles share it.
+        bandY0 = w.y;
+        bandRows = std::min(w.height, full.height - w.y);
+        band.assign(size_t(full.width) * size_t(bandRows), 0.0f);
+        if (b->RasterIO(GF_Read, 0, bandY0, full.width, bandRows, band.data(), full.width, bandRows, GDT_Float32, 0,
+                        0) != CE_None) {
+          bandRows = 0;
+          return fail(p.info.path + ": read failed (truncated or corrupt file?): " + errors.last());
+        }
+        b->FlushCache(false);  // the band is the only copy kept
+      }
+      for (int y = 0; y < w.height; ++y) {
+        std::copy_n(&band[size_t(w.y + y - bandY0) * size_t(full.width) + size_t(w.x)], w.width,
+                    &out.data[out.index(0, y)]);
+      }
+      return {};
+    }
+    if (w.y != lastY) b->FlushCache(false);
+    lastY = w.y;
+    // RasterIO on the window reads only the blocks that intersect it.
+    if (b->RasterIO(GF_Read, w.x, w.y, w.width, w.height, out.data.data(), w.width, w.height, GDT_Float32, 0, 0) !=
+        CE_None) {
+      return fail(p.info.path + ": read failed (truncated or corrupt file?): " + errors.last());
+    }
+    return {};
+  }
+
+  Result<Raster> read(const CellRect& w, bool allowAllNoData, bool isWindow) {
+    const DemInfo& info = p.info;
+    const std::string& path = info.path;
+    const Georef& full = info.georef;
+    if (w.width <= 0 || w.height <= 0 || w.x < 0 || w.y < 0 || w.x > full.width - w.width ||
+        w.y > full.height - w.height) {
+      std::ostringstream m;
+      m << path << ": window " << w.width << "x" << w.height << "+" << w.x << "+" << w.y << " is outside the "
+        << full.width << "x" << full.height << " raster";
+      return fail(m.str());
+    }
+    // The byte budget is checked before anything is allocated: a header may claim any size.
+    const double bytes = double(w.width) * double(w.height) * sizeof(float);
+    if (bytes > double(options.maxBytes)) {
+      std::ostringstream m;
+      m << path << ": " << w.width << "x" << w.height << " pixels (" << bytes / double(1 << 20)
+        << " MiB as float32) exceed the read budget of " << double(options.maxBytes) / double(1 << 20)
+        << " MiB; read a window";
+      return fail(m.str());
+    }
+
+    Raster r;
+    r.georef = full;
+    r.georef.width = w.width;
+    r.georef.height = w.height;
+    GeoTransform& t = r.georef.transform;
+    t.c[0] = full.transform.x(w.x, w.y);
+    t.c[3] = full.transform.y(w.x, w.y);
+    r.values = Grid<float>(w.width, w.height);
+    STRATA_TRY_STATUS(fetchRaw(w, r.values));
+
+    const bool nodataIsNaN = info.nodata && std::isnan(*info.nodata);
+    const float nodataRaw = info.nodata && !nodataIsNaN ? float(*info.nodata) : 0.0f;
+    const bool hasNumericNoData = info.nodata && !nodataIsNaN;
+    const double offset =
+        info.offsetIsBodyRadius && !options.keepBodyRadius ? info.offset - full.body.semiMajorM : info.offset;
+    const double scale = info.scale * info.unitToMetres;
+    const double offsetM = offset * info.unitToMetres;
+    size_t valid = 0;
+    for (int y = 0; y < w.height; ++y) {
+      for (int x = 0; x < w.width; ++x) {
+        float& v = r.values.at(x, y);
+        if (std::isnan(v)) {
+          if (nodataIsNaN) continue;
+          std::ostringstream m;
+          m << path << ": NaN value at pixel (" << w.x + x << ", " << w.y + y
+            << ") and no NaN nodata value; NaN is not an elevation (set a nodata value)";
+          return fail(m.str());
+        }
+        if (hasNumericNoData && v == nodataRaw) {
+          v = kNoData;
+          continue;
+        }
+        if (!std::isfinite(v)) {
+          std::ostringstream m;
+          m << path << ": infinite value at pixel (" << w.x + x << ", " << w.y + y << ")";
+          return fail(m.str());
+        }
+        v = float(double(v) * scale + offsetM);
+        ++valid;
+      }
+    }
+    if (valid == 0 && !allowAllNoData) {
+      std::ostringstream m;
+      m << path << ": no data: all " << w.width << "x" << w.height << " cells" << (isWindow ? " of the window" : "")
+        << " are nodata";
+      return fail(m.str());
+    }
+    return r;
+  }
+};
+
+DemFile::DemFile(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+DemFile::DemFile(DemFile&&) noexcept = default;
+DemFile& DemFile::operator=(DemFile&&) noexcept = default;
+DemFile::~DemFile() = default;
+
+Result<DemFile> DemFile::open(const std::string& path, const ReadOptions& options) {
+  STRATA_TRY(Probed p, probe(path, options));
+  auto impl = std::make_unique<Impl>();
+  impl->p = std::move(p);
+  impl->options = options;
+  return DemFile(std::move(impl));
+}
+
+const DemInfo& DemFile::info() const { return impl_->p.info; }
+
+Result<Raster> DemFile::read(const CellRect& window) {
+  return impl_->read(window, impl_->options.allowAllNoData, true);
+}
+
+Result<Grid<float>> DemFile::readPadded(const CellRect& w) {
+  if (w.width < 0 || w.height < 0) return fail(impl_->p.info.path + ": window with a negative size");
+  Grid<float> out(w.width, w.height, kNoData);
+  const auto& g = impl_->p.info.georef;
+  const int x0 = std::max(0, w.x), y0 = std::max(0, w.y);
+  const int x1 = int(std::min<int64_t>(g.width, int64_t(w.x) + w.width));
+  const int y1 = int(std::min<int64_t>(g.height, int64_t(w.y) + w.height));
+  if (x0 >= x1 || y0 >= y1) return out;
+  STRATA_TRY(Raster r, impl_->read({x0, y0, x1 - x0, y1 - y0}, true, true));
+  for (int y = y0; y < y1; ++y) {
+    std::copy_n(&r.values.data[r.values.index(0, y - y0)], x1 - x0, &out.data[out.index(x0 - w.x, y - w.y)]);
+  }
+  return out;
+}
 
 Result<DemInfo> probeDem(const std::string& path, const ReadOptions& options) {
   STRATA_TRY(Probed p, probe(path, options));
@@ -128,84 +280,43 @@ Result<DemInfo> probeDem(const std::string& path, const ReadOptions& options) {
 }
 
 Result<Raster> readDem(const std::string& path, const ReadOptions& options) {
-  STRATA_TRY(Probed p, probe(path, options));
-  const DemInfo& info = p.info;
-  const Georef& full = info.georef;
-  const PixelWindow w = options.window.value_or(PixelWindow{0, 0, full.width, full.height});
-  if (w.width <= 0 || w.height <= 0 || w.x < 0 || w.y < 0 || w.x > full.width - w.width ||
-      w.y > full.height - w.height) {
-    std::ostringstream m;
-    m << path << ": window " << w.width << "x" << w.height << "+" << w.x << "+" << w.y << " is outside the "
-      << full.width << "x" << full.height << " raster";
-    return fail(m.str());
-  }
-  // The byte budget is checked before anything is allocated: a header may claim any size.
-  const double bytes = double(w.width) * double(w.height) * sizeof(float);
-  if (bytes > double(options.maxBytes)) {
-    std::ostringstream m;
-    m << path << ": " << w.width << "x" << w.height << " pixels (" << bytes / double(1 << 20)
-      << " MiB as float32) exceed the read budget of " << double(options.maxBytes) / double(1 << 20)
-      << " MiB; read a window";
-    return fail(m.str());
-  }
+  STRATA_TRY(DemFile f, DemFile::open(path, options));
+  const Georef& full = f.info().georef;
+  const CellRect w = options.window.value_or(CellRect{0, 0, full.width, full.height});
+  return f.impl_->read(w, options.allowAllNoData, options.window.has_value());
+}
 
-  Raster r;
-  r.georef = full;
-  r.georef.width = w.width;
-  r.georef.height = w.height;
-  GeoTransform& t = r.georef.transform;
-  t.c[0] = full.transform.x(w.x, w.y);
-  t.c[3] = full.transform.y(w.x, w.y);
-  r.values = Grid<float>(w.width, w.height);
+Result<GeorefPresence> georefPresence(const std::string& path) {
+  STRATA_TRY(DatasetPtr ds, detail::openRaster(path));
+  GeorefPresence p;
+  double gt[6];
+  p.transform = ds->GetGeoTransform(gt) == CE_None;
+  p.crs = ds->GetSpatialRef() != nullptr;
+  return p;
+}
 
-  {
-    GdalErrorCapture errors;
-    GDALRasterBand* band = p.ds->GetRasterBand(options.band);
-    // RasterIO on the window reads only the blocks that intersect it.
-    if (band->RasterIO(GF_Read, w.x, w.y, w.width, w.height, r.values.data.data(), w.width, w.height, GDT_Float32, 0,
-                       0) != CE_None) {
-      return fail(path + ": read failed (truncated or corrupt file?): " + errors.last());
+Result<GeoTransform> parseGeoTransform(std::string_view text, const std::string& key) {
+  GeoTransform t;
+  std::string s(text);
+  for (char& c : s) {
+    if (c == ',') c = ' ';
+  }
+  std::istringstream in(s);
+  std::string word;
+  int n = 0;
+  while (in >> word) {
+    if (n == 6) return fail(key + ": '" + std::string(text) + "' has more than 6 numbers (c0,c1,c2,c3,c4,c5)");
+    char* end = nullptr;
+    const double v = std::strtod(word.c_str(), &end);
+    if (end != word.c_str() + word.size() || !std::isfinite(v)) {
+      return fail(key + ": '" + word + "' is not a finite number");
     }
+    t.c[n++] = v;
   }
-
-  const bool nodataIsNaN = info.nodata && std::isnan(*info.nodata);
-  const float nodataRaw = info.nodata && !nodataIsNaN ? float(*info.nodata) : 0.0f;
-  const bool hasNumericNoData = info.nodata && !nodataIsNaN;
-  const double offset =
-      info.offsetIsBodyRadius && !options.keepBodyRadius ? info.offset - full.body.semiMajorM : info.offset;
-  const double scale = info.scale * p.unitToMetres;
-  const double offsetM = offset * p.unitToMetres;
-  size_t valid = 0;
-  for (int y = 0; y < w.height; ++y) {
-    for (int x = 0; x < w.width; ++x) {
-      float& v = r.values.at(x, y);
-      if (std::isnan(v)) {
-        if (nodataIsNaN) continue;
-        std::ostringstream m;
-        m << path << ": NaN value at pixel (" << w.x + x << ", " << w.y + y
-          << ") and no NaN nodata value; NaN is not an elevation (set a nodata value)";
-        return fail(m.str());
-      }
-      if (hasNumericNoData && v == nodataRaw) {
-        v = kNoData;
-        continue;
-      }
-      if (!std::isfinite(v)) {
-        std::ostringstream m;
-        m << path << ": infinite value at pixel (" << w.x + x << ", " << w.y + y << ")";
-        return fail(m.str());
-      }
-      v = float(double(v) * scale + offsetM);
-      ++valid;
-    }
-  }
-  if (valid == 0 && !options.allowAllNoData) {
-    std::ostringstream m;
-    m << path << ": no data: all " << w.width << "x" << w.height << " cells" << (options.window ? " of the window" : "")
-      << " are nodata";
-    return fail(m.str());
-  }
-  return r;
+  if (n != 6)
+    return fail(key + ": '" + std::string(text) + "' needs 6 numbers (c0,c1,c2,c3,c4,c5 as GDAL orders them)");
+  if (t.c[1] * t.c[5] - t.c[2] * t.c[4] == 0) return fail(key + ": the pixel size is degenerate (c1 c5 - c2 c4 = 0)");
+  return t;
 }
 
 Status writeGeoTiff(const std::string& path, const Raster& raster, const WriteOptions& options) {
@@ -230,9 +341,15 @@ Status writeGeoTiff(const std::string& path, const Raster& raster, const WriteOp
                   " occurs in the data and is the nodata value");
     }
   }
+  const bool virtualPath = path.rfind("/vsi", 0) == 0;
+  if (!options.overwrite) {
+    VSIStatBufL st;
+    if (VSIStatL(path.c_str(), &st) == 0) return fail(path + ": already exists (not overwritten)");
+  }
   auto mem = detail::memDataset(g, &out);
   if (!mem) return fail(path + ": cannot write: " + mem.message());
   (*mem)->GetRasterBand(1)->SetNoDataValue(options.nodata);
+  for (const auto& [name, value] : options.metadata) (*mem)->SetMetadataItem(name.c_str(), value.c_str());
 
   GdalErrorCapture errors;
   GDALDriver* driver = GetGDALDriverManager()->GetDriverByName(options.cog ? "COG" : "GTiff");
@@ -261,6 +378,18 @@ Status writeGeoTiff(const std::string& path, const Raster& raster, const WriteOp
   if (CPLGetLastErrorType() >= CE_Failure) {
     VSIUnlink(tmp.c_str());
     return fail(path + ": cannot write GeoTIFF: " + errors.last());
+  }
+  if (!options.overwrite && !virtualPath) {
+    // link() fails if the target exists: no window between a check and the rename.
+    const int rc = ::link(tmp.c_str(), path.c_str());
+    const int err = errno;
+    VSIUnlink(tmp.c_str());
+    if (rc != 0) {
+      return fail(path + (err == EEXIST
+                              ? ": already exists (not overwritten)"
+                              : ": cannot move the written temporary into place: " + std::string(std::strerror(err))));
+    }
+    return {};
   }
   if (VSIRename(tmp.c_str(), path.c_str()) != 0) {
     VSIUnlink(tmp.c_str());

@@ -61,6 +61,33 @@ Result<DemSummary> summarizeDem(const std::string& path, const ReadOptions& opti
     s.maxLat = std::max(s.maxLat, by[i]);
   }
 
+  // A pole inside the grid is the extreme latitude and every longitude meets there; the boundary
+  // never passes through it (a polar stereographic grid's edge stays at -52 degrees while its
+  // middle reaches -90).
+  if (!g.geographic) {
+    auto inv = CrsTransform::fromGeographic(g);
+    if (!inv) return fail(path + ": " + inv.message());
+    const auto& t = g.transform.c;
+    const double det = t[1] * t[5] - t[2] * t[4];
+    for (double lat : {90.0, -90.0}) {
+      // The pole seen from two meridians: one point (polar projections) or a line (cylindrical
+      // ones, whose edge the boundary walk already follows).
+      double x[2] = {0, 120}, y[2] = {lat, lat};
+      if (!inv->transform(2, x, y)) continue;
+      double col[2], row[2];
+      for (int k = 0; k < 2; ++k) {
+        col[k] = ((x[k] - t[0]) * t[5] - (y[k] - t[3]) * t[2]) / det;
+        row[k] = ((y[k] - t[3]) * t[1] - (x[k] - t[0]) * t[4]) / det;
+      }
+      const bool point = std::abs(col[0] - col[1]) < 1e-6 && std::abs(row[0] - row[1]) < 1e-6;
+      if (point && col[0] > 0.5 && col[0] < g.width - 0.5 && row[0] > 0.5 && row[0] < g.height - 0.5) {
+        (lat > 0 ? s.maxLat : s.minLat) = lat;
+        s.minLon = -180;
+        s.maxLon = 180;
+      }
+    }
+  }
+
   // Centre pixel size along its edges, as geodesics on the body.
   const double mc = g.width / 2.0, mr = g.height / 2.0;
   auto p0 = pixelToLonLat(g, mc, mr), px = pixelToLonLat(g, mc + 1, mr), py = pixelToLonLat(g, mc, mr + 1);

@@ -77,6 +77,33 @@ Result<DatasetPtr> openRaster(const std::string& path) {
   return ds;
 }
 
+Result<DatasetPtr> openRaster(const std::string& path, const std::optional<std::string>& crs,
+                              const std::optional<GeoTransform>& transform) {
+  STRATA_TRY(DatasetPtr ds, openRaster(path));
+  if (!crs && !transform) return ds;
+  std::optional<OGRSpatialReference> srs;
+  if (crs) {
+    auto parsed = parseCrs(*crs);
+    if (!parsed) return fail(path + ": " + parsed.message());
+    srs = std::move(*parsed);
+  }
+  GdalErrorCapture errors;
+  GDALDriver* vrt = GetGDALDriverManager()->GetDriverByName("VRT");
+  STRATA_CHECK(vrt) << "GDAL has no VRT driver";
+  // A VRT copy references the file's pixels (nothing is copied) and takes its own georeference.
+  GDALDataset* copy = vrt->CreateCopy("", ds.get(), FALSE, nullptr, nullptr, nullptr);
+  if (!copy) return fail(path + ": cannot assign a georeference: " + errors.last());
+  // The VRT reads through the file's dataset: it is closed after the VRT.
+  DatasetPtr wrapped(copy, DatasetCloser{ds.release()});
+  if (transform) {
+    double gt[6];
+    std::copy(transform->c, transform->c + 6, gt);
+    wrapped->SetGeoTransform(gt);
+  }
+  if (srs) wrapped->SetSpatialRef(&*srs);
+  return wrapped;
+}
+
 Result<OGRSpatialReference> parseCrs(const std::string& text) {
   ensureGdal();
   OGRSpatialReference srs;

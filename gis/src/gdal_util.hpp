@@ -6,6 +6,7 @@
 #include <ogr_spatialref.h>
 
 #include <memory>
+#include <optional>
 #include <string>
 
 #include <strata/core/result.hpp>
@@ -33,7 +34,11 @@ class GdalErrorCapture {
 };
 
 struct DatasetCloser {
-  void operator()(GDALDataset* ds) const { GDALClose(GDALDataset::ToHandle(ds)); }
+  GDALDataset* base = nullptr;  ///< a dataset this one reads from (a VRT's source), closed after it
+  void operator()(GDALDataset* ds) const {
+    GDALClose(GDALDataset::ToHandle(ds));
+    if (base) GDALClose(GDALDataset::ToHandle(base));
+  }
 };
 using DatasetPtr = std::unique_ptr<GDALDataset, DatasetCloser>;
 
@@ -42,6 +47,12 @@ std::string withoutPath(std::string message, const std::string& path);
 
 /// Opens a raster read-only; errors name the file: missing, not a raster, corrupt.
 Result<DatasetPtr> openRaster(const std::string& path);
+
+/// Opens a raster read-only with a CRS and/or geotransform assigned (replacing the file's): the
+/// file wrapped in an in-memory VRT that carries them, so GDAL's warper and readers see them.
+/// Without either it is openRaster. Errors name the file (and the CRS that does not parse).
+Result<DatasetPtr> openRaster(const std::string& path, const std::optional<std::string>& crs,
+                              const std::optional<GeoTransform>& transform);
 
 /// Parses a user CRS ("EPSG:32612", WKT, PROJ string); traditional GIS axis order (x = lon/east).
 Result<OGRSpatialReference> parseCrs(const std::string& text);

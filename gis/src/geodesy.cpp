@@ -173,6 +173,28 @@ Result<CrsTransform> CrsTransform::toGeographic(const Georef& georef) {
   return t;
 }
 
+Result<Georef> describeCrs(const std::string& crs) {
+  STRATA_TRY(OGRSpatialReference srs, detail::parseCrs(crs));
+  if (!srs.IsGeographic() && !srs.IsProjected()) {
+    return fail("CRS '" + crs.substr(0, 80) + "' is neither geographic nor projected");
+  }
+  Georef g;
+  detail::fillCrs(srs, g);
+  return g;
+}
+
+Result<CrsTransform> CrsTransform::fromGeographic(const Georef& georef) {
+  STRATA_TRY(OGRSpatialReference srs, detail::srsOf(georef));
+  std::unique_ptr<OGRSpatialReference> geog(srs.CloneGeogCS());
+  if (!geog) return fail("CRS '" + georef.crsName + "' has no geographic base");
+  geog->SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  detail::GdalErrorCapture errors;
+  CrsTransform t;
+  t.impl_->ct.reset(OGRCreateCoordinateTransformation(geog.get(), &srs));
+  if (!t.impl_->ct) return fail("no transformation from lon/lat to '" + georef.crsName + "': " + errors.last());
+  return t;
+}
+
 bool CrsTransform::transform(std::size_t n, double* x, double* y, double* z) const {
   std::vector<int> ok(n, 0);
   detail::GdalErrorCapture quiet;

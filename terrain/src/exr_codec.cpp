@@ -4,6 +4,7 @@
 #include <OpenEXR/ImfFrameBuffer.h>
 #include <OpenEXR/ImfHeader.h>
 #include <OpenEXR/ImfIO.h>
+#include <OpenEXR/ImfStringAttribute.h>
 #include <OpenEXR/ImfTiledInputFile.h>
 #include <OpenEXR/ImfTiledOutputFile.h>
 
@@ -59,18 +60,23 @@ class MemIStream : public Imf::IStream {
 
 // EXR tiles inside a tile file: 64 x 64 samples (the whole level when smaller).
 constexpr int kExrTile = 64;
+constexpr const char* kTagAttribute = "strata:tile";
 
 }  // namespace
 
 std::vector<char> encodeTileExr(const std::vector<std::string>& channels,
-                                const std::vector<std::vector<gis::Grid<float>>>& levels) {
+                                const std::vector<std::vector<gis::Grid<float>>>& levels, const std::string& tag) {
   STRATA_CHECK(!levels.empty() && levels[0].size() == channels.size()) << "tile levels/channels mismatch";
   const int res = levels[0][0].width;
   Imf::Header header(res, res);
   header.compression() = Imf::ZIP_COMPRESSION;
+  // zlib level 1: on real float32 relief (1024^2 + mips of an upsampled SRTM tile) the files are
+  // the same size within 0.02 % as at OpenEXR's default level 4, for 13 % less compression time.
+  header.zipCompressionLevel() = 1;
   for (const auto& c : channels) header.channels().insert(c, Imf::Channel(Imf::FLOAT));
   const int ts = std::min(res, kExrTile);
   header.setTileDescription(Imf::TileDescription(ts, ts, Imf::MIPMAP_LEVELS, Imf::ROUND_DOWN));
+  header.insert(kTagAttribute, Imf::StringAttribute(tag));
   MemOStream os;
   {
     Imf::TiledOutputFile out(os, header, 1);
@@ -117,6 +123,17 @@ Result<std::vector<gis::Grid<float>>> decodeTileExrLevel(const std::string& name
     in.setFrameBuffer(fb);
     in.readTiles(0, in.numXTiles(level) - 1, 0, in.numYTiles(level) - 1, level);
     return out;
+  } catch (const std::exception& e) {
+    return fail(name + ": " + e.what());
+  }
+}
+
+Result<std::string> decodeTileExrTag(const std::string& name, const std::vector<char>& bytes) {
+  try {
+    MemIStream is(name, bytes);
+    Imf::TiledInputFile in(is, 1);
+    const auto* tag = in.header().findTypedAttribute<Imf::StringAttribute>(kTagAttribute);
+    return tag ? tag->value() : std::string();
   } catch (const std::exception& e) {
     return fail(name + ": " + e.what());
   }

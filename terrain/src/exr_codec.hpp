@@ -12,9 +12,14 @@
 namespace strata::terrain::detail {
 
 /// Encodes one tile: `levels[l][c]` is channel c at mip level l (level 0 square, each next level
-/// half the side, down to 1x1). Channel names must be valid EXR names without '.'.
+/// half the side, down to 1x1). Channel names must be valid EXR names without '.'. `tag` is
+/// stored as the string attribute "strata:tile" (where the tile belongs; `strata check` compares
+/// it with the manifest).
 std::vector<char> encodeTileExr(const std::vector<std::string>& channels,
-                                const std::vector<std::vector<gis::Grid<float>>>& levels);
+                                const std::vector<std::vector<gis::Grid<float>>>& levels, const std::string& tag);
+
+/// The "strata:tile" attribute of a tile file (empty when it has none).
+Result<std::string> decodeTileExrTag(const std::string& name, const std::vector<char>& bytes);
 
 /// Decodes mip level `level` of every channel in `channels` (in that order). `name` is used in
 /// error messages. Fails when the bytes are not such a tile, or the level or a channel is missing.

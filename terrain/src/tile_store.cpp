@@ -1,12 +1,15 @@
 #include <strata/terrain/tile_store.hpp>
 
 #include <fcntl.h>
+#include <sys/file.h>
 #include <unistd.h>
 #include <zlib.h>
 
 #include <algorithm>
 #include <bit>
+#include <cctype>
 #include <cerrno>
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
@@ -23,6 +26,7 @@
 
 #include <strata/core/files.hpp>
 #include <strata/core/log.hpp>
+#include <strata/gis/geodesy.hpp>
 
 #include "exr_codec.hpp"
 #include "manifest.hpp"
@@ -229,7 +233,7 @@ Result<DecodedPtr> loadTileLevel(const fs::path& dir, const std::vector<std::str
 // the manifest that names the new tiles is renamed into place.
 Status writeTileFile(const fs::path& path, const char* data, size_t size) {
   fs::path tmp = path;
-  tmp += ".tmp";
+  tmp += ".tmp-" + std::to_string(::getpid());
   const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd < 0) return fail(tmp.string() + ": cannot create: " + std::strerror(errno));
   size_t done = 0;
@@ -261,6 +265,139 @@ void syncDir(const fs::path& dir, bool wholeFileSystem) {
 
 bool sameValue(float a, float b) { return (std::isnan(a) && std::isnan(b)) || a == b; }
 
+// Parses the digits at s[i..] into v; false when there are none.
+bool digits(const std::string& s, size_t& i, uint64_t& v) {
+  const size_t start = i;
+  v = 0;
+  while (i < s.size() && std::isdigit(static_cast<unsigned char>(s[i])) && i - start < 19)
+    v = v * 10 + uint64_t(s[i++] - '0');
+  return i > start && (i == s.size() || !std::isdigit(static_cast<unsigned char>(s[i])));
+}
+
+// Whether `name` (a file in tiles/) is named like a tile of a store, x<X>_y<Y>_g<G>.exr, or a
+// writer's temporary of one (.exr.tmp, .exr.tmp-<pid>): the only files commit() may remove.
+bool isTileFileName(const std::string& name) {
+  size_t i = 0;
+  uint64_t v = 0;
+  auto lit = [&](const char* l) {
+    const size_t n = std::strlen(l);
+    if (name.compare(i, n, l) != 0) return false;
+    i += n;
+    return true;
+  };
+  if (!lit("x") || !digits(name, i, v) || !lit("_y") || !digits(name, i, v) || !lit("_g") || !digits(name, i, v) ||
+      !lit(".exr")) {
+    return false;
+  }
+  if (i == name.size()) return true;
+  if (!lit(".tmp")) return false;
+  if (i == name.size()) return true;
+  return lit("-") && digits(name, i, v) && i == name.size();
+}
+
+// Shortest round-trip text of a double.
+std::string shortest(double v) {
+  char buf[40];
+  return std::string(buf, std::to_chars(buf, buf + sizeof buf, v).ptr);
+}
+
+constexpr const char* kLockName = "writer.lock";
+
+// The exponent, samples and error of one tile under the store's metric (see fitTile).
+struct Fit {
+  int exp = 0;
+  std::vector<Grid<float>> samples;  // per field, 2^exp a side
+  std::vector<float> lo, hi, maxErr, rmsErr;
+  std::vector<uint64_t> valid;
+  bool empty() const {
+    return std::all_of(valid.begin(), valid.end(), [](uint64_t v) { return v == 0; });
+  }
+};
+
+// Block sums of one field: level j has (F >> j)^2 blocks of 2^j x 2^j base cells, counting only
+// cells inside the grid (the tile's first wIn x hIn cells).
+struct Pyramid {
+  struct Level {
+    int n = 0;
+    std::vector<double> sum;
+    std::vector<uint32_t> cnt;
+    std::vector<float> mn, mx;
+  };
+  std::vector<Level> levels;  // levels[j - 1] is level j (level 0 is the tile itself)
+};
+
+Pyramid buildPyramid(const Grid<float>& full, int wIn, int hIn, int top) {
+  Pyramid p;
+  const int F = full.width;
+  for (int j = 1; j <= top; ++j) {
+    Pyramid::Level L;
+    L.n = F >> j;
+    const size_t nb = size_t(L.n) * size_t(L.n);
+    L.sum.assign(nb, 0.0);
+    L.cnt.assign(nb, 0);
+    L.mn.assign(nb, std::numeric_limits<float>::infinity());
+    L.mx.assign(nb, -std::numeric_limits<float>::infinity());
+    for (int by = 0; by < L.n; ++by) {
+      for (int bx = 0; bx < L.n; ++bx) {
+        const size_t b = size_t(by) * size_t(L.n) + size_t(bx);
+        for (int k = 0; k < 4; ++k) {
+          const int cx = 2 * bx + (k & 1), cy = 2 * by + (k >> 1);
+          if (j == 1) {
+            if (cx >= wIn || cy >= hIn) continue;
+            const float v = full.at(cx, cy);
+            if (std::isnan(v)) continue;
+            L.sum[b] += v;
+            ++L.cnt[b];
+            L.mn[b] = std::min(L.mn[b], v);
+            L.mx[b] = std::max(L.mx[b], v);
+          } else {
+            const auto& c = p.levels.back();
+            const size_t ci = size_t(cy) * size_t(c.n) + size_t(cx);
+            if (!c.cnt[ci]) continue;
+            L.sum[b] += c.sum[ci];
+            L.cnt[b] += c.cnt[ci];
+            L.mn[b] = std::min(L.mn[b], c.mn[ci]);
+            L.mx[b] = std::max(L.mx[b], c.mx[ci]);
+          }
+        }
+      }
+    }
+    p.levels.push_back(std::move(L));
+  }
+  return p;
+}
+
+// Base cells of block (bx, by) of side b inside the grid's first wIn x hIn cells.
+uint64_t cellsInGrid(int bx, int by, int b, int wIn, int hIn) {
+  const int64_t cx = std::clamp<int64_t>(int64_t(wIn) - int64_t(bx) * b, 0, b);
+  const int64_t cy = std::clamp<int64_t>(int64_t(hIn) - int64_t(by) * b, 0, b);
+  return uint64_t(cx * cy);
+}
+
+// The stored sample of a block: the float mean, NaN when it has no data.
+float blockSample(const Pyramid::Level& L, size_t b) { return L.cnt[b] ? float(L.sum[b] / L.cnt[b]) : gis::kNoData; }
+
+// Whether level j of every field keeps voids void (no block mixes data and no data inside the
+// grid) and, when `tolM` is set, reconstructs every cell within tolM.
+bool levelFits(const std::vector<Pyramid>& pyr, int j, int wIn, int hIn, std::optional<double> tolM) {
+  if (j == 0) return true;
+  for (const auto& p : pyr) {
+    const auto& L = p.levels[size_t(j - 1)];
+    for (int by = 0; by < L.n; ++by) {
+      for (int bx = 0; bx < L.n; ++bx) {
+        const size_t b = size_t(by) * size_t(L.n) + size_t(bx);
+        if (!L.cnt[b]) continue;
+        if (L.cnt[b] != cellsInGrid(bx, by, 1 << j, wIn, hIn)) return false;
+        if (tolM) {
+          const double m = blockSample(L, b);
+          if (std::max(double(L.mx[b]) - m, m - double(L.mn[b])) > *tolM) return false;
+        }
+      }
+    }
+  }
+  return true;
+}
+
 }  // namespace
 
 struct TileStore::Impl {
@@ -290,6 +427,7 @@ struct TileStore::Impl {
   std::deque<Job> queue;                                           // neighbour prefetches
   bool stopping = false;
   std::thread worker;
+  int lockFd = -1;  // the writer lock (flock on writer.lock), taken by the first write
 
   Impl(fs::path d, detail::Manifest m, CacheOptions c)
       : dir(std::move(d)), man(std::move(m)), cacheOptions(c), cache(c.budgetBytes) {
@@ -303,6 +441,7 @@ struct TileStore::Impl {
     }
     queueCv.notify_all();
     if (worker.joinable()) worker.join();
+    if (lockFd >= 0) ::close(lockFd);  // releases the lock
   }
 
   int maxExp() const { return man.desc.metric.maxExp; }
@@ -459,30 +598,124 @@ struct TileStore::Impl {
     return out;
   }
 
-  // Writes `fields` (2^exp a side) and their mip chain as a new file for tile (tx, ty).
-  Status store(int tx, int ty, std::vector<Grid<float>> fields, int exp, std::vector<float> minV,
-               std::vector<float> maxV) {
+  // The cells of tile (tx, ty) inside the grid: its first wIn x hIn cells.
+  std::pair<int, int> inGrid(int tx, int ty) const {
+    return {std::min(footprint, man.desc.georef.width - tx * footprint),
+            std::min(footprint, man.desc.georef.height - ty * footprint)};
+  }
+
+  // Where tile (tx, ty) belongs, as written into its file and compared by verify(): its place,
+  // resolution, the georeference of its first cell and the CRS.
+  std::string tileTag(int tx, int ty, int exp) const {
+    const auto& g = man.desc.georef;
+    const double col = double(tx) * footprint, row = double(ty) * footprint;
+    const auto& c = g.transform.c;
+    const std::string& crs = g.crsWkt;
+    char crc[16];
+    std::snprintf(crc, sizeof crc, "%08x",
+                  unsigned(crc32_z(crc32_z(0L, Z_NULL, 0), reinterpret_cast<const Bytef*>(crs.data()), crs.size())));
+    return "x=" + std::to_string(tx) + " y=" + std::to_string(ty) + " exp=" + std::to_string(exp) +
+           " footprint=" + std::to_string(footprint) + " origin=" + shortest(g.transform.x(col, row)) + "," +
+           shortest(g.transform.y(col, row)) + " cell=" + shortest(c[1]) + "," + shortest(c[2]) + "," + shortest(c[4]) +
+           "," + shortest(c[5]) + " epsg=" + std::to_string(g.epsg.value_or(0)) + " wkt_crc32=" + crc;
+  }
+
+  // Fits a tile's full-resolution fields (footprint^2 each; only the first wIn x hIn cells are
+  // inside the grid, the rest is ignored) to the metric: the coarsest exponent allowed, its
+  // samples (block means), and its error against `full`. Range metric: `keep` supplies the
+  // min/max the exponent is chosen from (a resampled tile keeps its source's statistics).
+  Fit fit(const std::vector<Grid<float>>& full, int wIn, int hIn, const TileRecord* keep) const {
+    Fit f;
+    const size_t n = nf();
+    f.lo.assign(n, gis::kNoData);
+    f.hi.assign(n, gis::kNoData);
+    f.valid.assign(n, 0);
+    f.maxErr.assign(n, 0.0f);
+    f.rmsErr.assign(n, 0.0f);
+    for (size_t k = 0; k < n; ++k) {
+      float a = std::numeric_limits<float>::infinity(), b = -a;
+      for (int y = 0; y < hIn; ++y) {
+        for (int x = 0; x < wIn; ++x) {
+          const float v = full[k].at(x, y);
+          if (std::isnan(v)) continue;
+          a = std::min(a, v);
+          b = std::max(b, v);
+          ++f.valid[k];
+        }
+      }
+      if (f.valid[k]) f.lo[k] = a, f.hi[k] = b;
+    }
+    if (f.empty()) return f;
+    const int top = maxExp() - minExp();  // coarsest level considered
+    std::vector<Pyramid> pyr;
+    for (size_t k = 0; k < n; ++k) pyr.push_back(buildPyramid(full[k], wIn, hIn, top));
+    int j = 0;
+    if (man.desc.metric.kind == TileMetric::MaxError) {
+      for (j = top; j > 0 && !levelFits(pyr, j, wIn, hIn, man.desc.metric.maxErrorM); --j) {
+      }
+    } else {
+      std::vector<float> range(n);
+      for (size_t k = 0; k < n; ++k) range[k] = keep ? keep->maxV[k] - keep->minV[k] : f.hi[k] - f.lo[k];
+      j = maxExp() - chooseTileExp(range, evalRange(), minExp(), maxExp());
+      while (j > 0 && !levelFits(pyr, j, wIn, hIn, std::nullopt)) --j;
+    }
+    f.exp = maxExp() - j;
+    for (size_t k = 0; k < n; ++k) {
+      if (j == 0) {
+        Grid<float> g(footprint, footprint, gis::kNoData);
+        for (int y = 0; y < hIn; ++y) std::copy_n(&full[k].data[full[k].index(0, y)], wIn, &g.data[g.index(0, y)]);
+        f.samples.push_back(std::move(g));
+        continue;
+      }
+      const auto& L = pyr[k].levels[size_t(j - 1)];
+      Grid<float> g(L.n, L.n, gis::kNoData);
+      double maxE = 0;
+      for (size_t b = 0; b < g.data.size(); ++b) {
+        g.data[b] = blockSample(L, b);
+        if (L.cnt[b]) maxE = std::max({maxE, double(L.mx[b]) - g.data[b], double(g.data[b]) - L.mn[b]});
+      }
+      double sumSq = 0;
+      for (int y = 0; y < hIn; ++y) {
+        for (int x = 0; x < wIn; ++x) {
+          const float v = full[k].at(x, y);
+          if (std::isnan(v)) continue;
+          const double e = double(v) - double(g.at(x >> j, y >> j));
+          sumSq += e * e;
+        }
+      }
+      f.maxErr[k] = float(maxE);
+      f.rmsErr[k] = float(f.valid[k] ? std::sqrt(sumSq / double(f.valid[k])) : 0.0);
+      f.samples.push_back(std::move(g));
+    }
+    if (keep) f.lo = keep->minV, f.hi = keep->maxV;
+    return f;
+  }
+
+  // Writes a fitted tile (its samples and their mip chain) as a new file for tile (tx, ty).
+  Status store(int tx, int ty, Fit f) {
     std::vector<std::vector<Grid<float>>> levels;
-    levels.push_back(std::move(fields));
+    levels.push_back(std::move(f.samples));
     while (levels.back()[0].width > 1) {
       std::vector<Grid<float>> next;
       for (const auto& g : levels.back()) next.push_back(boxDownsample(g, 2));
       levels.push_back(std::move(next));
     }
-    const auto bytes = detail::encodeTileExr(fieldNames, levels);
+    const auto bytes = detail::encodeTileExr(fieldNames, levels, tileTag(tx, ty, f.exp));
     auto& r = rec(tx, ty);
     const uint64_t gen = man.nextGeneration++;
-    const std::string file =
-        "tiles/x" + std::to_string(tx) + "_y" + std::to_string(ty) + "_g" + std::to_string(gen) + ".exr";
+    const std::string file = detail::tileFileName(tx, ty, gen);
     STRATA_TRY_STATUS(writeTileFile(dir / file, bytes.data(), bytes.size()));
     r.present = true;
-    r.exp = exp;
+    r.exp = f.exp;
     r.generation = gen;
     r.file = file;
     r.crc32 = uint32_t(crc32_z(crc32_z(0L, Z_NULL, 0), reinterpret_cast<const Bytef*>(bytes.data()), bytes.size()));
     r.bytes = bytes.size();
-    r.minV = std::move(minV);
-    r.maxV = std::move(maxV);
+    r.minV = std::move(f.lo);
+    r.maxV = std::move(f.hi);
+    r.validCells = std::move(f.valid);
+    r.maxErrorM = std::move(f.maxErr);
+    r.rmsErrorM = std::move(f.rmsErr);
     return {};
   }
 
@@ -492,54 +725,66 @@ struct TileStore::Impl {
     return g;
   }
 
-  static void stats(const std::vector<Grid<float>>& fields, std::vector<float>& lo, std::vector<float>& hi) {
+  // Per-field min/max over the cells of tile (tx, ty) inside the grid (NaN: none).
+  void stats(int tx, int ty, const std::vector<Grid<float>>& fields, std::vector<float>& lo,
+             std::vector<float>& hi) const {
+    const auto [wIn, hIn] = inGrid(tx, ty);
     lo.assign(fields.size(), gis::kNoData);
     hi.assign(fields.size(), gis::kNoData);
     for (size_t f = 0; f < fields.size(); ++f) {
       float a = std::numeric_limits<float>::infinity(), b = -a;
-      for (float v : fields[f].data) {
-        if (std::isnan(v)) continue;
-        a = std::min(a, v);
-        b = std::max(b, v);
+      for (int y = 0; y < hIn; ++y) {
+        for (int x = 0; x < wIn; ++x) {
+          const float v = fields[f].at(x, y);
+          if (std::isnan(v)) continue;
+          a = std::min(a, v);
+          b = std::max(b, v);
+        }
       }
       if (a <= b) lo[f] = a, hi[f] = b;
     }
   }
 
-  Status put(int tx, int ty, const std::vector<Grid<float>>& full) {
-    std::vector<float> lo, hi;
-    stats(full, lo, hi);
-    auto& r = rec(tx, ty);
-    if (std::all_of(lo.begin(), lo.end(), [](float v) { return std::isnan(v); })) {
-      r = TileRecord{};
+  // Stores tile (tx, ty) from its full-resolution fields at the exponent the metric gives.
+  // `edit`: the fields are the tile's reconstruction with some cells changed, so its earlier
+  // error adds to the new one (a bound). `keep`: resampling (Range metric) from the tile's own
+  // reconstruction, keeping its statistics; nothing is written if the exponent stays.
+  Status put(int tx, int ty, const std::vector<Grid<float>>& full, bool edit, bool keep = false) {
+    STRATA_TRY_STATUS(lockForWriting());
+    const auto [wIn, hIn] = inGrid(tx, ty);
+    const TileRecord old = rec(tx, ty);
+    Fit f = fit(full, wIn, hIn, keep ? &old : nullptr);
+    if (f.empty()) {
+      rec(tx, ty) = TileRecord{};
       return {};
     }
-    std::vector<float> range(nf());
-    for (size_t f = 0; f < nf(); ++f) range[f] = hi[f] - lo[f];
-    const int exp = chooseTileExp(range, evalRange(), minExp(), maxExp());
-    std::vector<Grid<float>> fields;
-    for (const auto& g : full) fields.push_back(boxDownsample(g, 1 << (maxExp() - exp)));
-    return store(tx, ty, std::move(fields), exp, std::move(lo), std::move(hi));
+    if (keep && f.exp == old.exp) return {};
+    if (edit && old.present) {
+      for (size_t k = 0; k < nf(); ++k) {
+        f.maxErr[k] += old.maxErrorM[k];
+        f.rmsErr[k] += old.rmsErrorM[k];
+      }
+    }
+    return store(tx, ty, std::move(f));
   }
 
-  // Rewrites a tile at a new exponent from what it stores (its mip chain going down, piecewise-
-  // constant upsampling going up: detail it never stored cannot come back).
-  Status resample(int tx, int ty, int newExp) {
-    const auto& r = rec(tx, ty);
-    STRATA_TRY(DecodedPtr d, get(tx, ty, newExp, false));
-    std::vector<Grid<float>> fields;
-    for (const auto& g : d->fields) fields.push_back(replicateUpsample(g, newExp > r.exp ? 1 << (newExp - r.exp) : 1));
-    log::debug("terrain") << "tile " << tx << "," << ty << ": 2^" << r.exp << " -> 2^" << newExp;
-    return store(tx, ty, std::move(fields), newExp, r.minV, r.maxV);
+  // Rewrites a tile whose exponent the Range metric changes, from what it stores (detail it
+  // never stored cannot come back); its error bound grows by the resampling's.
+  Status resample(int tx, int ty) {
+    STRATA_TRY(auto full, loadFull(tx, ty));
+    log::debug("terrain") << "tile " << tx << "," << ty << ": resampling from 2^" << rec(tx, ty).exp;
+    return put(tx, ty, full, true, true);
   }
 
-  // Sets the evaluation range; every tile not in `skip` whose exponent changes is resampled.
+  // Sets the evaluation range; under the Range metric every tile not in `skip` whose exponent
+  // changes is resampled (the MaxError metric does not depend on it).
   Status applyRange(const std::vector<float>& lo, const std::vector<float>& hi, const std::set<size_t>& skip) {
     bool changed = false;
     for (size_t f = 0; f < nf(); ++f) changed |= !sameValue(lo[f], man.rangeLo[f]) || !sameValue(hi[f], man.rangeHi[f]);
     if (!changed) return {};
     man.rangeLo = lo;
     man.rangeHi = hi;
+    if (man.desc.metric.kind != TileMetric::Range) return {};
     const auto g = evalRange();
     for (int ty = 0; ty < man.tilesY; ++ty) {
       for (int tx = 0; tx < man.tilesX; ++tx) {
@@ -548,10 +793,38 @@ struct TileStore::Impl {
         if (!r.present || skip.count(i)) continue;
         std::vector<float> range(nf());
         for (size_t f = 0; f < nf(); ++f) range[f] = r.maxV[f] - r.minV[f];
-        const int e = chooseTileExp(range, g, minExp(), maxExp());
-        if (e != r.exp) STRATA_TRY_STATUS(resample(tx, ty, e));
+        if (chooseTileExp(range, g, minExp(), maxExp()) != r.exp) STRATA_TRY_STATUS(resample(tx, ty));
       }
     }
+    return {};
+  }
+
+  // Takes the store's writer lock (once; held until this object is destroyed).
+  Status lockForWriting() {
+    if (lockFd >= 0) return {};
+    const fs::path path = dir / kLockName;
+    const int fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (fd < 0) return fail(path.string() + ": cannot open the writer lock: " + std::strerror(errno));
+    if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
+      const int err = errno;
+      char buf[32] = {};
+      [[maybe_unused]] const ssize_t n = ::pread(fd, buf, sizeof buf - 1, 0);
+      ::close(fd);
+      if (err == EWOULDBLOCK) {
+        std::string holder(buf);
+        while (!holder.empty() && (holder.back() == '\n' || holder.back() == ' ')) holder.pop_back();
+        return fail(dir.string() + ": another writer holds this store (" +
+                    (holder.empty() ? std::string("writer.lock") : "pid " + holder) +
+                    "); one writer at a time: wait for it to finish, or stop it");
+      }
+      return fail(path.string() + ": cannot lock: " + std::strerror(err));
+    }
+    const std::string pid = std::to_string(::getpid()) + "\n";
+    if (::ftruncate(fd, 0) != 0 || ::pwrite(fd, pid.data(), pid.size(), 0) != ssize_t(pid.size())) {
+      // The lock holds without the pid; only the message of a refused writer loses it.
+      log::debug("terrain") << path.string() << ": cannot record the pid";
+    }
+    lockFd = fd;
     return {};
   }
 
@@ -587,7 +860,6 @@ Result<TileStore> TileStore::create(const fs::path& dir, StoreDesc desc, CacheOp
   auto valid = detail::validateDesc(desc);
   if (!valid) return fail(dir.string() + ": " + valid.message());
   std::error_code ec;
-  if (fs::exists(dir / detail::kManifestName, ec)) return fail(dir.string() + ": already holds a tile store");
   fs::create_directories(dir / "tiles", ec);
   if (ec) return fail(dir.string() + ": cannot create: " + ec.message());
   detail::Manifest m;
@@ -597,19 +869,35 @@ Result<TileStore> TileStore::create(const fs::path& dir, StoreDesc desc, CacheOp
   m.rangeLo.assign(desc.fields.size(), gis::kNoData);
   m.rangeHi.assign(desc.fields.size(), gis::kNoData);
   m.tiles.assign(size_t(m.tilesX) * size_t(m.tilesY), TileRecord{});
+  m.state.complete = false;
+  m.state.pass = 1;
   m.desc = std::move(desc);
   TileStore s(std::make_unique<Impl>(dir, std::move(m), cache));
+  // Locked before looking: two creators of one folder cannot both find it empty.
+  STRATA_TRY_STATUS(s.impl_->lockForWriting());
+  if (fs::exists(dir / detail::kManifestName, ec)) return fail(dir.string() + ": already holds a tile store");
+  for (const auto& e : fs::directory_iterator(dir / "tiles", ec)) {
+    if (isTileFileName(e.path().filename().string())) {
+      return fail(dir.string() + ": tiles/ holds tile files (" + e.path().filename().string() +
+                  ") but there is no manifest: not a store this ingest started; use an empty folder");
+    }
+  }
   STRATA_TRY_STATUS(s.commit());
   return s;
 }
 
-Result<TileStore> TileStore::open(const fs::path& dir, CacheOptions cache) {
+Result<TileStore> TileStore::open(const fs::path& dir, CacheOptions cache, OpenOptions options) {
   const fs::path path = dir / detail::kManifestName;
-  std::ifstream in(path);
+  std::ifstream in(path, std::ios::binary);
   if (!in) return fail(path.string() + ": cannot read (not a Strata tile store?)");
   std::stringstream text;
   text << in.rdbuf();
   STRATA_TRY(auto m, detail::parseManifest(text.str(), path.string()));
+  if (!m.state.complete && !options.allowIncomplete) {
+    return fail(dir.string() + ": incomplete store: its ingest stopped in pass " + std::to_string(m.state.pass) +
+                " after " + std::to_string(m.state.tilesDone) + " of " + std::to_string(int64_t(m.tilesX) * m.tilesY) +
+                " tiles; finish it with `strata ingest --resume` (same arguments)");
+  }
   return TileStore(std::make_unique<Impl>(dir, std::move(m), cache));
 }
 
@@ -641,9 +929,9 @@ std::pair<float, float> TileStore::globalRange(int field) const {
   return {impl_->man.rangeLo[size_t(field)], impl_->man.rangeHi[size_t(field)]};
 }
 
-Result<Grid<float>> TileStore::readWindow(int field, Window w, int lod) { return read(field, w, lod, nullptr); }
+Result<Grid<float>> TileStore::readWindow(int field, gis::CellRect w, int lod) { return read(field, w, lod, nullptr); }
 
-Result<std::optional<Grid<float>>> TileStore::tryReadWindow(int field, Window w, int lod) {
+Result<std::optional<Grid<float>>> TileStore::tryReadWindow(int field, gis::CellRect w, int lod) {
   bool missing = false;
   STRATA_TRY(auto g, read(field, w, lod, &missing));
   if (missing) return std::optional<Grid<float>>();
@@ -662,7 +950,7 @@ int TileStore::requestsPending() const {
   return int(impl_->requested.size());
 }
 
-Result<Grid<float>> TileStore::read(int field, Window w, int lod, bool* missing) {
+Result<Grid<float>> TileStore::read(int field, gis::CellRect w, int lod, bool* missing) {
   auto& I = *impl_;
   if (field < 0 || size_t(field) >= I.nf()) return fail(I.dir.string() + ": no field " + std::to_string(field));
   if (lod < 0 || lod > maxLod()) {
@@ -736,7 +1024,7 @@ Status TileStore::writeWindow(int field, int x, int y, const Grid<float>& values
         for (int xx = x0; xx < x1; ++xx) g.at(xx - tx * F, yy - ty * F) = values.at(xx - x, yy - y);
       }
       std::vector<float> lo, hi;
-      Impl::stats(full, lo, hi);
+      I.stats(tx, ty, full, lo, hi);
       tiles.emplace_back(tx, ty);
       merged.push_back(std::move(full));
       los.push_back(std::move(lo));
@@ -748,7 +1036,7 @@ Status TileStore::writeWindow(int field, int x, int y, const Grid<float>& values
   std::vector<float> lo, hi;
   I.unionRange(touched, los, his, lo, hi);
   STRATA_TRY_STATUS(I.applyRange(lo, hi, touched));
-  for (size_t k = 0; k < tiles.size(); ++k) STRATA_TRY_STATUS(I.put(tiles[k].first, tiles[k].second, merged[k]));
+  for (size_t k = 0; k < tiles.size(); ++k) STRATA_TRY_STATUS(I.put(tiles[k].first, tiles[k].second, merged[k], true));
   return {};
 }
 
@@ -759,7 +1047,7 @@ Status TileStore::putTile(int tx, int ty, const std::vector<Grid<float>>& fields
   for (const auto& g : fields) {
     STRATA_CHECK(g.width == I.footprint && g.height == I.footprint) << "tile field " << g.width << "x" << g.height;
   }
-  return I.put(tx, ty, fields);
+  return I.put(tx, ty, fields, false);
 }
 
 void TileStore::setEvaluationRange(int field, float lo, float hi) {
@@ -776,50 +1064,193 @@ Status TileStore::reevaluate() {
 
 Status TileStore::commit() {
   auto& I = *impl_;
+  STRATA_TRY_STATUS(I.lockForWriting());
   const fs::path tiles = I.dir / "tiles";
   // The tile files' data and names reach the disk before the manifest that names them.
   syncDir(tiles, true);
   const std::string text = detail::manifestToToml(I.man);
   STRATA_TRY_STATUS(writeFileAtomic(I.dir / detail::kManifestName, text));
   syncDir(I.dir, false);
-  // Superseded tiles, and leftovers of writers that died before their commit.
+  // Superseded tiles, and leftovers of writers that died before their commit: only files named
+  // like tiles (or their temporaries); anything else someone put in the folder stays.
   std::set<std::string> live;
   for (const auto& r : I.man.tiles) {
     if (r.present) live.insert(fs::path(r.file).filename().string());
   }
   std::error_code ec;
   for (const auto& e : fs::directory_iterator(tiles, ec)) {
-    if (!live.count(e.path().filename().string())) fs::remove(e.path(), ec);
+    const std::string name = e.path().filename().string();
+    if (e.is_regular_file(ec) && isTileFileName(name) && !live.count(name)) fs::remove(e.path(), ec);
   }
+  const std::string tmpPrefix = std::string(detail::kManifestName) + ".tmp";
   for (const auto& e : fs::directory_iterator(I.dir, ec)) {
-    if (e.path().filename().string().rfind(std::string(detail::kManifestName) + ".tmp", 0) == 0)
-      fs::remove(e.path(), ec);
+    if (e.is_regular_file(ec) && e.path().filename().string().rfind(tmpPrefix, 0) == 0) fs::remove(e.path(), ec);
   }
   return {};
+}
+
+Status TileStore::lockForWriting() { return impl_->lockForWriting(); }
+
+const BuildState& TileStore::buildState() const { return impl_->man.state; }
+void TileStore::setBuildState(BuildState state) { impl_->man.state = std::move(state); }
+
+ErrorSummary TileStore::errorSummary(int field, std::optional<gis::CellRect> w) const {
+  STRATA_CHECK(field >= 0 && size_t(field) < impl_->nf()) << "field " << field;
+  const int F = footprint();
+  int tx0 = 0, ty0 = 0, tx1 = tilesX() - 1, ty1 = tilesY() - 1;
+  if (w) {
+    tx0 = std::max(0, w->x / F);
+    ty0 = std::max(0, w->y / F);
+    tx1 = std::min(tilesX() - 1, (w->x + w->width - 1) / F);
+    ty1 = std::min(tilesY() - 1, (w->y + w->height - 1) / F);
+  }
+  ErrorSummary e;
+  double sumSq = 0;
+  for (int ty = ty0; ty <= ty1; ++ty) {
+    for (int tx = tx0; tx <= tx1; ++tx) {
+      const auto& r = impl_->rec(tx, ty);
+      if (!r.present) continue;
+      const auto f = size_t(field);
+      e.maxM = std::max(e.maxM, double(r.maxErrorM[f]));
+      sumSq += double(r.rmsErrorM[f]) * double(r.rmsErrorM[f]) * double(r.validCells[f]);
+      e.cells += r.validCells[f];
+    }
+  }
+  e.rmsM = e.cells ? std::sqrt(sumSq / double(e.cells)) : 0.0;
+  return e;
 }
 
 std::vector<TileProblem> TileStore::verify() const {
   auto& I = *impl_;
   std::vector<TileProblem> problems;
+  const std::string manifest = detail::kManifestName;
+  auto problem = [&](const std::string& file, const std::string& message) { problems.push_back({file, message}); };
+
+  // The CRS: parseable, and the manifest's EPSG code, name, kind and body are its own.
+  const auto& g = desc().georef;
+  if (!g.crsWkt.empty() || g.epsg) {
+    auto crs = gis::describeCrs(g.crsWkt.empty() ? "EPSG:" + std::to_string(*g.epsg) : g.crsWkt);
+    if (!crs) {
+      problem(manifest, manifest + ": georef.crs_wkt does not parse: " + crs.message());
+    } else {
+      auto differs = [&](const std::string& key, const std::string& have, const std::string& want) {
+        problem(manifest, manifest + ": georef." + key + " = " + have + " but crs_wkt says " + want);
+      };
+      auto epsgText = [](const std::optional<int>& e) { return e ? std::to_string(*e) : std::string("none"); };
+      if (!g.crsWkt.empty() && crs->epsg != g.epsg) differs("epsg", epsgText(g.epsg), epsgText(crs->epsg));
+      if (!g.crsWkt.empty() && crs->crsName != g.crsName)
+        differs("crs_name", "'" + g.crsName + "'", "'" + crs->crsName + "'");
+      if (crs->geographic != g.geographic)
+        differs("geographic", g.geographic ? "true" : "false", crs->geographic ? "true" : "false");
+      if (std::abs(crs->body.semiMajorM - g.body.semiMajorM) > 1e-6 * crs->body.semiMajorM ||
+          std::abs(crs->body.flattening - g.body.flattening) > 1e-9) {
+        differs("body_semi_major_m / body_flattening",
+                shortest(g.body.semiMajorM) + " / " + shortest(g.body.flattening),
+                shortest(crs->body.semiMajorM) + " / " + shortest(crs->body.flattening));
+      }
+    }
+  }
+
+  // Every present tile: size, checksum, decoding, its place, its samples against its record.
+  std::vector<float> lo(I.nf(), std::numeric_limits<float>::infinity()), hi(I.nf(), -lo[0]);
+  std::set<std::string> live;
   for (int ty = 0; ty < tilesY(); ++ty) {
     for (int tx = 0; tx < tilesX(); ++tx) {
       const auto& r = I.rec(tx, ty);
       if (!r.present) continue;
+      live.insert(fs::path(r.file).filename().string());
+      for (size_t f = 0; f < I.nf(); ++f) {
+        if (std::isnan(r.minV[f])) continue;
+        lo[f] = std::min(lo[f], r.minV[f]);
+        hi[f] = std::max(hi[f], r.maxV[f]);
+      }
       const TileRef ref = I.ref(tx, ty);
       auto bytes = readTileBytes(I.dir, ref);
       if (!bytes) {
-        problems.push_back({r.file, bytes.message()});
+        problem(r.file, bytes.message());
         continue;
       }
       auto finest = detail::decodeTileExrLevel(r.file, *bytes, I.fieldNames, 0);
       auto coarsest = detail::decodeTileExrLevel(r.file, *bytes, I.fieldNames, r.exp);
-      if (!finest || !coarsest) {
-        problems.push_back({r.file, !finest ? finest.message() : coarsest.message()});
-      } else if ((*finest)[0].width != 1 << r.exp || (*coarsest)[0].width != 1) {
-        problems.push_back({r.file, r.file + ": " + std::to_string((*finest)[0].width) +
-                                        " samples a side, the manifest says 2^" + std::to_string(r.exp)});
+      auto tag = detail::decodeTileExrTag(r.file, *bytes);
+      if (!finest || !coarsest || !tag) {
+        problem(r.file, !finest ? finest.message() : !coarsest ? coarsest.message() : tag.message());
+        continue;
+      }
+      if ((*finest)[0].width != 1 << r.exp || (*coarsest)[0].width != 1) {
+        problem(r.file, r.file + ": " + std::to_string((*finest)[0].width) + " samples a side, the manifest says 2^" +
+                            std::to_string(r.exp));
+        continue;
+      }
+      if (*tag != I.tileTag(tx, ty, r.exp)) {
+        problem(r.file, r.file + ": made for another place or grid (tile says '" + *tag + "', the manifest '" +
+                            I.tileTag(tx, ty, r.exp) + "')");
+        continue;
+      }
+      // Samples are block means of cells in [min, max]; each extreme is within the tile's error of
+      // some sample; the blocks with data cover exactly the valid cells.
+      const int j = maxLod() - r.exp;
+      const auto [wIn, hIn] = I.inGrid(tx, ty);
+      for (size_t f = 0; f < I.nf(); ++f) {
+        const auto& sm = (*finest)[f];
+        float smin = std::numeric_limits<float>::infinity(), smax = -smin;
+        uint64_t cells = 0;
+        for (int y = 0; y < sm.height; ++y) {
+          for (int x = 0; x < sm.width; ++x) {
+            const float v = sm.at(x, y);
+            if (std::isnan(v)) continue;
+            smin = std::min(smin, v);
+            smax = std::max(smax, v);
+            cells += cellsInGrid(x, y, 1 << j, wIn, hIn);
+          }
+        }
+        const std::string what = r.file + ": field '" + I.fieldNames[f] + "': ";
+        if (cells != r.validCells[f]) {
+          problem(r.file, what + std::to_string(cells) + " cells with data, the manifest says " +
+                              std::to_string(r.validCells[f]));
+          continue;
+        }
+        if (!cells) continue;
+        const double tol =
+            double(r.maxErrorM[f]) + 1e-6 * std::max(std::abs(double(r.maxV[f])), std::abs(double(r.minV[f]))) + 1e-6;
+        if (smin < r.minV[f] || smax > r.maxV[f] || double(r.maxV[f]) - smax > tol || double(smin) - r.minV[f] > tol) {
+          problem(r.file, what + "samples span " + shortest(smin) + " .. " + shortest(smax) + ", the manifest says " +
+                              shortest(r.minV[f]) + " .. " + shortest(r.maxV[f]) + " within " +
+                              shortest(r.maxErrorM[f]) + " m");
+        }
       }
     }
+  }
+  for (size_t f = 0; f < I.nf(); ++f) {
+    if (lo[f] > hi[f]) lo[f] = hi[f] = gis::kNoData;
+    if (!sameValue(lo[f], I.man.rangeLo[f]) || !sameValue(hi[f], I.man.rangeHi[f])) {
+      if (buildState().complete) {  // an ingest sets the ranges when it finishes
+        problem(manifest, manifest + ": field '" + I.fieldNames[f] + "': range " + shortest(I.man.rangeLo[f]) + " .. " +
+                              shortest(I.man.rangeHi[f]) + ", the tiles span " + shortest(lo[f]) + " .. " +
+                              shortest(hi[f]));
+      }
+    }
+  }
+  // Tile files the manifest does not name for a tile it lists as absent: a deleted entry (its
+  // data lost to readers). Other unnamed tile files are harmless leftovers of a writer that died
+  // (superseded generations of listed tiles, or uncommitted writes), which its next commit
+  // removes.
+  std::error_code ec;
+  std::vector<std::string> orphans;
+  for (const auto& e : fs::directory_iterator(I.dir / "tiles", ec)) {
+    const std::string name = e.path().filename().string();
+    if (!isTileFileName(name) || name.find(".tmp") != std::string::npos || live.count(name)) continue;
+    const auto tx = std::strtoull(name.c_str() + 1, nullptr, 10);
+    const auto ty = std::strtoull(name.c_str() + name.find("_y") + 2, nullptr, 10);
+    const auto gen = std::strtoull(name.c_str() + name.find("_g") + 2, nullptr, 10);
+    const bool listed = tx < uint64_t(tilesX()) && ty < uint64_t(tilesY()) && I.rec(int(tx), int(ty)).present;
+    if (!listed && gen < I.man.nextGeneration) orphans.push_back(name);
+  }
+  std::sort(orphans.begin(), orphans.end());
+  for (const auto& o : orphans) {
+    problem("tiles/" + o, "tiles/" + o +
+                              ": a tile file for a tile the manifest lists as absent (its entry deleted from the "
+                              "manifest?); its data is not read");
   }
   return problems;
 }
@@ -838,17 +1269,23 @@ StorageFootprint TileStore::footprintStats() const {
   StorageFootprint s;
   const uint64_t nf = impl_->nf();
   s.denseSamples = uint64_t(width()) * uint64_t(height()) * nf;
-  for (const auto& r : impl_->man.tiles) {
-    if (!r.present) continue;
-    const uint64_t n = uint64_t(1) << (2 * r.exp);
-    s.storedSamples += n * nf;
-    for (uint64_t side = uint64_t(1) << r.exp; side >= 1; side /= 2) s.storedWithMips += side * side * nf;
-    s.fileBytes += r.bytes;
+  for (int ty = 0; ty < tilesY(); ++ty) {
+    for (int tx = 0; tx < tilesX(); ++tx) {
+      const auto& r = impl_->rec(tx, ty);
+      if (!r.present) continue;
+      const auto [wIn, hIn] = impl_->inGrid(tx, ty);
+      // Samples of block side b covering the wIn x hIn cells inside the grid, level by level.
+      auto covering = [&](uint64_t b) { return uint64_t((wIn + b - 1) / b) * uint64_t((hIn + b - 1) / b); };
+      uint64_t b = uint64_t(1) << (maxLod() - r.exp);
+      s.storedSamples += covering(b) * nf;
+      for (int level = r.exp; level >= 0; --level, b *= 2) s.storedWithMips += covering(b) * nf;
+      s.fileBytes += r.bytes;
+    }
   }
   return s;
 }
 
-gis::Georef TileStore::windowGeoref(Window window, int lod) const {
+gis::Georef TileStore::windowGeoref(gis::CellRect window, int lod) const {
   gis::Georef g = desc().georef;
   const double s = double(1 << lod);
   const auto& c = desc().georef.transform.c;
@@ -863,7 +1300,7 @@ gis::Georef TileStore::windowGeoref(Window window, int lod) const {
   return g;
 }
 
-Result<LayeredTerrain> TileStore::readTerrain(Window window) {
+Result<LayeredTerrain> TileStore::readTerrain(gis::CellRect window) {
   LayeredTerrain t;
   t.georef = windowGeoref(window, 0);
   t.materials = desc().materials;

@@ -141,10 +141,10 @@ TEST(BadInput, NoGeoreferenceUnlessGivenExplicitly) {
   const std::string path = (dir / "plain.tif").string();
   test::SyntheticRaster s;
   ASSERT_TRUE(test::writeSynthetic(path, s));
-  EXPECT_CONTAINS(readError(path), "no georeference (no CRS and no geotransform); pass an explicit CRS");
+  EXPECT_CONTAINS(readError(path), "no georeference (no CRS and no geotransform); assign one (strata: --assign-crs");
   ReadOptions half;
   half.crs = "EPSG:32612";
-  EXPECT_CONTAINS(readError(path, half), "an explicit georeference needs both a CRS and a geotransform");
+  EXPECT_CONTAINS(readError(path, half), "no georeference (no geotransform); assign one");
   ReadOptions o = half;
   o.transform = GeoTransform{{400000, 30, 0, 4000000, 0, -30}};
   auto r = readDem(path, o);
@@ -220,7 +220,7 @@ TEST(BadInput, WindowAndBandOutOfRange) {
   o.band = 2;
   EXPECT_CONTAINS(readError(path, o), "band 2 requested, the file has 1");
   o.band = 1;
-  o.window = PixelWindow{-1, 0, 4, 4};
+  o.window = CellRect{-1, 0, 4, 4};
   EXPECT_CONTAINS(readError(path, o), "window 4x4+-1+0 is outside the 32x16 raster");
 }
 

@@ -166,7 +166,7 @@ TEST(DemIo, WindowEqualsTheSameCellsOfAFullRead) {
   auto full = readDem(path);
   ASSERT_TRUE(full.ok()) << full.message();
   ReadOptions o;
-  o.window = PixelWindow{300, 100, 64, 32};
+  o.window = CellRect{300, 100, 64, 32};
   auto win = readDem(path, o);
   ASSERT_TRUE(win.ok()) << win.message();
   ASSERT_EQ(win->values.width, 64);
@@ -176,7 +176,7 @@ TEST(DemIo, WindowEqualsTheSameCellsOfAFullRead) {
   EXPECT_DOUBLE_EQ(win->georef.transform.c[0], full->georef.transform.x(300, 100));
   EXPECT_DOUBLE_EQ(win->georef.transform.c[3], full->georef.transform.y(300, 100));
   EXPECT_EQ(win->georef.transform.c[1], full->georef.transform.c[1]);
-  o.window = PixelWindow{500, 0, 64, 32};
+  o.window = CellRect{500, 0, 64, 32};
   auto outside = readDem(path, o);
   ASSERT_FALSE(outside.ok());
   EXPECT_NE(outside.message().find("window 64x32+500+0 is outside the 512x512 raster"), std::string::npos)
@@ -218,7 +218,7 @@ TEST(DemIo, WindowReadsOnlyItsTiles) {
     }
   }
   ReadOptions o;
-  o.window = PixelWindow{10, 20, 200, 100};
+  o.window = CellRect{10, 20, 200, 100};
   auto win = readDem(path, o);
   ASSERT_TRUE(win.ok()) << win.message();
   EXPECT_EQ(win->values.at(0, 0), 10 + 10 * 20);
@@ -232,7 +232,7 @@ TEST(DemIo, WindowReadsOnlyItsTiles) {
 TEST(DemIo, WrittenGeoTiffReadsBackInGdalinfo) {
   const auto dir = strata::test::tempDir("write");
   ReadOptions o;
-  o.window = PixelWindow{100, 50, 96, 80};
+  o.window = CellRect{100, 50, 96, 80};
   auto src = readDem(test::dataFile("grand_canyon/grandcanyon_srtm_3857.tif"), o);
   ASSERT_TRUE(src.ok()) << src.message();
   src->values.at(3, 4) = kNoData;  // a hole must come back as nodata
@@ -263,7 +263,7 @@ TEST(DemIo, WrittenGeoTiffReadsBackInGdalinfo) {
     }
   }
   // A CRS without an EPSG code (the Moon's) survives the round trip.
-  o.window = PixelWindow{0, 0, 64, 32};
+  o.window = CellRect{0, 0, 64, 32};
   auto moon = readDem(test::dataFile("moon/LDEM_4.LBL"), o);
   ASSERT_TRUE(moon.ok()) << moon.message();
   const std::string moonPath = (dir / "moon.tif").string();

@@ -109,9 +109,11 @@ Expected expected(const Inputs& in, const Georef& t) {
   return e;
 }
 
-float blendExpected(float layer, float src, BlendMode m) {
+float blendExpected(float layer, float src, BlendMode m, bool fill = false) {
   if (std::isnan(src)) return layer;
-  if (std::isnan(layer)) return src;
+  // Corrections (add, subtract, multiply) leave no data where the layer has none, unless filling.
+  const bool corrects = m == BlendMode::Add || m == BlendMode::Subtract || m == BlendMode::Multiply;
+  if (std::isnan(layer)) return corrects && !fill ? kNoData : src;
   switch (m) {
     case BlendMode::Replace: return src;
     case BlendMode::Add: return layer + src;
@@ -145,9 +147,11 @@ TEST(Mosaic, EveryBlendModeCellByCellAcrossTwoCrs) {
 
   for (BlendMode m :
        {BlendMode::Replace, BlendMode::Add, BlendMode::Subtract, BlendMode::Multiply, BlendMode::Max, BlendMode::Min}) {
-    for (bool aFirst : {true, false}) {
+    for (int order = 0; order < 4; ++order) {
+      const bool aFirst = order % 2 == 0, fill = order >= 2;
       MosaicInput first{aFirst ? in.a : in.b, std::nullopt, BlendMode::Replace, Resampling::Nearest};
       MosaicInput second{aFirst ? in.b : in.a, std::nullopt, m, Resampling::Nearest};
+      second.fillNoData = fill;
       const MosaicInput inputs[] = {first, second};
       auto layer = buildMosaic("bedrock", t, inputs);
       ASSERT_TRUE(layer.ok()) << layer.message();
@@ -157,13 +161,13 @@ TEST(Mosaic, EveryBlendModeCellByCellAcrossTwoCrs) {
       int mismatches = 0;
       for (int r = 0; r < t.height; ++r) {
         for (int c = 0; c < t.width; ++c) {
-          const float want = blendExpected(blendExpected(kNoData, x.at(c, r), BlendMode::Replace), y.at(c, r), m);
+          const float want = blendExpected(blendExpected(kNoData, x.at(c, r), BlendMode::Replace), y.at(c, r), m, fill);
           const float got = layer->raster.values.at(c, r);
           // Same float operations on the same float inputs: exactly equal.
           const bool same = (std::isnan(want) && std::isnan(got)) || want == got;
           if (!same && ++mismatches <= 5) {
-            ADD_FAILURE() << toString(m) << (aFirst ? " A then B" : " B then A") << " cell " << c << "," << r << ": "
-                          << got << " want " << want;
+            ADD_FAILURE() << toString(m) << (fill ? "+fill" : "") << (aFirst ? " A then B" : " B then A") << " cell "
+                          << c << "," << r << ": " << got << " want " << want;
           }
         }
       }
@@ -196,7 +200,9 @@ TEST(Mosaic, BilinearKeepsConstantsAndLeavesUncoveredCellsNoData) {
   for (int i = 0; i < kBw; ++i) sb.values[size_t(i) * kBw + i] = -32768;  // nodata is never blended in
   ASSERT_TRUE(test::writeSynthetic(b, sb));
   for (Resampling rs : {Resampling::Bilinear, Resampling::Cubic}) {
-    const MosaicInput inputs[] = {{a, std::nullopt, BlendMode::Replace, rs}, {b, std::nullopt, BlendMode::Add, rs}};
+    // B fills the cells where A has no data (add+fill), so B-only cells read 40.
+    const MosaicInput inputs[] = {{a, std::nullopt, BlendMode::Replace, rs},
+                                  {b, std::nullopt, BlendMode::Add, rs, 1, true}};
     auto layer = buildMosaic("sum", t, inputs);
     ASSERT_TRUE(layer.ok()) << layer.message();
     int n250 = 0, n290 = 0, n40 = 0, nan = 0;

@@ -8,23 +8,24 @@
 #include <fstream>
 #include <random>
 
-#include <strata/render/procgen/generator.hpp>
-#include <strata/render/procgen/script_file.hpp>
-#include <strata/render/procgen/wavelet_gpu.hpp>
-#include <strata/terrain/procgen/wavelet.hpp>
+#include <strata/procgen/generator.hpp>
+#include <strata/procgen/script_file.hpp>
+#include <strata/procgen/shader_slots.hpp>
+#include <strata/procgen/wavelet.hpp>
+#include <strata/procgen/wavelet_gpu.hpp>
 
 #include "gl_fixture.hpp"
 #include "procgen_test_support.hpp"
 #include "strata_test.hpp"
 
-namespace strata::render::procgen {
+namespace strata::procgen {
 namespace {
 
 using gis::Grid;
-using terrain::procgen::Band;
-using terrain::procgen::PyramidShape;
+using procgen::Band;
+using procgen::PyramidShape;
 using test::GlTest;
-namespace cpu = terrain::procgen;
+namespace cpu = procgen;
 
 float maxAbsDiff(const Grid<float>& a, const Grid<float>& b) {
   EXPECT_EQ(a.size(), b.size());
@@ -175,12 +176,26 @@ TEST_F(GlTest, SyntaxErrorInUserScriptNamesTheUsersFileAndLine) {
 }
 
 TEST_F(GlTest, TemplateAndTransformShadersCompileOnTheirOwn) {
-  // Every embedded shader must compile by itself (the generation template falls back to a
-  // flat height() when no script is spliced in).
-  for (const char* name : {"procgen/generate.comp", "procgen/dwt53.comp", "procgen/dwt97.comp"}) {
-    auto p = gl::Program::compute(name);
+  // Every embedded shader must compile by itself, given procgen's binding slots (the generation
+  // template falls back to a flat height() when no script is spliced in).
+  for (const char* name :
+       {"procgen/shaders/generate.comp", "procgen/shaders/dwt53.comp", "procgen/shaders/dwt97.comp"}) {
+    auto p = gl::Program::compute(name, gl::definesFor(slots::kAll));
     EXPECT_TRUE(p) << p.message();
   }
+}
+
+TEST_F(GlTest, ShadersUseTheSlotsDeclaredInCpp) {
+  // The template with a script that reads both DEMs, so that their images are active too.
+  auto spliced =
+      spliceScript({"dems.toml", "float level(vec2 p, int lvl) { return dem0Level(p, lvl) + dem1Level(p, lvl); }\n", 1},
+                   ScriptForm::Level);
+  ASSERT_TRUE(spliced) << spliced.message();
+  test::expectProgramsMatchSlots("procgen/shaders/", slots::kAll,
+                                 {{{"procgen/shaders/dwt53.comp"}},
+                                  {{"procgen/shaders/dwt97.comp"}},
+                                  {{"procgen/shaders/generate.comp"}},
+                                  {{}, *spliced}});
 }
 
 TEST_F(GlTest, LevelFormRefusesMoreLevelsThanTheSizeAllows) {
@@ -406,4 +421,4 @@ TEST_F(GlTest, MultiLayerExampleGivesEachLayerItsOwnField) {
 }
 
 }  // namespace
-}  // namespace strata::render::procgen
+}  // namespace strata::procgen

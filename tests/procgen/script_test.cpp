@@ -5,11 +5,11 @@
 #include <regex>
 #include <sstream>
 
-#include <strata/render/procgen/script_file.hpp>
+#include <strata/procgen/script_file.hpp>
 
 #include "strata_test.hpp"
 
-namespace strata::render::procgen {
+namespace strata::procgen {
 namespace {
 
 std::string examplePath(const std::string& name) { return std::string(STRATA_SOURCE_DIR) + "/docs/examples/" + name; }
@@ -65,8 +65,8 @@ TEST(ProcgenScript, SplicedUserLinesKeepTheirFileAndLineNumbers) {
   for (std::string l; std::getline(in, l);) lines.push_back(l);
   ASSERT_EQ(lines.size(), where.size());
   // The user's "return 1.0;" is line 13 of mine.toml; the template's main() is where it is in
-  // shaders/procgen/generate.comp (numbering resumes after the user's text).
-  const auto templateLines = fileLines(std::string(STRATA_SOURCE_DIR) + "/shaders/procgen/generate.comp");
+  // procgen/shaders/generate.comp (numbering resumes after the user's text).
+  const auto templateLines = fileLines(std::string(STRATA_SOURCE_DIR) + "/procgen/shaders/generate.comp");
   int templateMain = 0;
   for (size_t i = 0; i < templateLines.size(); ++i) {
     if (templateLines[i].rfind("void main()", 0) == 0) templateMain = int(i) + 1;
@@ -124,7 +124,7 @@ TEST(ProcgenScript, ExamplesParseWithTheGlslLineNumbersOfTheFile) {
   ASSERT_TRUE(like);
   EXPECT_EQ(like->layers[0].matchDem, 0);
   EXPECT_EQ(like->levels, 5);
-  EXPECT_EQ(like->wavelet, terrain::procgen::Wavelet::Cdf53);  // the default
+  EXPECT_EQ(like->wavelet, procgen::Wavelet::Cdf53);  // the default
 }
 
 TEST(ProcgenScript, BadFilesNameTheFileAndTheField) {
@@ -149,4 +149,4 @@ TEST(ProcgenScript, BadFilesNameTheFileAndTheField) {
 }
 
 }  // namespace
-}  // namespace strata::render::procgen
+}  // namespace strata::procgen

@@ -5,12 +5,12 @@
 #include <cmath>
 #include <random>
 
-#include <strata/terrain/procgen/wavelet.hpp>
+#include <strata/procgen/wavelet.hpp>
 
 #include "procgen_test_support.hpp"
 #include "strata_test.hpp"
 
-namespace strata::terrain::procgen {
+namespace strata::procgen {
 namespace {
 
 float maxAbsDiff(const Grid<float>& a, const Grid<float>& b) {
@@ -172,4 +172,4 @@ TEST(Resample, BilinearKeepsCornersAndPlanes) {
 }
 
 }  // namespace
-}  // namespace strata::terrain::procgen
+}  // namespace strata::procgen

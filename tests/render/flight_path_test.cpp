@@ -1,9 +1,9 @@
 // Flight-path keyframes: parsing, errors that name the line, interpolation.
 #include <gtest/gtest.h>
 
-#include <strata/render/terrain/flight_path.hpp>
+#include <strata/render/flight_path.hpp>
 
-namespace strata::render::terrain {
+namespace strata::render {
 namespace {
 
 TEST(FlightPath, ParsesAndInterpolates) {
@@ -45,4 +45,4 @@ TEST(FlightPath, ErrorsNameTheLine) {
 }
 
 }  // namespace
-}  // namespace strata::render::terrain
+}  // namespace strata::render

@@ -6,9 +6,9 @@
 #include <numbers>
 #include <set>
 
-#include <strata/render/terrain/ring_mesh.hpp>
+#include <strata/render/ring_mesh.hpp>
 
-namespace strata::render::terrain {
+namespace strata::render {
 namespace {
 
 glm::dvec2 cartesian(const glm::vec2& polar) {
@@ -100,4 +100,4 @@ TEST_P(RingMeshTest, EdgesAreManifoldWithConsistentOrientation) {
 INSTANTIATE_TEST_SUITE_P(Sizes, RingMeshTest, ::testing::Values(1, 2, 3, 7, 16, 64));
 
 }  // namespace
-}  // namespace strata::render::terrain
+}  // namespace strata::render

@@ -6,9 +6,9 @@
 #include <map>
 #include <set>
 
-#include <strata/render/terrain/sliding_grid.hpp>
+#include <strata/render/sliding_grid.hpp>
 
-namespace strata::render::terrain {
+namespace strata::render {
 namespace {
 
 class SlidingGridMeshTest : public ::testing::TestWithParam<std::pair<int, int>> {};
@@ -73,4 +73,4 @@ INSTANTIATE_TEST_SUITE_P(Sizes, SlidingGridMeshTest,
                                            std::pair{64, 4}));
 
 }  // namespace
-}  // namespace strata::render::terrain
+}  // namespace strata::render

@@ -13,11 +13,11 @@
 #include <tuple>
 
 #include <strata/gis/dem_io.hpp>
-#include <strata/render/terrain/gpu_tile_cache.hpp>
-#include <strata/render/terrain/screen_error.hpp>
-#include <strata/render/terrain/sliding_grid.hpp>
-#include <strata/render/terrain/streamed_elevation.hpp>
-#include <strata/render/terrain/terrain_renderer.hpp>
+#include <strata/render/gpu_tile_cache.hpp>
+#include <strata/render/screen_error.hpp>
+#include <strata/render/sliding_grid.hpp>
+#include <strata/render/streamed_elevation.hpp>
+#include <strata/render/terrain_renderer.hpp>
 #include <strata/terrain/dem_sources.hpp>
 #include <strata/terrain/ingest.hpp>
 #include <strata/terrain/tile_store.hpp>
@@ -25,7 +25,7 @@
 #include "gl_fixture.hpp"
 #include "strata_test.hpp"
 
-namespace strata::render::terrain {
+namespace strata::render {
 namespace {
 
 using strata::terrain::TileStore;
@@ -226,7 +226,10 @@ TEST_F(GlTest, StreamedRenderMatchesTheWholeDemRender) {
   auto streamed = TerrainScene::createStreamed(openStore(), params);
   ASSERT_TRUE(streamed) << streamed.message();
   ASSERT_EQ(streamed->streamed()->coarseLevel(), 2);
-  auto ring = RingRenderer::create({.circles = 128});
+  // 64 circles: the ring wants, at distance r, texels about as large as its tangential spacing
+  // 2 pi r / 6i, which a window of N texels holds out to where that is its level: N >= 2n
+  // (docs/render-rings.md, "Streaming"). With 128 circles: 3.1 m mean, 33 m 99th percentile.
+  auto ring = RingRenderer::create({.circles = 64});
   ASSERT_TRUE(ring) << ring.message();
   const int w = 256, h = 160;
   auto t1 = OffscreenTarget::create(w, h), t2 = OffscreenTarget::create(w, h);
@@ -571,7 +574,11 @@ TEST_F(GlTest, GlobalStoreStreamsAcrossTheSeamInPlanetaryMode) {
   ASSERT_TRUE(streamed) << streamed.message();
   auto* s = streamed->streamed();
   ASSERT_EQ(s->coarseLevel(), 3);
-  auto ring = RingRenderer::create({.circles = 96});
+  // The rings spread to the horizon of the softened viewpoint (a range beyond it): the default
+  // range (the viewer's horizon plus the highest summit's, 4,900 km here) packs the 96 circles
+  // closer, and they then want level 0 beyond the level-0 window, where a coarser level stands in
+  // (measured 4.1 m mean with the default, 0.08 m with this).
+  auto ring = RingRenderer::create({.circles = 96, .rangeM = 2e7});
   ASSERT_TRUE(ring) << ring.message();
   const int w = 192, h = 120;
   auto t1 = OffscreenTarget::create(w, h), t2 = OffscreenTarget::create(w, h);
@@ -601,8 +608,8 @@ TEST_F(GlTest, GlobalStoreStreamsAcrossTheSeamInPlanetaryMode) {
   const Diff c = compare(*t1, *t2, 8);
   std::ofstream(test::outputDir("render") / "streaming_global.txt", std::ios::app)
       << "coarse_only elev_mean_m " << c.elevMeanM << " colour_fraction_over_8 " << c.colourFraction << "\n";
-  // Streamed: what the whole-DEM render samples, up to filtering order (measured 0.006 m mean,
-  // no pixel more than 1/255 off); the coarse level alone: at least ten times further off.
+  // Streamed: what the whole-DEM render samples, up to filtering order (measured 0.08 m mean,
+  // no pixel more than 3/255 off); the coarse level alone: at least ten times further off.
   EXPECT_LT(d.elevMeanM, 1.0);
   EXPECT_LT(d.colourFraction, 0.01);
   EXPECT_LT(d.terrainMismatch, size_t(w * h / 100));
@@ -610,4 +617,4 @@ TEST_F(GlTest, GlobalStoreStreamsAcrossTheSeamInPlanetaryMode) {
 }
 
 }  // namespace
-}  // namespace strata::render::terrain
+}  // namespace strata::render

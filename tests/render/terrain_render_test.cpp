@@ -5,23 +5,32 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <numeric>
 
 #include <strata/gis/dem_io.hpp>
 #include <strata/render/image_io.hpp>
-#include <strata/render/terrain/screen_error.hpp>
-#include <strata/render/terrain/sliding_grid.hpp>
-#include <strata/render/terrain/synthetic_dem.hpp>
-#include <strata/render/terrain/terrain_renderer.hpp>
+#include <strata/render/screen_error.hpp>
+#include <strata/render/shader_slots.hpp>
+#include <strata/render/sliding_grid.hpp>
+#include <strata/render/synthetic_dem.hpp>
+#include <strata/render/terrain_renderer.hpp>
 
 #include "gl_fixture.hpp"
 #include "strata_test.hpp"
 #include "terrain_fixture.hpp"
 
-namespace strata::render::terrain {
+namespace strata::render {
 namespace {
 
 using test::GlTest;
+
+TEST_F(GlTest, ShadersUseTheSlotsDeclaredInCpp) {
+  test::expectProgramsMatchSlots("render/shaders/", slots::kAll,
+                                 {{{"render/shaders/ring.vert", "render/shaders/terrain.frag"}},
+                                  {{"render/shaders/grid.vert", "render/shaders/terrain.frag"}},
+                                  {{"render/shaders/sliding.vert", "render/shaders/terrain.frag"}}});
+}
 
 Image8 colourImage(const OffscreenTarget& t) { return {t.width(), t.height(), 4, t.colour()}; }
 
@@ -115,11 +124,10 @@ TEST_F(GlTest, GrandCanyonMatchesGoldenImage) {
   shading.fogM = 150000;
   ASSERT_TRUE((*ring)->draw(*scene, kCanyonCamera, shading, *target));
   // Same driver: bit-identical. Another GPU/driver: rasterization and transcendental precision
-  // move silhouette pixels and shift shading slightly; 24/255 per channel is what a one-pixel
-  // silhouette shift between two similar terrain tones stays under, and 2% of the pixels is
-  // about two rows' worth of ridge lines.
-  const auto r =
-      test::compareWithGolden("grand_canyon_oblique", colourImage(*target), 24, 0.02, test::outputDir("render"));
+  // move silhouette pixels by one and shift shading slightly. The comparison allows one pixel of
+  // displacement and then no pixel more than 24/255 off, and a mean difference of 3/255: a
+  // crack, a hole or a brightness shift fails (tests/render/golden_compare_test.cpp).
+  const auto r = test::compareWithGolden("grand_canyon_oblique", colourImage(*target), {}, test::outputDir("render"));
   EXPECT_TRUE(r.ok) << r.message;
 }
 
@@ -239,12 +247,14 @@ TEST_F(GlTest, UndulationWithAndWithoutMultiSamplingAndMip) {
            << "\n";
     meanOf[mode] = mean(changes);
   }
-  // Measured on llvmpipe: 5.3 m without either, 2.3 m multi-sampling only, 0.97 m MIP only,
-  // 0.79 m with both (6.8x less). Asserted: both bring it under a quarter (a 1.7x margin), and
-  // each alone helps.
-  EXPECT_LT(meanOf[3], 0.25 * meanOf[0]);
-  EXPECT_LT(meanOf[3], meanOf[1]);
-  EXPECT_LT(meanOf[3], meanOf[2]);
+  // Measured on llvmpipe: 4.8 m without either, 2.1 m multi-sampling only, 0.93 m MIP only,
+  // 1.8 m with both. Both together filter each vertex's cell once, as a box (issue 17); MIP
+  // selection alone reads one sample at the level of the whole cell, a tent twice as wide:
+  // steadier, but farther from the full grid (before issue 17 both together filtered the cell
+  // twice: 0.75 m here, and twice today's error against the full grid at 40-80 km,
+  // docs/render-rings.md). Asserted: both bring the undulation under half of neither's (a 1.3x
+  // margin), and each alone helps.
+  EXPECT_LT(meanOf[3], 0.5 * meanOf[0]);
   EXPECT_LT(meanOf[1], meanOf[0]);
   EXPECT_LT(meanOf[2], meanOf[0]);
 }
@@ -290,8 +300,8 @@ TEST_P(PlanetGolden, FromOrbitMatchesGoldenImage) {
   EXPECT_GT(double(covered) / double(192 * 192), 0.3);
   EXPECT_LT(double(covered) / double(192 * 192), 0.79);
   // Tolerances as for the Grand Canyon (silhouette and shading shifts across drivers).
-  const auto r = test::compareWithGolden(std::string(v.name) + "_orbit", colourImage(*target), 24, 0.02,
-                                         test::outputDir("render"));
+  const auto r =
+      test::compareWithGolden(std::string(v.name) + "_orbit", colourImage(*target), {}, test::outputDir("render"));
   EXPECT_TRUE(r.ok) << r.message;
 }
 
@@ -356,6 +366,47 @@ TEST_F(GlTest, CliRendersTheMoonsProjectedDemInPlanetaryMode) {
   }
 }
 
+// The poles (issue 17 item 4): from 75 degrees of latitude looking at the pole, the Earth's north,
+// the Moon's south and Mars's north. Before, the MIP level was chosen by a texel's north-south
+// size while the columns converge at a pole (speckle radiating from it), the normals differenced
+// one column apart (a sliver of ground there: a starburst), and beyond the pole the latitude
+// formula divided 0 by 0 along the meridian opposite the viewer (a spike from the pole to the
+// horizon). The goldens would see each again (a crack or a spike has no match within a pixel).
+class PoleGolden : public GlTest, public ::testing::WithParamInterface<PlanetView> {};
+
+TEST_P(PoleGolden, MatchesGoldenImage) {
+  const PlanetView& v = GetParam();
+  auto dem = gis::readDemLonLat(test::dataPath(v.path));
+  ASSERT_TRUE(dem) << dem.message();
+  auto scene = TerrainScene::create(*dem, {.planetary = true});
+  ASSERT_TRUE(scene) << scene.message();
+  auto ring = RingRenderer::create({.circles = 128});
+  ASSERT_TRUE(ring) << ring.message();
+  auto target = OffscreenTarget::create(192, 120);
+  ASSERT_TRUE(target) << target.message();
+  Shading shading;
+  shading.sky = {0, 0, 0, 1};
+  shading.exaggeration = v.exaggeration;
+  shading.palette = v.palette;
+  ASSERT_TRUE((*ring)->draw(*scene, v.camera, shading, *target));
+  const auto r =
+      test::compareWithGolden(std::string(v.name) + "_pole", colourImage(*target), {}, test::outputDir("render"));
+  EXPECT_TRUE(r.ok) << r.message;
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Bodies, PoleGolden,
+    ::testing::Values(PlanetView{"earth_north", "earth/etopo20.tif", gis::Body::wgs84(),
+                                 CameraPose{.lon = 0, .lat = 75, .heightM = 1.5e6, .headingDeg = 0, .pitchDeg = -50},
+                                 20.0f, Palette::Hypsometric, false},
+                      PlanetView{"moon_south", "moon/LDEM_4.LBL", gis::Body::moon(),
+                                 CameraPose{.lon = 0, .lat = -75, .heightM = 4e5, .headingDeg = 180, .pitchDeg = -50},
+                                 5.0f, Palette::Grey, false},
+                      PlanetView{"mars_north", "mars/mola_megdr_4ppd.vrt", gis::Body::mars(),
+                                 CameraPose{.lon = 0, .lat = 75, .heightM = 8e5, .headingDeg = 0, .pitchDeg = -50},
+                                 10.0f, Palette::Rust, false}),
+    [](const ::testing::TestParamInfo<PlanetView>& i) { return std::string(i.param.name); });
+
 class NoJitter : public GlTest, public ::testing::WithParamInterface<double> {};
 
 TEST_P(NoJitter, TenThousandKilometresFromTheCentre) {
@@ -373,7 +424,9 @@ TEST_P(NoJitter, TenThousandKilometresFromTheCentre) {
   dem.georef.transform.c[5] = -1e-5;
   auto scene = TerrainScene::create(dem, {.planetary = true});
   ASSERT_TRUE(scene) << scene.message();
-  auto ring = RingRenderer::create({.circles = 64});
+  // The view range is the patch (448 m): the default, the horizon over a whole body, would lay
+  // the 64 circles for distant relief this body does not have.
+  auto ring = RingRenderer::create({.circles = 64, .rangeM = 600});
   ASSERT_TRUE(ring) << ring.message();
   const int w = 128, h = 96;
   auto target = OffscreenTarget::create(w, h);
@@ -419,6 +472,73 @@ TEST_P(NoJitter, TenThousandKilometresFromTheCentre) {
 
 // A sphere, and an ellipsoid with the Earth's flattening.
 INSTANTIATE_TEST_SUITE_P(Bodies, NoJitter, ::testing::Values(0.0, 1 / 298.257223563));
+
+TEST_F(GlTest, WholePlanetDemMovesSmoothlyAtTwentyCentimetresAFrame) {
+  // The whole Earth (ETOPO 20', 1080 x 540 texels of 37 km), planetary, the viewer 50 m above the
+  // Alps moving east 0.2 m a frame. A float texture coordinate over a whole-planet texture
+  // resolves 2^-24 of its width, 2.4 m here, and the hardware's bilinear weights are coarser
+  // still: the rendered elevation froze for several frames and then jumped. Texel offsets from
+  // the viewer (terrain_common.glsl, "Camera-relative") are small numbers, and the bilinear
+  // weights are computed from them: every step changes the image by the same amount.
+  auto dem = gis::readDemLonLat(test::dataPath("earth/etopo20.tif"));
+  ASSERT_TRUE(dem) << dem.message();
+  auto scene = TerrainScene::create(*dem, {.planetary = true});
+  ASSERT_TRUE(scene) << scene.message();
+  auto ring = RingRenderer::create({.circles = 64});
+  ASSERT_TRUE(ring) << ring.message();
+  const int w = 128, h = 96;
+  auto target = OffscreenTarget::create(w, h);
+  ASSERT_TRUE(target) << target.message();
+  const Shading shading;
+  const double lat = 46.2, radius = scene->radiusM();
+  const double degPerM = 180.0 / (kPi * radius * std::cos(lat * kPi / 180));
+  const double ground = scene->heightAt(8.0, lat);
+  std::vector<float> previous;
+  std::vector<double> steps, centre;
+  for (int frame = 0; frame < 10; ++frame) {
+    const CameraPose cam{
+        .lon = 8.0 + frame * 0.2 * degPerM, .lat = lat, .heightM = ground + 50, .headingDeg = 90, .pitchDeg = -35};
+    ASSERT_TRUE((*ring)->draw(*scene, cam, shading, *target));
+    auto elev = target->elevation();
+    const size_t mid = size_t(h / 2) * size_t(w) + size_t(w / 2);
+    if (!previous.empty()) {
+      double sum = 0;
+      size_t n = 0;
+      for (size_t i = 0; i < elev.size(); ++i) {
+        if (std::isfinite(elev[i]) && std::isfinite(previous[i])) {
+          sum += std::abs(elev[i] - previous[i]);
+          ++n;
+        }
+      }
+      ASSERT_GT(n, size_t(w * h / 2));
+      steps.push_back(sum / double(n));
+      centre.push_back(double(elev[mid]) - double(previous[mid]));
+    }
+    previous = std::move(elev);
+  }
+  std::ofstream report(test::outputDir("render") / "jitter_whole_planet.txt");
+  report << "# ETOPO20 planetary, viewer 50 m above the Alps moving east 0.2 m a frame, 64 circles, " << w << "x" << h
+         << "\n# mean |change| of rendered elevation (m), change at the centre pixel (m)\n";
+  for (size_t k = 0; k < steps.size(); ++k) report << steps[k] << " " << centre[k] << "\n";
+  const double median = percentile(steps, 0.5);
+  EXPECT_GT(median, 0.0);
+  // Smooth: every equal step changes the image by the same amount within a factor 1.5 (a frozen
+  // step is 0, a jump several times the median).
+  for (double s : steps) {
+    EXPECT_GT(s, median / 1.5);
+    EXPECT_LT(s, median * 1.5);
+  }
+  // Monotone: the ground seen at the centre moves the same way every step, by the same amount
+  // within a factor 1.5 (37 km texels: the surface is a plane over a few metres).
+  std::vector<double> mags;
+  for (double c : centre) mags.push_back(std::abs(c));
+  const double cm = percentile(mags, 0.5);
+  for (double c : centre) {
+    EXPECT_EQ(c > 0, centre[0] > 0);
+    EXPECT_GT(std::abs(c), cm / 1.5);
+    EXPECT_LT(std::abs(c), cm * 1.5);
+  }
+}
 
 TEST_F(GlTest, WaterAndMaterialLayersShowWhereTheyAre) {
   // A gentle 128^2 terrain seen from straight above: 5 m of water over the western half, 3 m of
@@ -469,6 +589,9 @@ TEST_F(GlTest, RainierRidgeCloseViewMatchesGoldenImage) {
   // south-west of the summit, looking at it. Ground-level views need a larger softening floor
   // than the default 50 m: with H = 50 m the circles 8 km out are ~8 km apart (spacing grows as
   // r^2 / H) and the 4,392 m summit is averaged away. The error report shows the effect.
+  // The SRTM voids are filled (gis::fillVoids): until issue 17 they were drawn at the DEM's
+  // lowest elevation, 263 m, and the golden had the pits baked in (a dark shaft wall on the left,
+  // a summit cut into facets); it was redrawn then.
   auto dem = gis::readDemLonLat(test::dataPath("rainier/mt_rainier_90m.tif"));
   ASSERT_TRUE(dem) << dem.message();
   auto scene = TerrainScene::create(*dem);
@@ -495,8 +618,289 @@ TEST_F(GlTest, RainierRidgeCloseViewMatchesGoldenImage) {
   // The 1000 m floor halves the error at least (measured in docs/render-rings.md).
   EXPECT_LT(meanBy[2], 0.5 * meanBy[0]);
   // The golden image with the 1000 m floor (the last render); tolerances as for the canyon.
-  const auto r = test::compareWithGolden("rainier_ridge", colourImage(*target), 24, 0.02, test::outputDir("render"));
+  const auto r = test::compareWithGolden("rainier_ridge", colourImage(*target), {}, test::outputDir("render"));
   EXPECT_TRUE(r.ok) << r.message;
+}
+
+// Rendered elevation against the full grid by distance from the viewer (docs/render-rings.md,
+// "Low-altitude views of distant relief"): 2 m, 50 m and 2 km above Rainier's summit looking at
+// Mount Adams 75 km away; the same heights over the Colorado's floor in the Grand Canyon,
+// looking up the canyon. Per renderer: the full grid (the metric's floor), the sliding grid, the
+// ring with its default softening and with the old fixed floor of 50 m.
+struct DistantView {
+  const char* site;
+  double lon, lat, agl, heading, pitch;
+};
+
+TEST_F(GlTest, DistantReliefStaysWithinItsErrorBound) {
+  auto rainierDem = gis::readDemLonLat(test::dataPath("rainier/mt_rainier_90m.tif"));
+  ASSERT_TRUE(rainierDem) << rainierDem.message();
+  auto rainier = TerrainScene::create(*rainierDem);
+  ASSERT_TRUE(rainier) << rainier.message();
+  auto canyon = grandCanyon();
+  ASSERT_TRUE(canyon) << canyon.message();
+  const int w = 320, h = 200;
+  auto target = OffscreenTarget::create(w, h);
+  ASSERT_TRUE(target) << target.message();
+  const Shading shading;
+  const std::vector<std::pair<double, double>> bands{{500, 1500}, {5000, 15000}, {40000, 80000}};
+  const DistantView views[] = {
+      {"rainier", -121.7608, 46.8525, 2, 164, -8},    {"rainier", -121.7608, 46.8525, 50, 164, -4},
+      {"rainier", -121.7608, 46.8525, 2000, 164, -8}, {"canyon", -112.414, 36.248, 2, 100, 2},
+      {"canyon", -112.414, 36.248, 50, 100, -2},      {"canyon", -112.414, 36.248, 2000, 100, -8}};
+  auto grid = GridRenderer::create();
+  auto sliding = SlidingGridRenderer::create({.halfCells = 64, .levels = 5});
+  auto ring = RingRenderer::create({.circles = 256});
+  auto ringOldFloor = RingRenderer::create({.circles = 256, .softMinM = 50});
+  ASSERT_TRUE(grid && sliding && ring && ringOldFloor);
+  std::ofstream report(test::outputDir("render") / "distant_relief.txt");
+  report << "# |rendered elevation - full grid| (m) by horizontal distance from the viewer, " << w << "x" << h
+         << "\n# site agl renderer | 0.5-1.5 km: pixels mean p95 | 5-15 km: ... | 40-80 km: ... | screen mean_px "
+            "p99_px\n";
+  std::vector<ElevationError> ringAt50, oldAt50;
+  CameraPose rainierAt50;
+  for (const auto& v : views) {
+    const bool isRainier = std::string(v.site) == "rainier";
+    TerrainScene& scene = isRainier ? *rainier : *canyon;
+    // The centre of the highest (Rainier) or lowest (canyon floor) cell within 5 cells, where
+    // the bilinear height the camera stands on and the grid's surface agree.
+    const auto& c = scene.georef().transform.c;
+    const int i0 = int((v.lon - c[0]) / c[1]), j0 = int((v.lat - c[3]) / c[5]);
+    CameraPose cam{.headingDeg = v.heading, .pitchDeg = v.pitch};
+    float best = isRainier ? -1e9f : 1e9f;
+    for (int j = j0 - 5; j <= j0 + 5; ++j) {
+      for (int i = i0 - 5; i <= i0 + 5; ++i) {
+        const float e = scene.heights().at(i, j);
+        if (isRainier ? e > best : e < best) {
+          best = e;
+          cam.lon = c[0] + (i + 0.5) * c[1];
+          cam.lat = c[3] + (j + 0.5) * c[5];
+        }
+      }
+    }
+    cam.heightM = scene.heightAt(cam.lon, cam.lat) + v.agl;
+    auto row = [&](const std::string& label, TerrainRenderer& r) {
+      EXPECT_TRUE(r.draw(scene, cam, shading, *target));
+      const auto e = elevationErrorByDistance(scene, cam, shading, *target, bands);
+      const auto px = screenSpaceError(scene, cam, shading, *target);
+      report << v.site << " " << v.agl << " " << label;
+      for (const auto& b : e) report << " | " << b.pixels << " " << b.meanM << " " << b.p95M;
+      report << " | " << px.meanPx << " " << px.p99Px << "\n";
+      return e;
+    };
+    // The metric's floor: the grid against itself (bands of a few silhouette pixels aside), at
+    // one height per site (its 2.9 million triangles are the slow part of this test).
+    if (v.agl == 50) {
+      for (const auto& b : row("grid", **grid)) {
+        if (b.pixels >= 200) {
+          EXPECT_LT(b.p95M, 0.02) << v.site << " " << v.agl << " m, " << b.fromM << " m";
+        }
+      }
+    }
+    row("sliding-64x5", **sliding);
+    const auto e = row("ring-256", **ring);
+    if (isRainier && v.agl == 50) {
+      // The golden of low-altitude distant relief: Mount Adams on the horizon, 75 km away.
+      const auto r =
+          test::compareWithGolden("rainier_distant_relief", colourImage(*target), {}, test::outputDir("render"));
+      EXPECT_TRUE(r.ok) << r.message;
+    }
+    const auto old = row("ring-256-floor-50m", **ringOldFloor);
+    if (isRainier && v.agl == 50) {
+      rainierAt50 = cam;
+      ringAt50 = e;
+      oldAt50 = old;
+    }
+  }
+  // 50 m above Rainier's summit: Mount Adams and the relief between stay (measured on llvmpipe:
+  // 1.1, 5.3 and 52 m mean at 1, 10 and 40-80 km, against 0.6, 120 and 299 m with the old floor
+  // of 50 m); bounds with a 50% margin.
+  ASSERT_EQ(ringAt50.size(), 3u);
+  for (const auto& b : ringAt50) EXPECT_GT(b.pixels, size_t(1000));
+  EXPECT_LT(ringAt50[0].meanM, 2.0);
+  EXPECT_LT(ringAt50[1].meanM, 8.0);
+  EXPECT_LT(ringAt50[2].meanM, 80.0);
+  EXPECT_LT(ringAt50[2].p95M, 225.0);
+  EXPECT_LT(ringAt50[2].meanM, 0.3 * oldAt50[2].meanM);
+  EXPECT_LT(ringAt50[1].meanM, 0.1 * oldAt50[1].meanM);
+
+  // The floor's default (a twelfth of the view range): the same view with others.
+  const auto layout = (*ring)->layout(*rainier, frameGeometry(*rainier, rainierAt50, shading, w, h));
+  report << "# rainier 50 m: range " << layout.rangeM << " m, default floor " << layout.softHeightM
+         << " m; the softening floor: softMinM | bands as above | screen\n";
+  // (50 m and the default are the ring rows above.)
+  for (const double floor : {2000.0, 4000.0, 16000.0}) {
+    auto r = RingRenderer::create({.circles = 256, .softMinM = floor});
+    ASSERT_TRUE(r);
+    const CameraPose cam = rainierAt50;
+    EXPECT_TRUE((*r)->draw(*rainier, cam, shading, *target));
+    const auto e = elevationErrorByDistance(*rainier, cam, shading, *target, bands);
+    const auto px = screenSpaceError(*rainier, cam, shading, *target);
+    report << "floor " << floor;
+    for (const auto& b : e) report << " | " << b.pixels << " " << b.meanM << " " << b.p95M;
+    report << " | " << px.meanPx << " " << px.p99Px << "\n";
+  }
+}
+
+// Voids (issue 17 item 3): Rainier's 9,033 SRTM no-data cells lie on the summit cone. Filled,
+// no pixel over a void may be drawn below the lowest valid cell around that void (a pit); as
+// holes, no pixel may show ground inside a void. Both renderers; the old fill (the DEM's lowest
+// elevation, 263 m) is run through the same check to show that it finds the pits.
+struct VoidRegions {
+  gis::Grid<int> region;       // void region of each cell (8-connected), -1 where there is data
+  std::vector<float> rimLowM;  // per region: the lowest valid cell touching it
+};
+
+VoidRegions voidRegions(const gis::Grid<float>& raw) {
+  VoidRegions v{gis::Grid<int>(raw.width, raw.height, -1), {}};
+  std::vector<std::pair<int, int>> stack;
+  for (int y0 = 0; y0 < raw.height; ++y0) {
+    for (int x0 = 0; x0 < raw.width; ++x0) {
+      if (!gis::isNoData(raw.at(x0, y0)) || v.region.at(x0, y0) >= 0) continue;
+      const int id = int(v.rimLowM.size());
+      float rim = std::numeric_limits<float>::infinity();
+      v.region.at(x0, y0) = id;
+      stack.assign(1, {x0, y0});
+      while (!stack.empty()) {
+        const auto [x, y] = stack.back();
+        stack.pop_back();
+        for (int dy = -1; dy <= 1; ++dy) {
+          for (int dx = -1; dx <= 1; ++dx) {
+            if (!raw.contains(x + dx, y + dy)) continue;
+            const float e = raw.at(x + dx, y + dy);
+            if (!gis::isNoData(e)) {
+              rim = std::min(rim, e);
+            } else if (v.region.at(x + dx, y + dy) < 0) {
+              v.region.at(x + dx, y + dy) = id;
+              stack.push_back({x + dx, y + dy});
+            }
+          }
+        }
+      }
+      v.rimLowM.push_back(rim);
+    }
+  }
+  return v;
+}
+
+struct VoidCheck {
+  size_t overVoid = 0;  // terrain pixels whose ground point lies in a void cell
+  size_t pits = 0;      // of those, drawn more than the tolerance below the void's rim
+  size_t inHoles = 0;   // terrain pixels whose ground point is well inside a hole (mask < 0.35)
+  double worstBelowRimM = 0;
+};
+
+VoidCheck checkVoids(const TerrainScene& scene, const gis::Grid<float>& raw, const VoidRegions& v,
+                     const CameraPose& cam, const Shading& shading, const OffscreenTarget& t, double tolM) {
+  VoidCheck c;
+  const int w = t.width(), h = t.height();
+  const auto f = frameGeometry(scene, cam, shading, w, h);
+  const auto depth = t.depth();
+  const auto elevation = t.elevation();
+  auto valid = [&](int x, int y) {
+    x = std::clamp(x, 0, raw.width - 1), y = std::clamp(y, 0, raw.height - 1);
+    return gis::isNoData(raw.at(x, y)) ? 0.0 : 1.0;
+  };
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const size_t i = size_t(y) * size_t(w) + size_t(x);
+      if (depth[i] <= 0 || !std::isfinite(elevation[i])) continue;
+      const glm::dvec3 p = unprojectPixel(f, cam, x, y, w, h, depth[i]);
+      const glm::dvec2 uv = f.uvCam + glm::dvec2(p) * f.uvPerMetre;
+      const double gx = uv.x * raw.width - 0.5, gy = uv.y * raw.height - 0.5;
+      const int cx = int(std::lround(gx)), cy = int(std::lround(gy));
+      if (!raw.contains(cx, cy)) continue;
+      // The bilinear void mask, as terrain.frag samples it.
+      const int x0 = int(std::floor(gx)), y0 = int(std::floor(gy));
+      const double fx = gx - x0, fy = gy - y0;
+      const double mask = (1 - fy) * ((1 - fx) * valid(x0, y0) + fx * valid(x0 + 1, y0)) +
+                          fy * ((1 - fx) * valid(x0, y0 + 1) + fx * valid(x0 + 1, y0 + 1));
+      c.inHoles += mask < 0.35;
+      const int id = v.region.at(cx, cy);
+      if (id < 0) continue;
+      ++c.overVoid;
+      const double below = v.rimLowM[size_t(id)] - elevation[i];
+      c.worstBelowRimM = std::max(c.worstBelowRimM, below);
+      c.pits += below > tolM;
+    }
+  }
+  return c;
+}
+
+TEST_F(GlTest, VoidsAreFilledOrLeftAsHolesNeverDrawnAsPits) {
+  auto dem = gis::readDemLonLat(test::dataPath("rainier/mt_rainier_90m.tif"));
+  ASSERT_TRUE(dem) << dem.message();
+  const auto regions = voidRegions(dem->values);
+  // The old fill: every void at the DEM's lowest elevation, as valid data.
+  gis::Raster oldFill = *dem;
+  float lowest = std::numeric_limits<float>::infinity();
+  for (float e : dem->values.data) {
+    if (!gis::isNoData(e)) lowest = std::min(lowest, e);
+  }
+  for (float& e : oldFill.values.data) {
+    if (gis::isNoData(e)) e = lowest;
+  }
+  auto filled = TerrainScene::create(*dem, {.voids = VoidMode::kFill});
+  auto holes = TerrainScene::create(*dem, {.voids = VoidMode::kHoles});
+  auto old = TerrainScene::create(oldFill);
+  ASSERT_TRUE(filled && holes && old);
+  EXPECT_EQ(filled->voidCount(), 9033u);
+  EXPECT_EQ(holes->voidCount(), 9033u);
+  EXPECT_EQ(old->voidCount(), 0u);
+  const int w = 192, h = 120;
+  auto target = OffscreenTarget::create(w, h);
+  ASSERT_TRUE(target) << target.message();
+  // 7 km south-west of the summit and 2 km above it, looking down at the cone.
+  const CameraPose cam{.lon = -121.83, .lat = 46.81, .heightM = 6400, .headingDeg = 48, .pitchDeg = -22};
+  Shading shading;
+  auto grid = GridRenderer::create();
+  auto ring = RingRenderer::create({.circles = 192});
+  ASSERT_TRUE(grid && ring);
+  std::ofstream report(test::outputDir("render") / "voids.txt");
+  report << "# Rainier's voids from 2 km above the summit, " << w << "x" << h
+         << "\n# renderer mode pixels_over_voids pits worst_below_rim_m pixels_inside_holes\n";
+  // Tolerances below the void's rim: the grid interpolates filled and rim cells bilinearly, all
+  // at or above the rim's lowest (1 cm for float); the ring's vertices average a footprint that
+  // reaches lower ground on the cone's flanks (measured up to 50 m: 100 m). A pit of the old
+  // fill is hundreds to thousands of metres deep.
+  struct Case {
+    const char* name;
+    TerrainRenderer* renderer;
+    double tolM;
+  };
+  for (const Case& k : {Case{"grid", grid->get(), 0.01}, Case{"ring-192", ring->get(), 100.0}}) {
+    ASSERT_TRUE(k.renderer->draw(*old, cam, shading, *target));
+    const auto o = checkVoids(*old, dem->values, regions, cam, shading, *target, k.tolM);
+    ASSERT_TRUE(k.renderer->draw(*filled, cam, shading, *target));
+    const auto f = checkVoids(*filled, dem->values, regions, cam, shading, *target, k.tolM);
+    const auto filledColour = target->colour();
+    ASSERT_TRUE(writeImage8((test::outputDir("render") / ("voids_fill_" + std::string(k.name) + ".png")).string(), w, h,
+                            4, filledColour));
+    ASSERT_TRUE(k.renderer->draw(*holes, cam, shading, *target));
+    const auto hl = checkVoids(*holes, dem->values, regions, cam, shading, *target, k.tolM);
+    ASSERT_TRUE(writeImage8((test::outputDir("render") / ("voids_holes_" + std::string(k.name) + ".png")).string(), w,
+                            h, 4, target->colour()));
+    if (std::string(k.name) == "ring-192") {
+      // The golden of voids drawn as holes (the sky through the glaciers' streaks).
+      const auto r =
+          test::compareWithGolden("rainier_voids_holes", colourImage(*target), {}, test::outputDir("render"));
+      EXPECT_TRUE(r.ok) << r.message;
+    }
+    report << k.name << " old-fill " << o.overVoid << " " << o.pits << " " << o.worstBelowRimM << " " << o.inHoles
+           << "\n"
+           << k.name << " fill " << f.overVoid << " " << f.pits << " " << f.worstBelowRimM << " " << f.inHoles << "\n"
+           << k.name << " holes " << hl.overVoid << " " << hl.pits << " " << hl.worstBelowRimM << " " << hl.inHoles
+           << "\n";
+    // The view sees the voids, and the check finds the old fill's pits.
+    EXPECT_GT(f.overVoid, size_t(800)) << k.name;
+    EXPECT_GT(o.pits, size_t(100)) << k.name;
+    EXPECT_GT(o.worstBelowRimM, 1000.0) << k.name;
+    // Filled: no pit.
+    EXPECT_EQ(f.pits, 0u) << k.name << ": " << f.worstBelowRimM << " m below a void's rim";
+    // Holes: no ground drawn inside a void; what was drawn there (filled) is gone.
+    EXPECT_EQ(hl.inHoles, 0u) << k.name;
+    EXPECT_LT(hl.overVoid, f.overVoid / 10) << k.name;
+  }
 }
 
 TEST_F(GlTest, PlanetaryModeDrawsTheEllipsoid) {
@@ -538,4 +942,4 @@ TEST_F(GlTest, PlanetaryModeDrawsTheEllipsoid) {
 }
 
 }  // namespace
-}  // namespace strata::render::terrain
+}  // namespace strata::render

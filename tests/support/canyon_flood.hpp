@@ -8,15 +8,15 @@
 
 #include <strata/core/result.hpp>
 #include <strata/gis/dem_io.hpp>
+#include <strata/sim/input.hpp>
 #include <strata/terrain/material.hpp>
-#include <strata/terrain/sim/sim_params.hpp>
 
 namespace strata::test {
 
 struct CanyonFlood {
-  terrain::sim::SimInput input;
-  terrain::sim::SimParams params;
-  terrain::sim::Source spring;
+  sim::SimInput input;
+  sim::SimParams params;
+  sim::Source spring;
 };
 
 /// `n` x `n` cells of the DEM from pixel (x0, y0), per-row dx from the latitude (spherical
@@ -44,13 +44,13 @@ inline Result<CanyonFlood> canyonFlood(const std::string& demPath, int x0, int y
   in.materials = {terrain::defaultMaterials()[0]};
   in.layersM = {gis::Grid<float>(n, n, 0.0f)};
   auto& p = c.params;
-  p.waterModel = int32_t(terrain::sim::WaterModel::kFiniteVolume);
+  p.waterModel = sim::WaterModel::kFiniteVolume;
   p.cflAlpha = 0.45f;
   p.maxDtS = 30.0f;
   p.manningN = 0.04f;  // bedrock channel with boulders, as the scenario
-  p.openEdges = terrain::sim::kEdgeWest | terrain::sim::kEdgeEast | terrain::sim::kEdgeNorth | terrain::sim::kEdgeSouth;
+  p.openEdges = sim::kEdgeWest | sim::kEdgeEast | sim::kEdgeNorth | sim::kEdgeSouth;
   c.spring.cells = {{springX - x0, springY - y0}};
-  c.spring.hydrographM3S = {{0.0, springM3S}, {1e9, springM3S}};
+  c.spring.dischargeM3S = TimeSeries({{0.0, springM3S}, {1e9, springM3S}});
   return c;
 }
 

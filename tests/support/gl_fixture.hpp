@@ -5,7 +5,14 @@
 // reported as skipped, never as passed.
 #include <gtest/gtest.h>
 
-#include <strata/render/gl/context.hpp>
+#include <optional>
+#include <span>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <strata/gl/context.hpp>
+#include <strata/gl/objects.hpp>
 
 namespace strata::test {
 
@@ -14,10 +21,24 @@ class GlTest : public ::testing::Test {
   void SetUp() override;
   void TearDown() override;
   /// The process-wide headless context (created on first use).
-  static render::gl::HeadlessContext& context();
+  static gl::HeadlessContext& context();
 
  private:
   long errorsBefore_ = 0;
 };
+
+/// A program to check against a binding table: one compute shader or a vertex + fragment pair
+/// (names of embedded shaders), or already-preprocessed compute source.
+struct SlotProgram {
+  std::vector<std::string> shaders;                       ///< {comp} or {vert, frag}
+  std::optional<gl::ShaderSource> source = std::nullopt;  ///< instead of `shaders`: a compute source (e.g. spliced)
+};
+
+/// The binding-slot check of one library (docs/architecture.md, "The GL layer"): every program
+/// compiles with the table's #defines, every block, sampler and image it has is declared in the
+/// table with the binding the program got (gl::checkBindings), every table entry is used by some
+/// program, and every program file under `folder` (e.g. "render/shaders/") is in some program.
+void expectProgramsMatchSlots(const std::string& folder, std::span<const gl::Binding> slots,
+                              const std::vector<SlotProgram>& programs);
 
 }  // namespace strata::test

@@ -1,16 +1,17 @@
 #pragma once
 // Small simulation scenes shared by the CPU reference tests (tests/terrain) and the GPU tests
 // (tests/render): the same inputs go to both solvers.
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
+#include <strata/sim/input.hpp>
 #include <strata/terrain/material.hpp>
-#include <strata/terrain/sim/sim_params.hpp>
 
 namespace strata::test {
 
 /// Four layers (rock, soil, sand, sediment) of the given thicknesses everywhere.
-inline void fourLayers(terrain::sim::SimInput& in, float rock, float soil, float sand, float sediment) {
+inline void fourLayers(sim::SimInput& in, float rock, float soil, float sand, float sediment) {
   const int w = in.baseM.width, h = in.baseM.height;
   in.materials = terrain::defaultMaterials();
   in.layersM = {gis::Grid<float>(w, h, rock), gis::Grid<float>(w, h, soil), gis::Grid<float>(w, h, sand),
@@ -19,8 +20,8 @@ inline void fourLayers(terrain::sim::SimInput& in, float rock, float soil, float
 
 /// A lake at rest at `datumM + 3 m` over a bumpy bed (datum + 0..5 m) with islands above the
 /// surface; 10 m cells. Depth is surface - bed where positive.
-inline terrain::sim::SimInput lakeAtRest(int n, double datumM) {
-  terrain::sim::SimInput in;
+inline sim::SimInput lakeAtRest(int n, double datumM) {
+  sim::SimInput in;
   in.baseM = gis::Grid<float>(n, n);
   in.waterDepthM = gis::Grid<float>(n, n);
   in.rowDxM = {10.0};
@@ -53,8 +54,8 @@ inline terrain::sim::SimInput lakeAtRest(int n, double datumM) {
 /// cross-slope ripple (gullies), datum 1500 m, no water; open to the east. Feed it with
 /// `steepSlopeSpring()`: a strong spring on the dry crest, the case where a long step used to
 /// break the water balance.
-inline terrain::sim::SimInput steepDrySlope() {
-  terrain::sim::SimInput in;
+inline sim::SimInput steepDrySlope() {
+  sim::SimInput in;
   const int w = 48, h = 16;
   in.baseM = gis::Grid<float>(w, h);
   in.rowDxM = {20.0};
@@ -68,10 +69,10 @@ inline terrain::sim::SimInput steepDrySlope() {
 }
 
 /// 200 m^3/s over two crest cells of `steepDrySlope()`, rising from 0 in 60 s, for 20 minutes.
-inline terrain::sim::Source steepSlopeSpring() {
-  terrain::sim::Source s;
+inline sim::Source steepSlopeSpring() {
+  sim::Source s;
   s.cells = {{1, 7}, {1, 8}};
-  s.hydrographM3S = {{0.0, 0.0}, {60.0, 200.0}, {1200.0, 200.0}};
+  s.dischargeM3S = TimeSeries({{0.0, 0.0}, {60.0, 200.0}, {1200.0, 200.0}});
   return s;
 }
 
@@ -79,8 +80,8 @@ inline terrain::sim::Source steepSlopeSpring() {
 /// corners; 10 m cells) and a fixed level on five cells in the middle of its west edge whose stage
 /// rises from 1 m to `stageM` above the datum over the first 600 s, then holds.
 struct LevelBasin {
-  terrain::sim::SimInput input;
-  terrain::sim::LevelBoundary level;
+  sim::SimInput input;
+  sim::LevelBoundary level;
 };
 inline LevelBasin levelBasin(int n, double stageM) {
   LevelBasin b;
@@ -97,13 +98,13 @@ inline LevelBasin levelBasin(int n, double stageM) {
     }
   }
   for (int y = n / 2 - 2; y <= n / 2 + 2; ++y) b.level.cells.push_back({0, y});
-  b.level.stageM = {{0.0, in.datumM + 1.0}, {600.0, in.datumM + stageM}};
+  b.level.stageM = TimeSeries({{0.0, in.datumM + 1.0}, {600.0, in.datumM + stageM}});
   return b;
 }
 
 /// A flat-bottomed closed box with a bumpy surface of water (a sloshing basin), 5 m cells.
-inline terrain::sim::SimInput sloshingBox(int n) {
-  terrain::sim::SimInput in;
+inline sim::SimInput sloshingBox(int n) {
+  sim::SimInput in;
   in.baseM = gis::Grid<float>(n, n);
   in.waterDepthM = gis::Grid<float>(n, n);
   in.rowDxM = {5.0};
@@ -127,8 +128,8 @@ namespace strata::test {
 
 /// A valley draining north to south with four layers (rock, soil, sand, sediment), rain and
 /// a spring at its head: water keeps flowing, so erosion, transport and deposition stay busy.
-inline terrain::sim::SimInput erodingValley(int n) {
-  terrain::sim::SimInput in;
+inline sim::SimInput erodingValley(int n) {
+  sim::SimInput in;
   in.baseM = gis::Grid<float>(n, n);
   in.rowDxM = {4.0};
   in.dyM = 4.0;
@@ -152,26 +153,26 @@ inline terrain::sim::SimInput erodingValley(int n) {
 
 /// Erosion parameters for erodingValley (pipes, erosion and thermal weathering on).
 /// Virtual pipes with a fixed 0.1 s step and 25 m^2 pipes (the water tests' default).
-inline terrain::sim::SimParams pipeParams() {
-  terrain::sim::SimParams p;
-  p.waterModel = int32_t(terrain::sim::WaterModel::kVirtualPipes);
+inline sim::SimParams pipeParams() {
+  sim::SimParams p;
+  p.waterModel = sim::WaterModel::kVirtualPipes;
   p.maxDtS = 0.1f;
   p.pipeAreaM2 = 25.0f;
   return p;
 }
 
 /// Flood mode with the CFL step (alpha 0.45) capped at 10 s.
-inline terrain::sim::SimParams floodParams() {
-  terrain::sim::SimParams p;
-  p.waterModel = int32_t(terrain::sim::WaterModel::kFiniteVolume);
+inline sim::SimParams floodParams() {
+  sim::SimParams p;
+  p.waterModel = sim::WaterModel::kFiniteVolume;
   p.maxDtS = 10.0f;
   p.cflAlpha = 0.45f;
   return p;
 }
 
-inline terrain::sim::SimParams erosionParams() {
-  terrain::sim::SimParams p;
-  p.waterModel = int32_t(terrain::sim::WaterModel::kVirtualPipes);
+inline sim::SimParams erosionParams() {
+  sim::SimParams p;
+  p.waterModel = sim::WaterModel::kVirtualPipes;
   p.maxDtS = 0.05f;
   p.pipeAreaM2 = 16.0f;
   p.rainMmPerHour = 50.0f;
@@ -187,11 +188,76 @@ inline terrain::sim::SimParams erosionParams() {
 }
 
 /// A spring at the valley head feeding erodingValley.
-inline terrain::sim::Source valleySpring(int n) {
-  terrain::sim::Source s;
+inline sim::Source valleySpring(int n) {
+  sim::Source s;
   for (int x = n / 2 - 2; x <= n / 2 + 2; ++x) s.cells.push_back({x, 1});
-  s.hydrographM3S = {{0.0, 2.0}, {200.0, 5.0}, {1000.0, 5.0}};
+  s.dischargeM3S = TimeSeries({{0.0, 2.0}, {200.0, 5.0}, {1000.0, 5.0}});
   return s;
+}
+
+}  // namespace strata::test
+
+namespace strata::test {
+
+/// A straight channel running south between two banks, 2 m cells: the channel (columns
+/// w/2 - 2 .. w/2 + 1) falls 0.04 m a cell; the banks rise 0.9 m a cell away from it (a slope of
+/// 0.45, 24 degrees: below the dry talus of sand, 0.62, above its undercut-bank angle, 0.31).
+/// Rock `rockM` thick under `sandM` of sand everywhere; no water. Datum 1200 m.
+inline sim::SimInput bankedChannel(int w, int h, float rockM, float sandM) {
+  sim::SimInput in;
+  in.baseM = gis::Grid<float>(w, h);
+  in.rowDxM = {2.0};
+  in.dyM = 2.0;
+  in.datumM = 1200.0;
+  fourLayers(in, rockM, 0.0f, sandM, 0.0f);
+  const int c0 = w / 2 - 2, c1 = w / 2 + 1;
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const int away = std::max({0, c0 - x, x - c1});
+      in.baseM.at(x, y) = float(1200.0 + 0.04 * (h - y) + 0.9 * away);
+    }
+  }
+  return in;
+}
+
+/// 4 m^3/s over the channel cells of bankedChannel's second row, from the start.
+inline sim::Source channelSpring(int w) {
+  sim::Source s;
+  for (int x = w / 2 - 2; x <= w / 2 + 1; ++x) s.cells.push_back({x, 1});
+  s.dischargeM3S = TimeSeries({{0.0, 4.0}, {1e6, 4.0}});
+  return s;
+}
+
+/// Flood mode with friction (Manning 0.035; the frictionless pipes run a spring's sheet down a
+/// slope at tens of m/s), CFL 0.45, steps of at most 0.5 s; thermal weathering and bank slippage
+/// on, erosion off; closed edges, no rain.
+inline sim::SimParams bankParams() {
+  sim::SimParams p;
+  p.waterModel = sim::WaterModel::kFiniteVolume;
+  p.cflAlpha = 0.45f;
+  p.maxDtS = 0.5f;
+  p.manningN = 0.035f;
+  p.dryDepthM = 1e-3f;
+  p.thermalEnabled = true;
+  p.slowWaterMS = 0.05f;
+  p.bankSlipRatePerS = 0.1f;
+  return p;
+}
+
+/// bankParams with everything on: rain (50 mm/h), erosion, deposition and dissolution, thermal
+/// weathering and bank slippage, an open south edge, and the scenarios' dry depth (1e-6 m: rain
+/// films carry tiny loads everywhere). Feed bankedChannel with channelSpring.
+inline sim::SimParams everythingOnParams() {
+  sim::SimParams p = bankParams();
+  p.erosionEnabled = true;
+  p.rainMmPerHour = 50.0f;
+  p.capacityK = 0.05f;
+  p.erosionRate = 0.5f;
+  p.depositionRate = 0.3f;
+  p.deepWaterM = 2.0f;
+  p.dryDepthM = 1e-6f;
+  p.openEdges = sim::kEdgeSouth;
+  return p;
 }
 
 }  // namespace strata::test

@@ -1,12 +1,20 @@
 // The store's command-line verbs, run as the real `strata` binary.
 #include <gtest/gtest.h>
 
+#include <fcntl.h>
+#include <signal.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
+#include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <map>
+#include <thread>
 
+#include <strata/core/interrupt.hpp>
 #include <strata/gis/dem_io.hpp>
 #include <strata/terrain/dem_sources.hpp>
 #include <strata/terrain/ingest.hpp>
@@ -75,7 +83,7 @@ TEST(StrataCheck, PassesASoundStoreAndNamesACorruptTile) {
   const auto bad = runCli("check " + dir.string());
   EXPECT_EQ(bad.status, 1) << bad.output;
   EXPECT_NE(bad.output.find(victim.filename().string() + ": checksum mismatch"), std::string::npos) << bad.output;
-  EXPECT_NE(bad.output.find("1 corrupt tile"), std::string::npos) << bad.output;
+  EXPECT_NE(bad.output.find("result    1 problem(s)"), std::string::npos) << bad.output;
 
   const auto missing = runCli("check " + (dir / "nothing").string());
   EXPECT_EQ(missing.status, 1);
@@ -152,7 +160,7 @@ TEST(DemSources, MosaicWindowsMatchTheSource) {
   auto info = gis::probeDem(dem);
   ASSERT_TRUE(info) << info.message();
   gis::ReadOptions window;
-  window.window = gis::PixelWindow{100, 200, 64, 32};
+  window.window = gis::CellRect{100, 200, 64, 32};
   auto ref = gis::readDem(dem, window);
   ASSERT_TRUE(ref) << ref.message();
   // One input on the store's own grid: read directly, bit for bit.
@@ -174,6 +182,250 @@ TEST(DemSources, MosaicWindowsMatchTheSource) {
     // ~2000 m (1.2e-4 m) in the interpolation weights: 1e-2 m is a safe bound for the sum.
     ASSERT_NEAR(b->data[i], 2.0f * ref->values.data[i], 1e-2f) << i;
   }
+}
+
+std::string q(const fs::path& p) { return "'" + p.string() + "'"; }
+
+// gdal_translate SRC -> DST with extra arguments.
+fs::path crop(const fs::path& dst, const std::string& args, const std::string& src = "rainier/mt_rainier_90m.tif") {
+  const std::string cmd = "gdal_translate -q " + args + " " + q(test::dataPath(src)) + " " + q(dst) + " 2>&1";
+  STRATA_CHECK(std::system(cmd.c_str()) == 0) << cmd;
+  return dst;
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+std::map<std::string, std::string> storeFiles(const fs::path& dir) {
+  std::map<std::string, std::string> files;
+  for (const auto& e : fs::recursive_directory_iterator(dir)) {
+    if (e.is_regular_file() && e.path().filename() != "writer.lock") {
+      files[fs::relative(e.path(), dir).string()] = slurp(e.path());
+    }
+  }
+  return files;
+}
+
+bool sameCells(const gis::Grid<float>& a, const gis::Grid<float>& b) {
+  if (a.width != b.width || a.height != b.height) return false;
+  for (size_t i = 0; i < a.data.size(); ++i) {
+    if (std::isnan(a.data[i]) != std::isnan(b.data[i])) return false;
+    if (!std::isnan(a.data[i]) && a.data[i] != b.data[i]) return false;
+  }
+  return true;
+}
+
+TEST(StrataIngest, TwoHalvesMosaicToTheWholeAndPathsWithAnAtWork) {
+  const auto dir = test::tempDir("halves");
+  const auto west = crop(dir / "we@st.tif", "-srcwin 600 500 128 160");  // '@' in the name
+  const auto east = crop(dir / "east.tif", "-srcwin 728 500 128 160");
+  const auto whole = crop(dir / "whole.tif", "-srcwin 600 500 256 160");
+  auto ing = runCli("ingest " + q(dir / "halves") + " --dem " + q(west) + " --blend replace " + q(east) +
+                    " --min-exp 1 --max-exp 6");
+  ASSERT_EQ(ing.status, 0) << ing.output;
+  ASSERT_EQ(runCli("ingest " + q(dir / "whole") + " --dem " + q(whole) + " --min-exp 1 --max-exp 6").status, 0);
+  ASSERT_EQ(runCli("export " + q(dir / "halves") + " " + q(dir / "halves.tif")).status, 0);
+  auto ex = runCli("export " + q(dir / "whole") + " " + q(dir / "whole_out.tif"));
+  ASSERT_EQ(ex.status, 0) << ex.output;
+  EXPECT_NE(ex.output.find("167 of 40960 cells are nodata"), std::string::npos) << ex.output;
+  auto a = gis::readDem((dir / "halves.tif").string()), b = gis::readDem((dir / "whole_out.tif").string()),
+       src = gis::readDem(whole.string());
+  ASSERT_TRUE(a && b && src);
+  EXPECT_TRUE(sameCells(a->values, b->values));
+  // Exact at the default tolerance, with the source's voids as nodata, and it says so.
+  EXPECT_TRUE(sameCells(a->values, src->values));
+  FILE* p = popen(("gdalinfo " + q(dir / "halves.tif")).c_str(), "r");
+  std::string out;
+  char buf[4096];
+  for (size_t n; (n = fread(buf, 1, sizeof buf, p)) > 0;) out.append(buf, n);
+  pclose(p);
+  EXPECT_NE(out.find("STRATA_MAX_ERROR_M=0"), std::string::npos) << out;
+  EXPECT_NE(out.find("STRATA_ERROR_TOLERANCE_M=0.5"), std::string::npos) << out;
+  // The older PATH@MODE form still works where it is unambiguous.
+  auto legacy = runCli("ingest " + q(dir / "legacy") + " --dem " + q(whole) + " --dem " + q(east.string() + "@max") +
+                       " --max-exp 6");
+  EXPECT_EQ(legacy.status, 0) << legacy.output;
+}
+
+TEST(StrataExport, NeverOverwritesOrWritesInsideAStore) {
+  const auto dir = test::tempDir("export");
+  const auto dem = crop(dir / "dem.tif", "-srcwin 600 500 128 96");
+  const auto store = dir / "store";
+  ASSERT_EQ(runCli("ingest " + q(store) + " --dem " + q(dem) + " --max-exp 6").status, 0);
+  const auto manifest = slurp(store / "manifest.toml");
+  auto onManifest = runCli("export " + q(store) + " " + q(store / "manifest.toml"));
+  EXPECT_EQ(onManifest.status, 1);
+  EXPECT_NE(onManifest.output.find("inside the tile store"), std::string::npos) << onManifest.output;
+  EXPECT_EQ(slurp(store / "manifest.toml"), manifest);
+  EXPECT_EQ(runCli("export " + q(store) + " " + q(store / "tiles" / "x.tif")).status, 1);
+  EXPECT_EQ(runCli("check " + q(store)).status, 0);
+  std::ofstream(dir / "mine.tif") << "not to be replaced";
+  auto existing = runCli("export " + q(store) + " " + q(dir / "mine.tif"));
+  EXPECT_EQ(existing.status, 1);
+  EXPECT_NE(existing.output.find("mine.tif: already exists (pass --overwrite to replace it)"), std::string::npos);
+  EXPECT_EQ(slurp(dir / "mine.tif"), "not to be replaced");
+  EXPECT_EQ(runCli("export " + q(store) + " " + q(dir / "mine.tif") + " --overwrite").status, 0);
+  auto outside = runCli("export " + q(store) + " " + q(dir / "w.tif") + " --window 100 0 64 8");
+  EXPECT_EQ(outside.status, 1);
+  EXPECT_NE(outside.output.find("reaches outside level 0's 128 x 96 cells"), std::string::npos) << outside.output;
+}
+
+TEST(StrataCheck, FailsOnAnIncompleteStoreAndOnAMissingTile) {
+  const auto dir = test::tempDir("incomplete");
+  auto dem = gis::readDem(crop(dir / "dem.tif", "-srcwin 600 500 256 128").string());
+  ASSERT_TRUE(dem);
+  int reads = 0;
+  auto values = dem->values;
+  IngestOptions o;
+  o.metric = {1, 6};
+  auto r = ingest(dir / "store", dem->georef,
+                  {{{"bedrock", LayerKind::Bedrock, ""},
+                    [&](int x, int y, int w, int h) -> Result<gis::Grid<float>> {
+                      if (++reads == 3) setInterrupted(true);
+                      gis::Grid<float> g(w, h);
+                      for (int j = 0; j < h; ++j)
+                        std::copy_n(&values.data[values.index(x, y + j)], w, &g.data[g.index(0, j)]);
+                      return g;
+                    }}},
+                  o);
+  setInterrupted(false);
+  ASSERT_FALSE(r);
+  auto check = runCli("check " + q(dir / "store"));
+  EXPECT_EQ(check.status, 1) << check.output;
+  EXPECT_NE(check.output.find("INCOMPLETE: ingest stopped in pass 2 after 3 of 8 tiles"), std::string::npos)
+      << check.output;
+  auto ex = runCli("export " + q(dir / "store") + " " + q(dir / "out.tif"));
+  EXPECT_EQ(ex.status, 1);
+  EXPECT_NE(ex.output.find("incomplete store"), std::string::npos) << ex.output;
+  EXPECT_FALSE(fs::exists(dir / "out.tif"));
+  // A complete store whose tile file is gone: check fails naming it, export of it fails.
+  ASSERT_EQ(runCli("ingest " + q(dir / "done") + " --dem " + q(dir / "dem.tif") + " --max-exp 6").status, 0);
+  fs::remove(dir / "done" / "tiles" / "x1_y0_g2.exr");
+  auto missing = runCli("check " + q(dir / "done"));
+  EXPECT_EQ(missing.status, 1);
+  EXPECT_NE(missing.output.find("tiles/x1_y0_g2.exr: missing or unreadable"), std::string::npos) << missing.output;
+  EXPECT_EQ(runCli("export " + q(dir / "done") + " " + q(dir / "o.tif") + " --window 64 0 8 8").status, 1);
+}
+
+TEST(StrataIngest, CtrlCStopsCleanlyAndResumeGivesTheSameBytes) {
+  const auto dir = test::tempDir("ctrlc");
+  const std::string args = " --synthetic 2048 --max-exp 6 --min-exp 2";
+  ASSERT_EQ(runCli("ingest " + q(dir / "reference") + args).status, 0);
+  // The same ingest, SIGINT once it has written some tiles.
+  const std::string store = (dir / "store").string();
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    const int devnull = ::open("/dev/null", O_WRONLY);
+    dup2(devnull, 1);
+    dup2(devnull, 2);
+    execl(STRATA_CLI, STRATA_CLI, "ingest", store.c_str(), "--synthetic", "2048", "--max-exp", "6", "--min-exp", "2",
+          static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  auto tiles = [&] {
+    std::error_code ec;
+    return std::distance(fs::directory_iterator(dir / "store" / "tiles", ec), fs::directory_iterator());
+  };
+  while (tiles() < 50 && std::chrono::steady_clock::now() < until)
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  ASSERT_EQ(kill(child, SIGINT), 0);
+  int status = 0;
+  waitpid(child, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status)) << "killed by the signal instead of stopping: " << status;
+  ASSERT_EQ(WEXITSTATUS(status), 1) << "finished before the interrupt";
+  auto check = runCli("check " + q(dir / "store"));
+  EXPECT_EQ(check.status, 1);
+  EXPECT_NE(check.output.find("INCOMPLETE"), std::string::npos) << check.output;
+  EXPECT_NE(check.output.find("result    0 problem(s), store incomplete"), std::string::npos) << check.output;
+  auto resumed = runCli("ingest " + q(dir / "store") + args + " --resume");
+  ASSERT_EQ(resumed.status, 0) << resumed.output;
+  EXPECT_NE(resumed.output.find("(resumed at tile "), std::string::npos) << resumed.output;
+  EXPECT_TRUE(storeFiles(dir / "store") == storeFiles(dir / "reference"));
+  EXPECT_EQ(runCli("check " + q(dir / "store")).status, 0);
+}
+
+TEST(StrataIngest, RefusesBadNumbersEmptyInputAndNeverReportsNegativeSavings) {
+  const auto dir = test::tempDir("numbers");
+  const auto dem = crop(dir / "dem.tif", "-srcwin 600 500 64 64");
+  struct Case {
+    std::string args, want;
+  };
+  const std::vector<Case> cases = {
+      {"--max-error nan", "--max-error nan: expected a finite number in [0, 1e+06]"},
+      {"--max-error inf", "--max-error inf: expected a finite number"},
+      {"--max-error -1", "--max-error -1: expected a finite number"},
+      {"--max-exp 20", "--min-exp 5 / --max-exp 20: need 0 <= min-exp <= max-exp <= 14"},
+      {"--resolution 0", "--resolution: cell sizes must be finite and positive"},
+      {"--resolution nan", "--resolution: cell sizes must be finite and positive"},
+      {"--extent 0 0 nan 1", "--extent: coordinates must be finite"},
+      {"--extent 1 0 0 1", "--extent: needs xmin < xmax and ymin < ymax"},
+      {"--metric fast", "--metric 'fast': expected max-error or range"},
+      {"--resampling lanczos", "--resampling 'lanczos': expected nearest, bilinear, cubic, min or min-if-coarser"},
+  };
+  for (const auto& c : cases) {
+    auto r = runCli("ingest " + q(dir / "s") + " --dem " + q(dem) + " " + c.args);
+    EXPECT_EQ(r.status, 1) << c.args;
+    EXPECT_NE(r.output.find("strata ingest: " + c.want), std::string::npos) << c.args << ": " << r.output;
+    EXPECT_FALSE(fs::exists(dir / "s" / "manifest.toml")) << c.args;
+  }
+  auto synth = runCli("ingest " + q(dir / "s") + " --synthetic 16 --cell-size nan");
+  EXPECT_NE(synth.output.find("--cell-size nan: expected a finite number"), std::string::npos) << synth.output;
+  // All nodata: an error, and no store left behind.
+  const auto empty = crop(dir / "empty.tif", "-srcwin 0 0 32 32 -a_nodata 0 -scale 0 5000 0 0");
+  auto none = runCli("ingest " + q(dir / "none") + " --dem " + q(empty));
+  EXPECT_EQ(none.status, 1);
+  EXPECT_NE(none.output.find("no data: every cell of the 32x32 grid is nodata"), std::string::npos) << none.output;
+  EXPECT_FALSE(fs::exists(dir / "none"));
+  // A 1 x 1 DEM: nothing saved, nothing negative.
+  const auto one = crop(dir / "one.tif", "-srcwin 600 600 1 1");
+  auto r = runCli("ingest " + q(dir / "one_store") + " --dem " + q(one));
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("0.0% saved against dense"), std::string::npos) << r.output;
+}
+
+TEST(StrataInfo, DescribesAStoreAndAssignsAMissingGeoreference) {
+  const auto dir = test::tempDir("info");
+  const auto dem = crop(dir / "dem.tif", "-srcwin 600 500 64 64");
+  ASSERT_EQ(runCli("ingest " + q(dir / "store") + " --dem " + q(dem) + " --max-exp 6 --max-error 20").status, 0);
+  auto store = runCli("info " + q(dir / "store"));
+  EXPECT_EQ(store.status, 0) << store.output;
+  EXPECT_NE(store.output.find("metric    max-error: each tile the coarsest within 20 m of every source cell"),
+            std::string::npos)
+      << store.output;
+  EXPECT_NE(store.output.find("error     bedrock      max "), std::string::npos) << store.output;
+  // A DEM without a georeference: refused, then described with one assigned.
+  const auto bare = crop(dir / "bare.tif", "-srcwin 600 500 64 64 -co PROFILE=BASELINE");
+  // Its side file keeps only the nodata value (the SRTM voids), not the CRS and geotransform.
+  std::ofstream(bare.string() + ".aux.xml")
+      << "<PAMDataset><PAMRasterBand band=\"1\"><NoDataValue>-32768</NoDataValue></PAMRasterBand></PAMDataset>\n";
+  auto refused = runCli("info " + q(bare));
+  EXPECT_EQ(refused.status, 1);
+  EXPECT_NE(refused.output.find("no georeference (no CRS and no geotransform)"), std::string::npos) << refused.output;
+  auto dinfo = gis::probeDem(dem.string());
+  ASSERT_TRUE(dinfo);
+  std::string gt;
+  for (double c : dinfo->georef.transform.c) {
+    char b[40];
+    std::snprintf(b, sizeof b, "%.17g,", c);
+    gt += b;
+  }
+  gt.pop_back();
+  auto assigned = runCli("info " + q(bare) + " --assign-crs EPSG:4326 --assign-geotransform " + gt);
+  EXPECT_EQ(assigned.status, 0) << assigned.output;
+  EXPECT_NE(assigned.output.find("CRS         WGS 84 (EPSG:4326)"), std::string::npos) << assigned.output;
+  // And ingested with one: the same cells as the georeferenced file.
+  auto ing = runCli("ingest " + q(dir / "bare_store") + " --dem " + q(bare) +
+                    " --assign-crs EPSG:4326 --assign-geotransform " + gt + " --max-exp 6");
+  ASSERT_EQ(ing.status, 0) << ing.output;
+  ASSERT_EQ(runCli("export " + q(dir / "bare_store") + " " + q(dir / "bare_out.tif")).status, 0);
+  auto a = gis::readDem((dir / "bare_out.tif").string()), b = gis::readDem(dem.string());
+  ASSERT_TRUE(a && b);
+  EXPECT_TRUE(sameCells(a->values, b->values));
+  EXPECT_EQ(a->georef.transform.c[0], b->georef.transform.c[0]);
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
-// The store on real DEMs (Grand Canyon, Mount Rainier) and a synthetic scene: resolution maps,
-// memory saved against dense storage, exact reads in complex tiles, and ingest memory bounded by
-// the tile size rather than the input size.
+// The store on real DEMs: every shared DEM within its error bound with its nodata mask exactly
+// and the recorded error equal to the measured one (the default max-error metric); the seed's
+// relief metric on the Grand Canyon, Rainier and a synthetic scene (resolution maps, memory saved
+// against dense storage).
 #include <gtest/gtest.h>
 
 #include <OpenImageIO/imagebuf.h>
@@ -10,6 +11,8 @@
 #include <fstream>
 #include <set>
 
+#include <strata/gis/dem_io.hpp>
+#include <strata/terrain/dem_sources.hpp>
 #include <strata/terrain/ingest.hpp>
 #include <strata/terrain/synthetic.hpp>
 #include <strata/terrain/tile_store.hpp>
@@ -82,11 +85,12 @@ void writeResolutionMap(const TileStore& store, const fs::path& png, int scale) 
   out->close();
 }
 
-// The same number of metric bins as the seed's 2^5..2^10 (six), on tiles small enough that a
-// 512 x 512 DEM has 8 x 8 of them.
+// The seed's relief metric with the same number of bins as its 2^5..2^10 (six), on tiles small
+// enough that a 512 x 512 DEM has 8 x 8 of them.
 IngestOptions realDataOptions() {
   IngestOptions o;
   o.metric = {1, 6};
+  o.metric.kind = TileMetric::Range;
   o.cache.prefetch = false;
   return o;
 }
@@ -224,6 +228,101 @@ TEST(StoreOnRealData, EtopoAsAGlobalLayoutWrapsAtTheDateLine) {
   ASSERT_TRUE(metric);
   writeResolutionMap(*metric, test::outputDir("terrain") / "etopo20_resolution.png", 16);
   report("etopo20_global", *metric);
+}
+
+// One shared DEM and how to store it.
+struct SharedDem {
+  const char* file;
+  bool global;
+};
+
+class EveryDem : public ::testing::TestWithParam<SharedDem> {};
+
+// Each shared DEM, read through GDAL (demReader: scale, offset, nodata as the file says), at the
+// default tolerance and at a lossy one: every cell read back is within the tolerance, the nodata
+// mask is the source's exactly, and the store's recorded error is the measured one.
+TEST_P(EveryDem, StaysWithinItsToleranceWithItsNodataMask) {
+  const std::string path = test::dataPath(GetParam().file);
+  auto src = gis::readDem(path);
+  ASSERT_TRUE(src) << src.message();
+  const auto& ref = src->values;
+  const std::string name = fs::path(GetParam().file).stem().string();
+  for (double tol : {kDefaultMaxErrorM, 20.0, 100.0}) {
+    IngestOptions o;
+    o.metric = {1, 7};  // tiles of 128 cells, stored at 2^1..2^7 samples
+    o.metric.maxErrorM = tol;
+    o.layout = GetParam().global ? TileLayout::Global : TileLayout::Planar;
+    o.cache.prefetch = false;
+    const auto dir = test::tempDir(name + "_" + std::to_string(int(tol * 10)));
+    auto rep = ingest(dir, src->georef, {{{"bedrock", LayerKind::Bedrock, ""}, demReader(path)}}, o);
+    ASSERT_TRUE(rep) << rep.message();
+    auto store = TileStore::open(dir, o.cache);
+    ASSERT_TRUE(store) << store.message();
+    auto back = store->readWindow(0, {0, 0, ref.width, ref.height}, 0);
+    ASSERT_TRUE(back) << back.message();
+    double maxErr = 0, sumSq = 0;
+    uint64_t cells = 0, maskDiffers = 0;
+    for (size_t i = 0; i < ref.data.size(); ++i) {
+      const bool a = std::isnan(ref.data[i]), b = std::isnan(back->data[i]);
+      if (a != b) {
+        ++maskDiffers;
+        continue;
+      }
+      if (a) continue;
+      const double e = std::abs(double(back->data[i]) - double(ref.data[i]));
+      maxErr = std::max(maxErr, e);
+      sumSq += e * e;
+      ++cells;
+    }
+    EXPECT_EQ(maskDiffers, 0u);
+    EXPECT_LE(maxErr, tol);
+    const auto rec = store->errorSummary(0);
+    EXPECT_EQ(rec.cells, cells);
+    // Both are max |sample - cell| over the same float32 values, in double: equal once rounded
+    // to the float32 the manifest keeps.
+    EXPECT_EQ(float(rec.maxM), float(maxErr));
+    // RMS: per-tile float32 RMS combined; 1e-5 relative covers the float rounding.
+    EXPECT_NEAR(rec.rmsM, std::sqrt(sumSq / double(cells)), 1e-5 * rec.rmsM + 1e-9);
+    EXPECT_EQ(store->verify().size(), 0u);
+    const auto fp = store->footprintStats();
+    std::ofstream(test::outputDir("terrain") / "memory_saved_max_error.txt", std::ios::app)
+        << name << " tolerance " << tol << " m: " << store->width() << "x" << store->height() << ", tiles of "
+        << store->footprint() << ", 2^1..2^7: " << 100.0 * fp.savedFraction() << "% saved (with mips "
+        << 100.0 * (1.0 - double(fp.storedWithMips) / double(fp.denseSamples)) << "%), max error " << rec.maxM
+        << " m, RMS " << rec.rmsM << " m over " << rec.cells << " cells\n";
+    std::cout << name << " at " << tol << " m: " << 100.0 * fp.savedFraction() << "% saved, max " << rec.maxM
+              << " m, RMS " << rec.rmsM << " m\n";
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Shared, EveryDem,
+                         ::testing::Values(SharedDem{"grand_canyon/grand_canyon_512.tif", false},
+                                           SharedDem{"grand_canyon/grandcanyon_srtm_3857.tif", false},
+                                           SharedDem{"rainier/mt_rainier_90m.tif", false},
+                                           SharedDem{"earth/etopo20.tif", true}, SharedDem{"moon/LDEM_4.LBL", false},
+                                           SharedDem{"mars/mola_megdr_4ppd.vrt", true}),
+                         [](const auto& p) {
+                           std::string n = fs::path(p.param.file).stem().string();
+                           for (char& c : n) c = std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
+                           return n;
+                         });
+
+TEST(StoreOnRealData, AOneCellDemSavesNothingRatherThanANegativeAmount) {
+  // A 1 x 1 piece of Rainier: one 1024-cell tile whose samples beyond the grid hold nothing.
+  gis::ReadOptions o;
+  o.window = gis::CellRect{600, 600, 1, 1};
+  auto one = gis::readDem(test::dataPath("rainier/mt_rainier_90m.tif"), o);
+  ASSERT_TRUE(one);
+  const auto dir = test::tempDir("one");
+  auto values = one->values;
+  auto rep = ingest(dir, one->georef, {{{"bedrock", LayerKind::Bedrock, ""}, gridReader(values)}});
+  ASSERT_TRUE(rep) << rep.message();
+  EXPECT_EQ(rep->footprint.denseSamples, 1u);
+  EXPECT_EQ(rep->footprint.storedSamples, 1u);
+  EXPECT_EQ(rep->footprint.savedFraction(), 0.0);
+  auto store = TileStore::open(dir);
+  ASSERT_TRUE(store);
+  EXPECT_EQ(store->readWindow(0, {0, 0, 1, 1})->data[0], values.data[0]);
 }
 
 }  // namespace

@@ -32,7 +32,6 @@ gis::Georef planarGeoref(int w, int h) {
   gis::Georef g;
   g.epsg = 32612;
   g.crsName = "WGS 84 / UTM zone 12N";
-  g.crsWkt = "PROJCS[\"WGS 84 / UTM zone 12N\"]";
   g.transform = {{500000.0, 30.0, 0.0, 4000000.0, 0.0, -30.0}};
   g.width = w;
   g.height = h;
@@ -47,11 +46,20 @@ SyntheticScene smallScene() {
   return s;
 }
 
-IngestOptions smallOptions(bool prefetch = false) {
+// The seed's relief metric (what most tests here pin down) unless told otherwise.
+IngestOptions smallOptions(bool prefetch = false, TileMetric metric = TileMetric::Range) {
   IngestOptions o;
   o.metric = {kMinExp, kMaxExp};
+  o.metric.kind = metric;
   o.cache.prefetch = prefetch;
   return o;
+}
+
+// verify()'s problems, one per line (empty: none).
+std::string problemsOf(const TileStore& s) {
+  std::string out;
+  for (const auto& p : s.verify()) out += p.message + "\n";
+  return out;
 }
 
 IngestSource bedrockFrom(WindowReader r) { return {{"bedrock", LayerKind::Bedrock, ""}, std::move(r)}; }
@@ -167,7 +175,7 @@ TEST(TileStore, ManifestRoundTripsGeoreferenceAndRecords) {
       EXPECT_EQ(a.tile(tx, ty).maxV, b->tile(tx, ty).maxV);
     }
   }
-  EXPECT_TRUE(b->verify().empty());
+  EXPECT_EQ(problemsOf(*b), "");
 }
 
 TEST(TileStore, BadManifestsAreRefusedNamingTheField) {
@@ -187,10 +195,10 @@ TEST(TileStore, BadManifestsAreRefusedNamingTheField) {
   auto r1 = with("max_exp = 6", "max_exp = 7");
   ASSERT_FALSE(r1);
   EXPECT_NE(r1.message().find("footprint_cells"), std::string::npos) << r1.message();
-  auto r2 = with("kind = 'planar'", "kind = 'cubic'");
+  auto r2 = with("kind = \"planar\"", "kind = \"cubic\"");
   ASSERT_FALSE(r2);
   EXPECT_NE(r2.message().find("layout.kind"), std::string::npos) << r2.message();
-  auto r3 = with("talus_angle_deg = 70", "talus_angle_deg = 170");
+  auto r3 = with("talus_angle_deg = 70.0", "talus_angle_deg = 170.0");
   ASSERT_FALSE(r3);
   EXPECT_NE(r3.message().find("talus_angle_deg"), std::string::npos) << r3.message();
   auto r4 = with("format = ", "formt = ");
@@ -312,7 +320,7 @@ TEST(TileStore, WritesReevaluateTheTileAndTheGlobalRange) {
   ASSERT_TRUE(store.commit());
   auto again = TileStore::open(dir);
   EXPECT_EQ(again->tile(1, 0).exp, kMaxExp);
-  EXPECT_TRUE(again->verify().empty());
+  EXPECT_EQ(problemsOf(*again), "");
   // Superseded files are gone after the commit: one file per present tile.
   EXPECT_EQ(std::distance(fs::directory_iterator(dir / "tiles"), fs::directory_iterator()), 6);
   EXPECT_FALSE(store.writeWindow(0, 3 * kFootprint - 1, 0, Grid<float>(2, 1, 0.0f)));
@@ -425,7 +433,7 @@ TEST(TileCache, TryReadWindowNeverReadsAFileOnTheCallersThread) {
   const double delayMs = 50;
   auto store = TileStore::open(dir, {.budgetBytes = size_t(64) << 20, .prefetch = false, .loadDelayMs = delayMs});
   ASSERT_TRUE(store);
-  const Window w{kFootprint / 2, kFootprint / 2, 2 * kFootprint, kFootprint};  // over 3 x 2 tiles
+  const gis::CellRect w{kFootprint / 2, kFootprint / 2, 2 * kFootprint, kFootprint};  // over 3 x 2 tiles
   const auto t0 = std::chrono::steady_clock::now();
   auto first = store->tryReadWindow(0, w, 0);
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
@@ -478,19 +486,24 @@ std::vector<float> allCells(TileStore& s) {
 
 TEST(TileStore, AWriterKilledBeforeItsCommitLeavesTheEarlierStore) {
   const auto dir = test::tempDir("store");
-  auto store = ingestScene(dir, 3 * kFootprint, 2 * kFootprint, smallScene());
-  const auto before = allCells(store);
-  // Writes whose tile files land on disk, then a "crash" before commit: one new tile file is
-  // truncated, a manifest temporary and a tile temporary are left half written.
-  Grid<float> patch(2 * kFootprint, kFootprint, 7.0f);
-  ASSERT_TRUE(store.writeWindow(0, 10, 10, patch));
-  const auto newFile = dir / store.tile(1, 0).file;
+  std::vector<float> before;
+  fs::path newFile;
+  {
+    auto store = ingestScene(dir, 3 * kFootprint, 2 * kFootprint, smallScene());
+    before = allCells(store);
+    // Writes whose tile files land on disk, then a "crash" before commit (the writer goes away,
+    // releasing its lock): one new tile file is truncated, a manifest temporary and a tile
+    // temporary are left half written.
+    Grid<float> patch(2 * kFootprint, kFootprint, 7.0f);
+    ASSERT_TRUE(store.writeWindow(0, 10, 10, patch));
+    newFile = dir / store.tile(1, 0).file;
+  }
   fs::resize_file(newFile, fs::file_size(newFile) / 2);
   std::ofstream(dir / "manifest.toml.tmp") << "format = \"strata-tile-st";
   std::ofstream(dir / "tiles" / "x9_y9_g999.exr.tmp") << "partial";
   auto reopened = TileStore::open(dir, {.prefetch = false});
   ASSERT_TRUE(reopened) << reopened.message();
-  EXPECT_TRUE(reopened->verify().empty());
+  EXPECT_EQ(problemsOf(*reopened), "");
   EXPECT_EQ(allCells(*reopened), before);
   // The next commit sweeps the leftovers.
   ASSERT_TRUE(reopened->commit());
@@ -522,7 +535,7 @@ TEST(TileStore, AWriterKilledMidStreamLeavesACommittedVersion) {
   ASSERT_TRUE(WIFSIGNALED(status)) << "the writer stopped on its own (status " << status << ")";
   auto st = TileStore::open(dir, {.prefetch = false});
   ASSERT_TRUE(st) << st.message();
-  EXPECT_TRUE(st->verify().empty());
+  EXPECT_EQ(problemsOf(*st), "");
   const auto cells = allCells(*st);
   std::set<float> values;
   for (float v : cells) {

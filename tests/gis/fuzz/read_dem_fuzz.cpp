@@ -52,7 +52,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       (void)areas;
     }
     const auto& g = info->georef;
-    o.window = strata::gis::PixelWindow{g.width / 3, g.height / 3, g.width / 2 + 1, g.height / 2 + 1};
+    o.window = strata::gis::CellRect{g.width / 3, g.height / 3, g.width / 2 + 1, g.height / 2 + 1};
     auto w = strata::gis::readDem(path, o);
     (void)w;
   }

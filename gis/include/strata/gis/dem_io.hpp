@@ -4,18 +4,17 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
 
 #include <strata/core/result.hpp>
 #include <strata/gis/raster.hpp>
 
 namespace strata::gis {
-
-/// A pixel rectangle of a raster: top-left (x, y) and size, in pixels.
-struct PixelWindow {
-  int x = 0, y = 0, width = 0, height = 0;
-};
 
 /// A DEM's metadata, read without reading its pixels.
 struct DemInfo {
@@ -27,6 +26,9 @@ struct DemInfo {
   double scale = 1;  ///< value = raw * scale + offset
   double offset = 0;
   std::optional<double> nodata;  ///< raw nodata value, when the band has one
+  double unitToMetres = 1;       ///< metres per unit of the band's vertical unit (0.3048 for feet)
+  /// Block (GDAL's natural read unit) of band 1: a striped file has blockWidth = the raster width.
+  int blockWidth = 0, blockHeight = 0;
   /// True when the band's offset is the body's radius (PDS radius products such as LOLA's LDEM):
   /// readDem then returns heights above the reference sphere (offset minus the radius).
   bool offsetIsBodyRadius = false;
@@ -34,11 +36,12 @@ struct DemInfo {
 
 /// How to read a DEM.
 struct ReadOptions {
-  std::optional<PixelWindow> window;  ///< read only this window (default: the whole raster)
-  /// For files without georeference: the CRS (EPSG:n, WKT or PROJ) and geotransform to use.
-  /// Both or neither; without them a file with no CRS or no geotransform is refused.
-  std::optional<std::string> crs;
-  std::optional<GeoTransform> transform;
+  std::optional<CellRect> window = std::nullopt;  ///< read only this window (default: the whole raster)
+  /// A CRS (EPSG:n, WKT or PROJ) and/or a geotransform to assign, replacing the file's (for
+  /// files without georeference; GDAL's -a_srs / -a_gt). A file left with no CRS or no
+  /// geotransform is refused.
+  std::optional<std::string> crs = std::nullopt;
+  std::optional<GeoTransform> transform = std::nullopt;
   int band = 1;                                 ///< 1-based band index
   std::size_t maxBytes = std::size_t(4) << 30;  ///< refuse windows whose float32 copy exceeds this
   bool allowAllNoData = false;                  ///< an all-nodata window is an error unless set
@@ -48,9 +51,48 @@ struct ReadOptions {
 /// Metadata of a DEM (driver, georeference, band type, scale/offset, nodata). Errors name the file.
 Result<DemInfo> probeDem(const std::string& path, const ReadOptions& options = {});
 
+/// Which parts of a georeference a file has of its own.
+struct GeorefPresence {
+  bool crs = false;
+  bool transform = false;
+};
+/// Opens `path` and says whether it carries a CRS and a geotransform (before any assignment).
+Result<GeorefPresence> georefPresence(const std::string& path);
+
 /// Reads a DEM (or a window of it) as metres; nodata -> NaN. NaN values stored in the file (other
 /// than as the nodata value) are an error. The Georef describes the window read.
 Result<Raster> readDem(const std::string& path, const ReadOptions& options = {});
+
+/// An open DEM read window after window without reopening it, for streaming (ingest, mosaics).
+/// Windows requested row of tiles by row of tiles decode each input block about once: a striped
+/// file (blocks as wide as the raster) is read a band of whole rows at a time and the band is
+/// kept until a window leaves it; other layouts go through GDAL's block cache, which is flushed
+/// when a window starts a new row (so memory stays at about one row of tiles). Not thread-safe.
+class DemFile {
+ public:
+  /// Probes `path` (as probeDem) and keeps it open. options.window is ignored.
+  static Result<DemFile> open(const std::string& path, const ReadOptions& options = {});
+  DemFile(DemFile&&) noexcept;
+  DemFile& operator=(DemFile&&) noexcept;
+  ~DemFile();
+
+  const DemInfo& info() const;
+  /// Reads a window inside the raster, as readDem with that window (options.allowAllNoData and
+  /// options.maxBytes apply).
+  Result<Raster> read(const CellRect& window);
+  /// Reads a window that may reach past the raster's edges (NaN there), all-nodata allowed.
+  Result<Grid<float>> readPadded(const CellRect& window);
+
+ private:
+  friend Result<Raster> readDem(const std::string& path, const ReadOptions& options);
+  struct Impl;
+  explicit DemFile(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+/// Parses a geotransform "c0,c1,c2,c3,c4,c5" (GDAL's order; commas or spaces between the six
+/// numbers): every term finite, the pixel size not degenerate. `key` names the option in errors.
+Result<GeoTransform> parseGeoTransform(std::string_view text, const std::string& key);
 
 /// Reads a DEM on a lon/lat grid of its body, as planetary rendering needs: a geographic DEM as
 /// it is; an equirectangular (equidistant cylindrical) DEM on a sphere with its standard parallel
@@ -65,10 +107,14 @@ struct WriteOptions {
   bool cog = false;          ///< Cloud Optimized GeoTIFF (GDAL's COG driver, with overviews)
   float nodata = -32768.0f;  ///< value written for NaN cells (must not occur as a real value)
   int blockSize = 256;       ///< tile size in pixels (power of two, 16..4096)
+  bool overwrite = true;     ///< false: an existing `path` is an error (checked atomically at the rename)
+  /// GDAL metadata items (name, value) written into the file (gdalinfo lists them).
+  std::vector<std::pair<std::string, std::string>> metadata;
 };
 
 /// Writes float32, DEFLATE-compressed, tiled GeoTIFF with CRS, geotransform and nodata; writes a
 /// temporary next to `path` and renames it into place, so readers never see a partial file.
+/// With `overwrite` false the temporary is linked into place (fails if `path` exists) instead.
 Status writeGeoTiff(const std::string& path, const Raster& raster, const WriteOptions& options = {});
 
 }  // namespace strata::gis

@@ -85,6 +85,8 @@ class CrsTransform {
   static Result<CrsTransform> create(const std::string& from, const std::string& to);
   /// From a Georef's CRS to the geographic lon/lat CRS on the same datum (the body's).
   static Result<CrsTransform> toGeographic(const Georef& georef);
+  /// The inverse: lon/lat on the Georef's own datum to its CRS.
+  static Result<CrsTransform> fromGeographic(const Georef& georef);
   ~CrsTransform();
   CrsTransform(CrsTransform&&) noexcept;
   CrsTransform& operator=(CrsTransform&&) noexcept;
@@ -96,6 +98,11 @@ class CrsTransform {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+/// A CRS ("EPSG:n", WKT or PROJ) as a Georef's CRS fields (WKT2, EPSG code, name, geographic,
+/// body); the grid fields are left at their defaults. Fails naming the CRS when it does not
+/// parse or is neither geographic nor projected.
+Result<Georef> describeCrs(const std::string& crs);
 
 /// Geographic lon/lat of a grid position (pixel coordinates, (0,0) = top-left corner).
 Result<LonLat> pixelToLonLat(const Georef& georef, double col, double row);

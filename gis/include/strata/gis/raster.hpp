@@ -3,6 +3,7 @@
 // (never a number that could be mistaken for an elevation), and is written back as the file's
 // nodata value.
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <limits>
@@ -35,6 +36,24 @@ struct Georef {
   int width = 0, height = 0;
   Body body = Body::wgs84();
   std::string verticalUnit = "m";
+};
+
+/// A rectangle of cells of a grid (pixels of a raster, cells of a tile level or of a simulation
+/// region): [x, x + width) x [y, y + height), (x, y) its top-left cell. The one cell rectangle of
+/// Strata: readers' windows, tile store windows, simulation regions and blocks, editor dabs.
+struct CellRect {
+  int x = 0, y = 0, width = 0, height = 0;
+
+  bool empty() const { return width <= 0 || height <= 0; }
+  /// The smallest rectangle holding both (an empty one adds nothing).
+  CellRect united(const CellRect& o) const {
+    if (empty()) return o;
+    if (o.empty()) return *this;
+    const int x0 = std::min(x, o.x), y0 = std::min(y, o.y);
+    const int x1 = std::max(x + width, o.x + o.width), y1 = std::max(y + height, o.y + o.height);
+    return {x0, y0, x1 - x0, y1 - y0};
+  }
+  bool operator==(const CellRect&) const = default;
 };
 
 /// A dense row-major grid, row 0 at the top (north for north-up rasters).

@@ -11,12 +11,12 @@
 
 namespace strata::terrain {
 
-/// Windows of band 1 of `path`, on the DEM's own grid (metres; nodata -> NaN).
+/// Windows of band 1 of `path`, on the DEM's own grid (metres; nodata -> NaN). The file is opened
+/// once (gis::DemFile), so a row of tiles decodes each of its blocks about once.
 WindowReader demReader(const std::string& path);
 
-/// Windows of `inputs` warped onto `grid` and blended in order (gis::warpToGrid / blendInto);
-/// NaN where no input has data. When the only input is a file on exactly `grid` with mode
-/// Replace, windows are read directly instead of warped.
+/// Windows of `inputs` on `grid`, blended in order (gis::MosaicReader); NaN where no input has
+/// data. Inputs on the grid's own cells are read directly, the others warped per window.
 Result<WindowReader> mosaicReader(std::vector<gis::MosaicInput> inputs, const gis::Georef& grid);
 
 }  // namespace strata::terrain

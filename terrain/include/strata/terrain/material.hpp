@@ -16,6 +16,10 @@ struct Material {
   float dissolutionRate = 0.0f;                   ///< dissolution in slow water (m of material per m of water per s)
   float talusAngleDeg = 35.0f;                    ///< steepest stable slope; steeper is weathered down (degrees)
   float densityKgM3 = 2650.0f;                    ///< bulk density (kg/m^3)
+  /// Rate at which material above its talus angle moves down (1/s): the share of the excess
+  /// moved in a step of dt is ~ rate * dt (docs/sim-erosion.md, E7). Loose sand slides within
+  /// seconds; bedrock weathers over days.
+  float weatheringRatePerS = 0.1f;
 };
 
 /// Defaults from textbook values: bedrock barely erodes and stands steep; sand moves easily and

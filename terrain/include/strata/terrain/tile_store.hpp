@@ -1,13 +1,16 @@
 #pragma once
-// The out-of-core layered terrain: a pyramid of equal-footprint tiles on disk whose resolution
-// follows their complexity (the seed metric), each with a mip chain, read and written through a
-// RAM cache with a byte budget. See docs/architecture.md, "Terrain store", for the layout, the
-// on-disk format and why.
+// The out-of-core layered terrain: a pyramid of equal-footprint tiles on disk, each stored at the
+// coarsest resolution whose reconstruction stays within a vertical error bound (or, as an option,
+// at the resolution the seed's relief metric picks), each with a mip chain, read and written
+// through a RAM cache with a byte budget. One writer at a time (a lock); a store being built is
+// marked incomplete until its ingest finishes. See docs/architecture.md, "Terrain store".
 //
 // Grids and levels: the store's base grid (level 0) is georef.width x georef.height cells. A tile
 // covers footprint() = 2^maxExp base cells a side; level L has cells 2^L base cells wide, so a tile
 // spans footprint() >> L level-L cells. A tile of exponent e stores 2^e x 2^e samples per field
 // (box means of the base cells; e = maxExp is the base grid itself) plus its mip chain down to 1x1.
+// A base-grid read of a tile repeats each sample over its block (piecewise constant): that is the
+// reconstruction the error bound is measured on.
 
 #include <cstdint>
 #include <filesystem>
@@ -28,10 +31,24 @@ namespace strata::terrain {
 /// and fold over the poles.
 enum class TileLayout { Planar, Global };
 
-/// The seed metric's parameters: tile resolutions are 2^minExp .. 2^maxExp cells a side.
+/// How a tile's resolution is chosen.
+/// MaxError: the coarsest 2^e (minExp <= e <= maxExp) whose reconstruction (each sample repeated
+/// over its block) differs from every source cell by at most maxErrorM, and whose blocks are each
+/// all data or all no data (a coarse tile never fills a void). Range: the seed's relief metric
+/// (chooseTileExp), with the same no-void rule.
+enum class TileMetric { MaxError, Range };
+
+/// Default vertical tolerance of MaxError (m): half a metre, below the 1 m step of the integer
+/// DEMs (SRTM, ETOPO, MOLA) and far below their stated accuracy (SRTM: 16 m absolute, 6 m
+/// relative at 90 %). See docs/architecture.md, "Terrain store".
+inline constexpr double kDefaultMaxErrorM = 0.5;
+
+/// The metric's parameters: tile resolutions are 2^minExp .. 2^maxExp cells a side.
 struct TileMetricParams {
   int minExp = 5;
   int maxExp = 10;
+  TileMetric kind = TileMetric::MaxError;
+  double maxErrorM = kDefaultMaxErrorM;  ///< MaxError: largest |stored - source| allowed (m), finite, >= 0
 };
 
 /// The seed metric. For each field f, m_f = tileRange[f] / globalRange[f] (0 where either is 0 or
@@ -70,6 +87,34 @@ struct TileRecord {
   uint32_t crc32 = 0;             ///< zlib crc32 of the whole file
   uint64_t bytes = 0;             ///< file size
   std::vector<float> minV, maxV;  ///< per field, over the tile's valid base cells (NaN: none)
+  /// Per field: base cells with data, and the largest and RMS |reconstruction - source| over them
+  /// (m). After edits (writeWindow) the errors are bounds: the error against what was written
+  /// plus the tile's earlier error.
+  std::vector<uint64_t> validCells;
+  std::vector<float> maxErrorM, rmsErrorM;
+};
+
+/// Achieved vertical error over some tiles of one field.
+struct ErrorSummary {
+  double maxM = 0;     ///< largest |reconstruction - source| (m)
+  double rmsM = 0;     ///< root mean square over the cells with data (m)
+  uint64_t cells = 0;  ///< cells with data
+};
+
+/// How far a store's build got. An ingest marks its store incomplete while it runs and records
+/// its progress at each checkpoint, so `ingest --resume` continues where it stopped; readers
+/// refuse an incomplete store unless told otherwise.
+struct BuildState {
+  bool complete = true;
+  int pass = 0;           ///< ingest pass in progress (1: field ranges, 2: tiles)
+  int64_t tilesDone = 0;  ///< tiles of that pass done, in row-major order
+  /// Per field, what it is read from (files with size and time, options): resume checks it.
+  std::vector<std::string> sources;
+};
+
+/// How to open a store.
+struct OpenOptions {
+  bool allowIncomplete = false;  ///< open a store whose build did not finish (check, resume)
 };
 
 /// RAM cache settings.
@@ -91,21 +136,18 @@ struct CacheStats {
   double hitRate() const { return hits + misses ? double(hits) / double(hits + misses) : 0.0; }
 };
 
-/// A rectangle of cells of one level.
-struct Window {
-  int x = 0, y = 0, width = 0, height = 0;
-};
-
 /// A tile that failed verification: its file (relative to the store) and why.
 struct TileProblem {
   std::string file;
   std::string message;
 };
 
-/// Sizes for "memory saved against a dense grid".
+/// Sizes for "memory saved against a dense grid". Samples are counted where they cover the grid:
+/// an edge tile's samples beyond the grid's edge hold nothing (NaN, compressed away) and are not
+/// counted, so a store never "saves" a negative amount.
 struct StorageFootprint {
   uint64_t denseSamples = 0;    ///< width x height x fields of the base grid
-  uint64_t storedSamples = 0;   ///< sum over present tiles of 4^exp x fields (finest level only)
+  uint64_t storedSamples = 0;   ///< over present tiles: samples (finest level) covering the grid, x fields
   uint64_t storedWithMips = 0;  ///< the same with each tile's mip chain
   uint64_t fileBytes = 0;       ///< tile files on disk (zip compressed)
   double savedFraction() const { return denseSamples ? 1.0 - double(storedSamples) / double(denseSamples) : 0.0; }
@@ -113,10 +155,14 @@ struct StorageFootprint {
 
 class TileStore {
  public:
-  /// Creates an empty store (every tile absent) in `dir` (created; must not hold a manifest yet).
+  /// Creates an empty, incomplete store (every tile absent) in `dir` (created; must not hold a
+  /// manifest or tile files yet) and holds its writer lock. Call setBuildState({.complete = true})
+  /// and commit() when it holds its data.
   static Result<TileStore> create(const std::filesystem::path& dir, StoreDesc desc, CacheOptions cache = {});
-  /// Opens a store from its manifest. Fails, naming the file and field, on a bad manifest.
-  static Result<TileStore> open(const std::filesystem::path& dir, CacheOptions cache = {});
+  /// Opens a store from its manifest. Fails, naming the file and field, on a bad manifest, and on
+  /// an incomplete store unless `options.allowIncomplete`. Reading takes no lock; the first write
+  /// takes the store's writer lock (and fails if another process or object holds it).
+  static Result<TileStore> open(const std::filesystem::path& dir, CacheOptions cache = {}, OpenOptions options = {});
 
   TileStore(TileStore&&) noexcept;
   TileStore& operator=(TileStore&&) noexcept;
@@ -137,17 +183,23 @@ class TileStore {
   const TileRecord& tile(int tx, int ty) const;
   /// The range each tile's metric is evaluated against (the union of the tiles' ranges).
   std::pair<float, float> globalRange(int field) const;
+  /// Achieved error of field `field` over the whole store, or over the tiles a base-grid window
+  /// touches.
+  ErrorSummary errorSummary(int field, std::optional<gis::CellRect> baseWindow = std::nullopt) const;
+  const BuildState& buildState() const;
+  /// Records the build state (written by the next commit).
+  void setBuildState(BuildState state);
 
   /// Reads `window` (cells of level `lod`) of field `field`. Touches only the tiles the window
   /// covers. Planar: cells outside the grid are NaN. Global: x wraps at the seam and rows beyond
   /// a pole continue on the other side of it. Fails naming the tile file when a tile is corrupt.
-  Result<gis::Grid<float>> readWindow(int field, Window window, int lod = 0);
+  Result<gis::Grid<float>> readWindow(int field, gis::CellRect window, int lod = 0);
   /// readWindow without waiting for the disk: the window if every tile level it needs is decoded
   /// in RAM, else nullopt, after asking the background loader for each missing one. Requests are
   /// served in order, before neighbour prefetches, one at a time, and decode into the RAM cache
   /// (a later call reads them, unless the cache evicted them meanwhile). Fails like readWindow on
   /// bad arguments, and naming the tile once the loader found it corrupt.
-  Result<std::optional<gis::Grid<float>>> tryReadWindow(int field, Window window, int lod = 0);
+  Result<std::optional<gis::Grid<float>>> tryReadWindow(int field, gis::CellRect window, int lod = 0);
   /// Drops the loader's requests that it has not started (the reader moved on; it asks again).
   void clearRequests();
   /// Tile levels requested and not yet decoded (queued or being decoded).
@@ -165,19 +217,28 @@ class TileStore {
   /// Recomputes the global ranges from the tiles; where they moved, resamples every tile whose
   /// exponent changes.
   Status reevaluate();
+  /// Takes the store's writer lock now (writes take it anyway): fails, naming the holder's pid,
+  /// while another process or TileStore object writes the store. Held until destruction.
+  Status lockForWriting();
   /// Makes all writes durable: the manifest is written to a temporary file and renamed into
-  /// place (after the tile files it names), then superseded tile files are removed.
+  /// place (after the tile files it names), then superseded tile files are removed (only files
+  /// named like this store's tiles, x<X>_y<Y>_g<G>.exr, and their temporaries; nothing else in
+  /// the folder is touched).
   Status commit();
 
-  /// Reads every present tile, checks its size, checksum and decoding. Empty: the store is sound.
+  /// Checks the whole store: the manifest's CRS parses and agrees with its EPSG code, name and
+  /// body; every present tile's file exists with its size and checksum, decodes at the recorded
+  /// resolution, carries the manifest's georeference for its place, and holds samples within the
+  /// recorded range and error; field ranges and error summaries agree with the tiles; no tile
+  /// file in tiles/ is left that the manifest does not name. Empty: the store is sound.
   std::vector<TileProblem> verify() const;
   /// Tile exponents, tilesX() x tilesY() (NaN where absent).
   gis::Grid<float> resolutionMap() const;
   StorageFootprint footprintStats() const;
   /// The georeference of a window read at `lod` (same CRS, scaled and shifted geotransform).
-  gis::Georef windowGeoref(Window window, int lod) const;
+  gis::Georef windowGeoref(gis::CellRect window, int lod) const;
   /// All fields of a base-grid window as a LayeredTerrain (materials from the store).
-  Result<LayeredTerrain> readTerrain(Window window);
+  Result<LayeredTerrain> readTerrain(gis::CellRect window);
 
   CacheStats cacheStats() const;
   void resetCacheStats();
@@ -188,8 +249,13 @@ class TileStore {
   struct Impl;
   explicit TileStore(std::unique_ptr<Impl> impl);
   // readWindow (missing null) or tryReadWindow (missing set when a tile level was requested).
-  Result<gis::Grid<float>> read(int field, Window window, int lod, bool* missing);
+  Result<gis::Grid<float>> read(int field, gis::CellRect window, int lod, bool* missing);
   std::unique_ptr<Impl> impl_;
 };
+
+/// A store described for people (what `strata info STORE` and `strata check STORE` print): grid,
+/// CRS, tiles, metric and tolerance, build state, per field its range and achieved error, the
+/// resolution histogram and the storage saved. One line per item, each ending in '\n'.
+std::string describeStore(const TileStore& store);
 
 }  // namespace strata::terrain

@@ -1,0 +1,135 @@
+#version 450
+// Terrain shading shared by the renderers: sun lighting with normals from the height texture,
+// a hypsometric tint, material layers blended by thickness, water coloured by depth, haze.
+#include "terrain_common.glsl"
+
+in VertexData {
+  vec3 rel;
+  vec2 dt;  // level-0 texels from the viewer
+  vec3 sph;  // planetary: direction from the body's centre, nadir frame
+  vec2 uv;
+  float lod;
+  float elev;
+  vec3 up;
+}
+fs;
+
+layout(binding = SLOT_WATER) uniform sampler2D uWater;  // water depth (m), optional
+layout(binding = SLOT_LAYERS) uniform sampler2D uLayers;  // thickness (m) of up to four layers, bottom first, optional
+layout(binding = SLOT_SEDIMENT) uniform sampler2D uSediment;  // suspended sediment (m of material), optional
+uniform int uHasWater;
+layout(binding = SLOT_WATER_STATE) uniform sampler2D uWaterState;  // simulation state (h, s, hu, hv), optional
+uniform int uHasSediment;
+uniform int uHasWaterState;
+layout(binding = SLOT_VOID_MASK) uniform sampler2D uVoidMask;  // 1 with data, 0 over voids drawn as holes, optional
+uniform int uHasVoidMask;
+uniform vec3 uSiltColour;        // water colour at high sediment concentration
+uniform float uSiltConcentration; // concentration s / h at which water is 1 - 1/e of the way to silt
+uniform int uHasLayers;
+uniform float uSeaLevelM;        // water below this elevation when uHasSea
+uniform int uHasSea;
+uniform float uWaterDepthScaleM; // depth at which water looks 1/e of the way to deep
+uniform float uLayerOpaqueM;     // thickness at which a layer hides 1/e of what is below
+uniform vec3 uLayerColour[4];
+uniform vec2 uElevRange;         // elevations (m) at the two ends of the tint
+uniform int uPalette;            // 0: hypsometric (Earth), 1: grey (airless bodies), 2: rust (Mars)
+uniform vec3 uSunDir;            // unit, towards the sun, in the viewer's ENU frame
+uniform vec3 uPole;              // planetary: unit vector to the north pole, viewer's ENU frame
+uniform vec4 uSky;               // haze colour
+uniform float uFogM;             // haze distance (m); 0: none
+
+layout(location = 0) out vec4 oColour;
+layout(location = 1) out float oElevation;
+
+vec3 hypsometric(float t) {
+  const vec3 c0 = vec3(0.22, 0.42, 0.20), c1 = vec3(0.55, 0.55, 0.33), c2 = vec3(0.62, 0.47, 0.33);
+  const vec3 c3 = vec3(0.55, 0.52, 0.50), c4 = vec3(0.95, 0.95, 0.97);
+  t = clamp(t, 0.0, 1.0);
+  if (t < 0.3) return mix(c0, c1, t / 0.3);
+  if (t < 0.6) return mix(c1, c2, (t - 0.3) / 0.3);
+  if (t < 0.85) return mix(c2, c3, (t - 0.6) / 0.25);
+  return mix(c3, c4, (t - 0.85) / 0.15);
+}
+
+void main() {
+  // Planetary: the fragment's texel offset from its own direction on the body, not interpolated
+  // between the vertices' offsets: longitude wraps at the meridian opposite the viewer (a triangle
+  // across it interpolated through the whole globe: a seam from the pole) and is far from linear
+  // across a triangle near a pole.
+  vec2 q = uPlanetary != 0 ? dtOfSphereDir(normalize(fs.sph)) : fs.dt;
+  vec2 uv = uPlanetary != 0 ? uvOf(q) : fs.uv;
+  if (uv.y < 0.0 || uv.y > 1.0 || (uWrapU == 0 && (uv.x < 0.0 || uv.x > 1.0))) discard;
+  // Voids drawn as holes: nothing where the bilinear mask says the point is nearer a void cell's
+  // centre than a valid one's (the hole's edge runs midway between them).
+  if (uHasVoidMask != 0 && textureLod(uVoidMask, uv, 0.0).r < 0.5) discard;
+
+  // Surface gradient (m/m, exaggerated) from central differences one texel of the vertex's
+  // MIP level apart.
+  float lod = fs.lod;
+  float d = exp2(lod);
+  // On a body the east-west difference spans as much ground as the north-south one: 1 / cos(lat)
+  // times as many columns, read at a level as much coarser (columns converge at the poles, and
+  // one column there is a sliver of ground: its differences were noise, a starburst).
+  vec2 dd = vec2(d);
+  float lodX = lod;
+  if (uPlanetary != 0) {
+    float c = max(cos(uv.y / uGeoToUv.w + uGeoToUv.z), 1e-3);
+    dd.x = d / c;
+    lodX = lod + log2(1.0 / c);
+  }
+  float hx = terrainHeight(q + vec2(dd.x, 0.0), lodX) - terrainHeight(q - vec2(dd.x, 0.0), lodX);
+  float hy = terrainHeight(q + vec2(0.0, dd.y), lod) - terrainHeight(q - vec2(0.0, dd.y), lod);
+  vec2 metresPerTexel;
+  vec3 east = vec3(1.0, 0.0, 0.0), north = vec3(0.0, 1.0, 0.0), up = vec3(0.0, 0.0, 1.0);
+  if (uPlanetary == 0) {
+    metresPerTexel = 1.0 / uTexelPerMetre;
+  } else {
+    float lat = uv.y / uGeoToUv.w + uGeoToUv.z;
+    metresPerTexel = vec2(uRadius * max(cos(lat), 1e-3), uRadius) / uTexelPerRad;
+    up = normalize(fs.up);
+    east = normalize(cross(uPole, up));
+    north = cross(up, east);
+  }
+  vec2 grad = uExaggeration * vec2(hx, hy) / (2.0 * dd * metresPerTexel);
+  vec3 nLocal = normalize(vec3(-grad, 1.0));
+  vec3 n = nLocal.x * east + nLocal.y * north + nLocal.z * up;
+
+  float elev = fs.elev;
+  float t = clamp((elev - uElevRange.x) / max(uElevRange.y - uElevRange.x, 1.0), 0.0, 1.0);
+  vec3 albedo = uPalette == 1   ? mix(vec3(0.30), vec3(0.80), t)
+                : uPalette == 2 ? mix(vec3(0.42, 0.20, 0.10), vec3(0.85, 0.62, 0.42), t)
+                                : hypsometric(t);
+  if (uHasLayers != 0) {
+    vec4 thick = textureLod(uLayers, uv, lod);
+    for (int k = 0; k < 4; ++k) albedo = mix(albedo, uLayerColour[k], 1.0 - exp(-max(thick[k], 0.0) / uLayerOpaqueM));
+  }
+  float light = 0.25 + 0.75 * max(dot(n, uSunDir), 0.0);
+  vec3 colour = albedo * light;
+
+  float depth = 0.0, simDepth = 0.0;
+  float sediment = 0.0;
+  if (uHasWater != 0) simDepth = textureLod(uWater, uv, lod).r;
+  if (uHasSediment != 0) sediment = textureLod(uSediment, uv, lod).r;
+  if (uHasWaterState != 0) {
+    vec4 st = textureLod(uWaterState, uv, lod);
+    simDepth = max(simDepth, st.r);
+    sediment = max(sediment, st.g);
+  }
+  depth = max(depth, simDepth);
+  if (uHasSea != 0) depth = max(depth, uSeaLevelM - elev);
+  if (depth > 0.0) {
+    float k = 1.0 - exp(-depth / uWaterDepthScaleM);
+    vec3 water = mix(vec3(0.25, 0.62, 0.70), vec3(0.02, 0.10, 0.32), k);
+    if (sediment > 0.0 && simDepth > 0.0) {
+      // Suspended sediment tints the simulated water by its concentration s / h.
+      float conc = sediment / simDepth;
+      water = mix(water, uSiltColour, 1.0 - exp(-conc / uSiltConcentration));
+    }
+    float sunOnWater = 0.6 + 0.4 * max(dot(up, uSunDir), 0.0);
+    colour = mix(colour, water * sunOnWater, 0.55 + 0.45 * k);
+  }
+  if (uFogM > 0.0) colour = mix(colour, uSky.rgb, 1.0 - exp(-length(fs.rel) / uFogM));
+
+  oColour = vec4(colour, 1.0);
+  oElevation = elev;
+}

@@ -1,0 +1,245 @@
+#include <strata/render/streamed_elevation.hpp>
+
+#include <strata/gis/fill_nodata.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <string>
+
+#include <strata/core/check.hpp>
+#include <strata/terrain/tile_store.hpp>
+
+namespace strata::render {
+
+namespace {
+int wrap(int a, int n) { return ((a % n) + n) % n; }
+}  // namespace
+
+StreamedElevation::~StreamedElevation() = default;
+
+Result<std::unique_ptr<StreamedElevation>> StreamedElevation::create(strata::terrain::TileStore store,
+                                                                     const StreamParams& params, bool wrapLongitude) {
+  const std::string where = "render: streaming " + store.dir().string() + ": ";
+  if (wrapLongitude && store.desc().layout != strata::terrain::TileLayout::Global) {
+    return fail(where + "wrapping in longitude needs a global store (this one is planar)");
+  }
+  const int p = params.pageSize, n = params.clipSize;
+  if (p < 8 || p > 1024 || (p & (p - 1)) != 0) {
+    return fail(where + "page size " + std::to_string(p) + " is not a power of two in 8..1024");
+  }
+  if (n < p || n % p != 0 || n > 8192) {
+    return fail(where + "clip size " + std::to_string(n) + " is not a multiple of the page size " + std::to_string(p) +
+                " in " + std::to_string(p) + "..8192");
+  }
+  if (params.uploadPagesPerFrame < 0) return fail(where + "negative upload budget");
+  const int field = store.fieldIndex(params.field);
+  if (field < 0) return fail(where + "no field '" + params.field + "'");
+
+  std::unique_ptr<StreamedElevation> s(new StreamedElevation());
+  s->params_ = params;
+  s->field_ = field;
+  s->wrapX_ = wrapLongitude;
+  s->store_ = std::make_unique<strata::terrain::TileStore>(std::move(store));
+  auto& st = *s->store_;
+  const auto [lo, hi] = st.globalRange(field);
+  if (!(lo <= hi)) return fail(where + "field '" + params.field + "' has no valid elevation");
+  s->minM_ = lo;
+  s->maxM_ = hi;
+
+  // The coarse level: the finest whose whole extent fits in one window.
+  int c = 0;
+  while (st.levelWidth(c) > n || st.levelHeight(c) > n) ++c;
+  if (c > st.maxLod()) {
+    return fail(where + "clip size " + std::to_string(n) + " is too small: level " + std::to_string(st.maxLod()) +
+                " (the store's coarsest) is " + std::to_string(st.levelWidth(st.maxLod())) + " cells wide");
+  }
+  // terrain_common.glsl holds 16 window origins.
+  if (c > 16) {
+    return fail(where + "clip size " + std::to_string(n) + " needs " + std::to_string(c) +
+                " streamed levels for this grid, more than 16: use a larger one");
+  }
+  s->coarse_ = c;
+  const int cw = st.levelWidth(c), ch = st.levelHeight(c);
+  STRATA_TRY(auto coarse, st.readWindow(field, {0, 0, cw, ch}, c));
+  // Voids of the coarse level filled from the cells around them, not pits. The streamed pages
+  // are still filled with the lowest elevation (GpuCacheOptions::noDataFill): a page has no
+  // neighbours to fill from (docs/render-rings.md, "Voids").
+  STRATA_TRY(const size_t filled, gis::fillVoids(coarse));
+  (void)filled;
+  s->coarseCpu_ = std::move(coarse);
+  s->coarseTex_ = gl::Texture::create2D(gl::TextureFormat::kR32F, cw, ch, 0);
+  s->coarseTex_.upload(s->coarseCpu_.data.data());
+  s->coarseTex_.generateMipmap();
+  if (wrapLongitude) s->coarseTex_.setWrap(gl::Wrap::kRepeat, gl::Wrap::kClampToEdge);
+
+  // The stack: one toroidal layer per level 0..C-1 (one unused layer when C = 0, so that the
+  // sampler always has a texture), bilinear with wrap-around addressing.
+  const int layers = std::max(c, 1);
+  s->clip_ = gl::Texture::create2DArray(gl::TextureFormat::kR32F, n, n, layers, 1);
+  s->clip_.setWrap(gl::Wrap::kRepeat);
+  const int k = n / p;
+  s->flags_ = gl::Texture::create2DArray(gl::TextureFormat::kR32UI, k, k, layers, 1);
+  s->flags_.setFilter(gl::Filter::kNearest);  // integer textures are incomplete with linear filtering
+  s->flagsCpu_.assign(size_t(k) * size_t(k) * size_t(layers), 0u);
+  s->origins_.assign(size_t(layers), glm::ivec2(0));
+
+  size_t fixed = 0;
+  for (int l = 0; l < s->coarseTex_.levels(); ++l) {
+    fixed += size_t(std::max(1, cw >> l)) * size_t(std::max(1, ch >> l)) * sizeof(float);
+  }
+  fixed += size_t(n) * size_t(n) * size_t(layers) * sizeof(float) + s->flagsCpu_.size() * sizeof(uint32_t);
+  const size_t page = size_t(p) * size_t(p) * sizeof(float);
+  if (params.gpuBudgetBytes < fixed + page) {
+    return fail(where + "GPU budget of " + std::to_string(params.gpuBudgetBytes) + " bytes is below the stack's " +
+                std::to_string(fixed) + " bytes plus one " + std::to_string(page) + "-byte page");
+  }
+  STRATA_TRY(auto cache,
+             GpuTileCache::create(st, {.pageSize = p, .budgetBytes = params.gpuBudgetBytes - fixed, .noDataFill = lo}));
+  s->cache_ = std::make_unique<GpuTileCache>(std::move(cache));
+  s->stats_.gpuBudgetBytes = params.gpuBudgetBytes;
+  return s;
+}
+
+int StreamedElevation::width() const { return store_->width(); }
+int StreamedElevation::height() const { return store_->height(); }
+
+glm::ivec2 StreamedElevation::levelSize(int level) const {
+  return {store_->levelWidth(level), store_->levelHeight(level)};
+}
+
+size_t StreamedElevation::flagIndex(int level, int px, int py) const {
+  const int k = slots();
+  return (size_t(level) * size_t(k) + size_t(wrap(py, k))) * size_t(k) + size_t(wrap(px, k));
+}
+
+bool StreamedElevation::inWindow(int level, int px, int py) const {
+  const glm::ivec2 o = origins_[size_t(level)] / params_.pageSize;
+  return px >= o.x && py >= o.y && px < o.x + slots() && py < o.y + slots();
+}
+
+bool StreamedElevation::pageReady(int level, int px, int py) const {
+  if (level >= coarse_) return true;
+  if (!placed_ || !inWindow(level, px, py)) return false;
+  return flagsCpu_[flagIndex(level, px, py)] != 0;
+}
+
+void StreamedElevation::moveWindow(int level, glm::ivec2 origin) {
+  const int p = params_.pageSize, k = slots();
+  const glm::ivec2 o = origin / p;  // origin is a multiple of p
+  const glm::ivec2 ext = levelSize(level);
+  const bool had = placed_;
+  for (int py = o.y; py < o.y + k; ++py) {
+    for (int px = o.x; px < o.x + k; ++px) {
+      if (had && inWindow(level, px, py)) continue;  // stays resident in its slot
+      // Pages wholly outside the level's cells are never sampled (the shader clamps to the
+      // level's extent): ready at once, nothing to copy. Wrapping in longitude, columns past
+      // the seam are real pages (the store's global reads take them modulo the grid).
+      const bool outside = (!wrapX_ && (px < 0 || px * p >= ext.x)) || py < 0 || py * p >= ext.y;
+      flagsCpu_[flagIndex(level, px, py)] = outside ? 1u : 0u;
+      if (!outside) pending_.push_back({level, px, py});
+    }
+  }
+  origins_[size_t(level)] = origin;
+  flagsDirty_ = true;
+}
+
+Status StreamedElevation::update(glm::dvec2 cell) {
+  const int p = params_.pageSize, half = slots() / 2;
+  ++stats_.frames;
+  std::vector<glm::ivec2> wanted(static_cast<size_t>(coarse_));
+  for (int l = 0; l < coarse_; ++l) {
+    // The page corner nearest to the viewer, half a window from the window's corner.
+    const glm::dvec2 c = cell / std::exp2(double(l));
+    wanted[size_t(l)] = p * glm::ivec2(int(std::lround(c.x / p)) - half, int(std::lround(c.y / p)) - half);
+  }
+  for (int l = 0; l < coarse_; ++l) {
+    if (!placed_ || wanted[size_t(l)] != origins_[size_t(l)]) {
+      // Pages that leave lose their slot; those still pending are dropped below.
+      moveWindow(l, wanted[size_t(l)]);
+    }
+  }
+  placed_ = true;
+  std::erase_if(pending_, [&](const Pending& q) { return !inWindow(q.level, q.px, q.py); });
+  // Coarse levels first (they stand in for the finer ones), then nearest to the viewer.
+  auto distance = [&](const Pending& q) {
+    const glm::dvec2 c = cell / std::exp2(double(q.level));
+    return glm::length(glm::dvec2((q.px + 0.5) * p, (q.py + 0.5) * p) - c);
+  };
+  std::sort(pending_.begin(), pending_.end(), [&](const Pending& a, const Pending& b) {
+    if (a.level != b.level) return a.level > b.level;
+    return distance(a) < distance(b);
+  });
+  // Requests of earlier frames are for where the viewer was: ask again, in this frame's order.
+  if (!params_.waitForDisk) store_->clearRequests();
+  int count = 0;
+  size_t next = 0;
+  std::vector<Pending> waiting;
+  for (; next < pending_.size() && count < params_.uploadPagesPerFrame; ++next) {
+    const Pending q = pending_[next];
+    STRATA_TRY(const int layer, cache_->acquire({field_, q.px, q.py, q.level}, params_.waitForDisk));
+    if (layer < 0) {  // its tiles are being decoded: a coarser level stands in meanwhile
+      waiting.push_back(q);
+      continue;
+    }
+    const int k = slots();
+    gl::copyTexels(cache_->pages(), {.layer = layer}, clip_,
+                   {.x = wrap(q.px, k) * p, .y = wrap(q.py, k) * p, .layer = q.level}, p, p);
+    flagsCpu_[flagIndex(q.level, q.px, q.py)] = 1u;
+    flagsDirty_ = true;
+    ++count;
+  }
+  stats_.lastFramePagesWaiting = int(waiting.size());
+  waiting.insert(waiting.end(), pending_.begin() + std::ptrdiff_t(next), pending_.end());
+  pending_ = std::move(waiting);
+  stats_.pagesCopied += uint64_t(count);
+  stats_.lastFramePagesCopied = count;
+  if (flagsDirty_) {
+    for (int l = 0; l < flags_.layers(); ++l) {
+      flags_.upload(flagsCpu_.data() + size_t(l) * size_t(slots()) * size_t(slots()), 0, 0, 0, slots(), slots(), l);
+    }
+    flagsDirty_ = false;
+  }
+  return {};
+}
+
+std::array<float, 4> StreamedElevation::cellQuad(int i, int j) {
+  // Without waitForDisk a tile not in RAM yet is requested, and the coarse level answers
+  // meanwhile (draw() asks for the ground under the viewer every frame).
+  std::optional<gis::Grid<float>> read;
+  if (params_.waitForDisk) {
+    if (auto r = store_->readWindow(field_, {i, j, 2, 2}, 0)) read = std::move(*r);
+  } else if (auto r = store_->tryReadWindow(field_, {i, j, 2, 2}, 0)) {
+    read = std::move(*r);
+  }
+  std::array<float, 4> q{};
+  if (read) {
+    for (size_t k = 0; k < 4; ++k) q[k] = std::isnan(read->data[k]) ? minM_ : read->data[k];
+    return q;
+  }
+  const int s = 1 << coarse_;
+  const auto at = [&](int x, int y) {
+    return coarseCpu_.at(std::clamp(x / s, 0, coarseCpu_.width - 1), std::clamp(y / s, 0, coarseCpu_.height - 1));
+  };
+  return {at(i, j), at(i + 1, j), at(i, j + 1), at(i + 1, j + 1)};
+}
+
+size_t StreamedElevation::gpuBytes() const {
+  size_t b = 0;
+  for (int l = 0; l < coarseTex_.levels(); ++l) {
+    b += size_t(std::max(1, coarseTex_.width() >> l)) * size_t(std::max(1, coarseTex_.height() >> l)) * sizeof(float);
+  }
+  b += size_t(clip_.width()) * size_t(clip_.height()) * size_t(clip_.layers()) * sizeof(float);
+  b += flagsCpu_.size() * sizeof(uint32_t);
+  return b + cache_->stats().bytesAllocated;
+}
+
+StreamStats StreamedElevation::stats() const {
+  StreamStats s = stats_;
+  s.pending = int(pending_.size());
+  s.gpuBytes = gpuBytes();
+  s.cache = cache_->stats();
+  return s;
+}
+
+}  // namespace strata::render

@@ -1,0 +1,77 @@
+#pragma once
+// From a scenario to what the solver starts from: the region cut from the DEM (read as a window,
+// nothing outside it), per-row cell sizes and geodesic cell areas, the layers, the sources
+// placed on cells, the initial water. Checks that need the terrain happen here, before any
+// simulation: the region must lie inside the DEM and every source inside the region; messages
+// name the scenario file, line and key.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <strata/core/result.hpp>
+#include <strata/gis/raster.hpp>
+#include <strata/scenario/scenario.hpp>
+#include <strata/sim/input.hpp>
+
+namespace strata::scenario {
+
+struct ScenarioDomain {
+  gis::Raster bed;                   ///< the region's bedrock elevation (m); georef of the region
+  gis::Grid<uint8_t> inside;         ///< 1 for cells of the region, 0 outside a polygon region (walls)
+  gis::Grid<double> cellAreaM2;      ///< geodesic area of each cell (m^2)
+  sim::SimInput input;               ///< ready for a solver's create()
+  sim::SimParams params;             ///< from [model], [erosion], [water]
+  std::vector<sim::Source> sources;  ///< inflows, on cells
+  std::vector<std::string> sourceNames;
+  std::vector<sim::LevelBoundary> levels;  ///< fixed water levels, on cells (stage in m above the DEM's reference)
+  std::vector<std::string> levelNames;
+  double rainMmPerHour = 0;             ///< uniform rain rate while it falls
+  double rainStartS = 0, rainEndS = 0;  ///< rain falls in [start, end)
+  double damBreakVolumeM3 = 0;          ///< initial water from dam breaks
+  double totalAreaM2 = 0;               ///< area of the region's cells
+  /// What [terrain] breach_inflows carved (nothing when off).
+  struct {
+    int paths = 0, cells = 0;          ///< paths carved, cells changed on them
+    double maxCutM = 0, maxFillM = 0;  ///< the largest lowering and raising (m)
+    double cutM3 = 0, fillM3 = 0;      ///< terrain removed and added
+  } breach;
+  /// What [terrain] fill_depressions raised (nothing when off).
+  struct {
+    int cells = 0;
+    double maxM = 0, volumeM3 = 0;
+  } filled;
+};
+
+/// Elevation given to cells outside a polygon region: a wall no flood in a DEM tops.
+inline constexpr float kWallElevationM = 20000.0f;
+
+/// Builds the domain in named steps: the region's window of the DEM or store, the grid planned
+/// (at least 4 x 4 cells, and a run on it must fit in `memoryBudgetBytes`, 0: the memory the
+/// machine has available; refused naming region.cell_size before anything is read), the bed
+/// (resampled to region.cell_size, mosaicked), the polygon mask, geodesic cell sizes, the layer
+/// stack (with erosion on, some loose material), the model parameters, and the inflows, levels,
+/// rain and dam breaks placed on cells.
+Result<ScenarioDomain> buildDomain(const Scenario& scenario, uint64_t memoryBudgetBytes = 0);
+
+/// Cell sizes of a georeferenced grid as the solvers use them: the geodesic area of each cell,
+/// dy the geodesic length of a column cell, and per-row dx such that dx * dy is the row's cell
+/// area (at the grid's middle column).
+struct CellSizes {
+  gis::Grid<double> cellAreaM2;
+  double dyM = 0;
+  std::vector<double> rowDxM;
+};
+Result<CellSizes> measureCells(const gis::Georef& georef);
+
+/// The solver parameters a scenario's [model], [erosion] and [water] ask for.
+sim::SimParams modelParams(const Scenario& scenario);
+
+/// Cells (x, y) a polyline passes through, each once, in order (sampled at a quarter cell).
+std::vector<std::pair<int, int>> cellsAlong(const std::vector<std::array<double, 2>>& pixelPoints, int width,
+                                            int height);
+
+/// Whether pixel-space point (x, y) lies inside the polygon (even-odd rule).
+bool insidePolygon(const std::vector<std::array<double, 2>>& polygon, double x, double y);
+
+}  // namespace strata::scenario

@@ -1,0 +1,164 @@
+#pragma once
+// A what-if scenario: the terrain, the region, the model, the water, the time and the outputs,
+// read from a TOML file. Every dimensional value carries its unit ("6 h", "12 mm/h",
+// "5000 m3/s"; a bare number is the SI unit: s, m, m/s, m3/s); a wrong unit, an unknown key or an
+// inconsistent value is refused before any work with "file:line: key 'a.b': what is wrong".
+// The format is documented in docs/scenario.md.
+
+#include <array>
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <strata/core/result.hpp>
+#include <strata/core/time_series.hpp>
+#include <strata/sim/params.hpp>
+
+namespace strata::scenario {
+
+/// Where coordinates in the file are given: lon/lat degrees (WGS84 or the body's geographic
+/// CRS), or x/y in the DEM's own CRS.
+enum class CoordFrame { LonLat, DemCrs };
+
+/// Points, a polyline or a polygon, as written in the file.
+struct Place {
+  CoordFrame frame = CoordFrame::LonLat;
+  std::vector<std::array<double, 2>> points;
+  int line = 0;     ///< line in the scenario file, for later messages
+  std::string key;  ///< e.g. "water.inflow[0].at_lonlat"
+};
+
+struct Inflow {
+  std::string name;
+  Place place;            ///< one point (a spring) or a polyline (an inflow line)
+  TimeSeries hydrograph;  ///< discharge (m^3/s) over time (s)
+};
+
+struct Rain {
+  double rateMPerS = 0;          ///< uniform rate
+  std::string raster;            ///< optional raster of rate multipliers (path)
+  double startS = 0, endS = -1;  ///< endS < 0: until the end
+};
+
+/// A volume of water standing behind a (removed) dam at t = 0.
+struct DamBreak {
+  Place polygon;
+  double surfaceElevationM = 0;  ///< water surface inside the polygon
+};
+
+/// A fixed water level (a Dirichlet condition, docs/sim-water.md W26): the cells of a line or a
+/// polygon are held at depth max(0, stage(t) - bed).
+struct Level {
+  std::string name;
+  Place place;           ///< a polyline or a polygon
+  bool polygon = false;  ///< place is a polygon (cells whose centre is inside), else a line
+  TimeSeries stage;      ///< water surface elevation (m) over time (s)
+  int stageLine = 0;     ///< line of `stage` in the file, for later messages
+};
+
+enum class Boundary { Closed, Open };
+
+/// What runs the simulation: the GL backend on a hardware GPU and the CPU backend otherwise
+/// (auto), or one of them by name.
+enum class Backend { kAuto, kCpu, kGpu };
+
+struct LayerSpec {
+  std::string material;   ///< a name from the material table
+  double thicknessM = 0;  ///< uniform thickness, or
+  std::string raster;     ///< a thickness raster
+};
+
+struct Scenario {
+  std::filesystem::path file;  ///< the scenario file; relative paths inside are relative to it
+  std::string name, description;
+  /// The line of every key read ("region.cell_size", "water.inflow[0].hydrograph"; a table's
+  /// own name, e.g. "region", for the table), for messages of checks that come later.
+  std::map<std::string, int> keyLines;
+
+  /// "file:line: key 'k': " (the line where `key` is written; without it when not written), the
+  /// start of every message about a key.
+  std::string at(const std::string& key) const;
+
+  struct {
+    std::vector<std::string> dems;  ///< resolved paths (mosaicked in order)
+    std::string store;
+    std::vector<LayerSpec> layers;  ///< loose material on top of the bedrock DEM, bottom first
+    /// Carve each inflow's least-barrier path to an open edge (docs/scenario.md, "Breaching").
+    bool breachInflows = false;
+    /// Raise every cell that does not drain to an open edge to its spill level (docs/scenario.md).
+    bool fillDepressions = false;
+  } terrain;
+
+  struct {
+    enum Kind { Whole, BBox, Polygon } kind = Whole;
+    Place place;           ///< BBox: two points (west-south, east-north); Polygon: the ring
+    double cellSizeM = 0;  ///< 0: the DEM's own resolution
+  } region;
+
+  struct {
+    sim::WaterModel kind = sim::WaterModel::kFiniteVolume;
+    Backend backend = Backend::kAuto;
+    double manningN = 0.035;   ///< s/m^(1/3)
+    double cfl = 0.45;         ///< flood mode needs <= 0.5 (positivity of the finite-volume scheme)
+    double maxStepS = 30.0;    ///< cap on the adaptive step (s); see docs/scenario.md
+    bool sharpSlopes = false;  ///< flood mode: MC slopes instead of minmod (W21); see docs/sim-water.md
+    std::array<Boundary, 4> boundaries{Boundary::Open, Boundary::Open, Boundary::Open, Boundary::Open};  ///< W E S N
+  } model;
+
+  struct {
+    bool enabled = false;
+    double capacity = 0.05, erosionRate = 0.01, depositionRate = 0.01, dissolutionRate = 0.0;
+    bool thermal = true;
+  } erosion;
+
+  struct {
+    std::vector<Inflow> inflows;
+    std::optional<Rain> rain;
+    std::vector<DamBreak> damBreaks;
+    std::vector<Level> levels;
+    double evaporationMPerS = 0;
+  } water;
+
+  double durationS = 0;
+  double outputIntervalS = 0;
+  /// Time run before t = 0 with every inflow and level held at its t = 0 value and no rain (a
+  /// river's base flow settling into its bed); the outputs and the balance start at t = 0.
+  double spinUpS = 0;
+
+  struct {
+    std::vector<std::string> maps{"max_depth", "max_speed", "arrival_time", "inundation_duration", "final_depth"};
+    double wetThresholdM = 0.05;  ///< depth above which a cell counts as flooded
+    bool pictures = true;
+    bool plots = true;
+  } outputs;
+};
+
+/// At most this many output intervals (each writes the maps, the series and a checkpoint).
+inline constexpr long long kMaxOutputIntervals = 100000;
+
+/// Reads and checks a scenario file (syntax, keys, units, internal consistency). Checks that
+/// need the terrain (region inside the DEM, sources inside the region) come later, once it is read.
+Result<Scenario> loadScenario(const std::filesystem::path& file);
+/// The same from text; `fileName` is used in messages and to resolve relative paths.
+Result<Scenario> parseScenario(std::string_view text, const std::filesystem::path& fileName);
+
+/// "6 h" -> 21600. `dimension` is "time", "length", "rate" (m/s), "discharge" (m3/s) or "speed".
+Result<double> parseQuantity(std::string_view text, std::string_view dimension);
+
+/// "auto", "cpu" or "gpu" (the [model] backend key and the --backend option).
+Result<Backend> parseBackend(std::string_view name);
+
+/// `text` with its control characters escaped ("\\n", "\\x01"): user text quoted in a message
+/// keeps it one line and cannot drive a terminal.
+std::string oneLine(std::string_view text);
+
+/// All output map names the runner knows.
+const std::vector<std::string>& knownOutputMaps();
+/// The maps only an erosion run has (a subset of knownOutputMaps): asked for by default when
+/// erosion is on and [outputs] lists no maps.
+const std::vector<std::string>& erosionOutputMaps();
+
+}  // namespace strata::scenario

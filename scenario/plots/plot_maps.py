@@ -1,0 +1,97 @@
+#!/usr/bin/python3
+"""Draws a Strata run's GeoTIFF maps as PNG pictures over a hillshade of the terrain.
+
+    plot_maps.py RUN_FOLDER
+
+Reads RUN/maps/elevation.tif and every other RUN/maps/*.tif (max_depth, max_speed, arrival_time,
+inundation_duration, final_depth, terrain_change, exposed_material, suspended_sediment) and writes RUN/plots/<name>.png with lon/lat
+(or CRS) axes, a colour bar with units, and the terrain's hillshade underneath.
+"""
+import sys
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+from osgeo import gdal  # noqa: E402
+
+gdal.UseExceptions()
+
+STYLE = {
+    "max_depth": ("Maximum water depth", "m", "Blues", None),
+    "final_depth": ("Water depth at the end", "m", "Blues", None),
+    "max_speed": ("Maximum flow speed", "m/s", "inferno", None),
+    "arrival_time": ("Arrival time of the water", "h", "viridis_r", 1 / 3600.0),
+    "inundation_duration": ("Time under water", "h", "magma_r", 1 / 3600.0),
+    "terrain_change": ("Terrain change (erosion < 0 < deposition)", "m", "RdBu", None),
+    "exposed_material": ("Exposed material at the end (layer number - 1)", "layer", "tab10", None),
+    "suspended_sediment": ("Suspended sediment at the end", "m", "YlOrBr", None),
+}
+
+
+def read(path):
+    ds = gdal.Open(str(path))
+    band = ds.GetRasterBand(1)
+    a = band.ReadAsArray().astype(np.float64)
+    nodata = band.GetNoDataValue()
+    if nodata is not None:
+        a[a == nodata] = np.nan
+    gt = ds.GetGeoTransform()
+    extent = [gt[0], gt[0] + gt[1] * ds.RasterXSize, gt[3] + gt[5] * ds.RasterYSize, gt[3]]
+    geographic = ds.GetSpatialRef() is not None and ds.GetSpatialRef().IsGeographic()
+    return a, extent, gt, geographic
+
+
+def hillshade(z, gt, geographic):
+    dx = abs(gt[1]) * (111320.0 * np.cos(np.radians(gt[3])) if geographic else 1.0)
+    dy = abs(gt[5]) * (110540.0 if geographic else 1.0)
+    gy, gx = np.gradient(z, dy, dx)
+    slope = np.arctan(np.hypot(gx, gy))
+    aspect = np.arctan2(-gx, gy)
+    az, alt = np.radians(315.0), np.radians(45.0)
+    return np.clip(np.sin(alt) * np.cos(slope) + np.cos(alt) * np.sin(slope) * np.cos(az - aspect), 0, 1)
+
+
+def main():
+    if len(sys.argv) != 2:
+        sys.exit(__doc__)
+    run = Path(sys.argv[1])
+    z, extent, gt, geographic = read(run / "maps" / "elevation.tif")
+    shade = hillshade(z, gt, geographic)
+    out = run / "plots"
+    out.mkdir(exist_ok=True)
+    for name, (title, unit, cmap, scale) in STYLE.items():
+        path = run / "maps" / (name + ".tif")
+        if not path.exists():
+            continue
+        a, _, _, _ = read(path)
+        if scale:
+            a = a * scale
+        a = np.ma.masked_invalid(a)
+        if name.endswith("depth") or name in ("inundation_duration", "suspended_sediment"):
+            a = np.ma.masked_less_equal(a, 0)
+        fig, ax = plt.subplots(figsize=(7.5, 6.2))
+        ax.imshow(shade, extent=extent, cmap="gray", vmin=0, vmax=1)
+        if a.count() > 0:
+            if name == "terrain_change":
+                lim = float(np.nanmax(np.abs(a))) or 1.0
+                im = ax.imshow(a, extent=extent, cmap=cmap, vmin=-lim, vmax=lim, alpha=0.85)
+            elif name == "exposed_material":
+                im = ax.imshow(a, extent=extent, cmap=cmap, vmin=-0.5, vmax=9.5, alpha=0.85, interpolation="nearest")
+            else:
+                im = ax.imshow(a, extent=extent, cmap=cmap, alpha=0.85)
+            fig.colorbar(im, ax=ax, shrink=0.8, label=f"{title.lower()} ({unit})")
+        ax.set_title(title)
+        ax.set_xlabel("longitude (°)" if geographic else "x (m)")
+        ax.set_ylabel("latitude (°)" if geographic else "y (m)")
+        fig.tight_layout()
+        tmp = out / (name + ".tmp.png")
+        fig.savefig(tmp, dpi=100)
+        tmp.replace(out / (name + ".png"))
+        plt.close(fig)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,89 @@
+#include "checkpoint.hpp"
+
+#include <strata/core/bytes.hpp>
+#include <strata/sim/state_codec.hpp>
+
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <type_traits>
+
+#ifndef STRATA_VERSION
+#define STRATA_VERSION "unknown"
+#endif
+
+namespace strata::scenario {
+namespace {
+
+constexpr char kMagic[8] = {'S', 'T', 'R', 'A', 'T', 'A', 'C', '4'};
+
+}  // namespace
+
+uint64_t fnv1a(std::string_view text) {
+  uint64_t h = 1469598103934665603ull;
+  for (unsigned char c : text) h = (h ^ c) * 1099511628211ull;
+  return h;
+}
+
+std::string encodeCheckpoint(const CheckpointOwner& owner, const Checkpoint& c) {
+  ByteWriter w;
+  w.out.append(kMagic, sizeof kMagic);
+  w.str(STRATA_VERSION);
+  w.str(owner.command);
+  w.pod(owner.scenarioHash);
+  w.pod(int32_t(c.interval));
+  w.pod(c.wallS);
+  w.vec(c.series);
+  w.pod(c.spinUp);
+  w.str(sim::encodeState(c.state));
+  w.pod(fnv1a(w.out));
+  return w.out;
+}
+
+Result<Checkpoint> decodeCheckpoint(const std::filesystem::path& path, const CheckpointOwner& owner) {
+  std::ifstream f(path, std::ios::binary);
+  if (!f) return fail(path.string() + ": cannot read the checkpoint");
+  std::stringstream ss;
+  ss << f.rdbuf();
+  const std::string data = ss.str();
+  if (data.size() < sizeof kMagic + 8 || std::memcmp(data.data(), kMagic, sizeof kMagic) != 0) {
+    return fail(path.string() + ": not a Strata checkpoint (or one of an older format)");
+  }
+  uint64_t sum = 0;
+  std::memcpy(&sum, data.data() + data.size() - 8, 8);
+  const std::string_view body(data.data(), data.size() - 8);
+  if (fnv1a(body) != sum) return fail(path.string() + ": the checkpoint is damaged (its checksum does not match)");
+  ByteReader r{body, sizeof kMagic};
+  std::string version, command;
+  uint64_t hash = 0;
+  int32_t interval = 0;
+  r.str(version);
+  r.str(command);
+  r.pod(hash);
+  r.pod(interval);
+  if (!r.ok) return fail(path.string() + ": truncated checkpoint");
+  if (version != STRATA_VERSION) {
+    return fail(path.string() + ": written by Strata " + version + ", this is " + STRATA_VERSION +
+                "; run again without --resume");
+  }
+  if (command != owner.command) {
+    return fail(path.string() + ": written by `strata " + command + "`, not `strata " + owner.command + "`");
+  }
+  if (hash != owner.scenarioHash) return fail(path.string() + ": written by a different scenario (the file changed)");
+  Checkpoint c;
+  c.interval = interval;
+  r.pod(c.wallS);
+  r.vec(c.series);
+  r.pod(c.spinUp);
+  std::string state;
+  r.str(state);
+  if (!r.ok || r.at != body.size() || c.interval < 0 || !(c.wallS >= 0)) {
+    return fail(path.string() + ": truncated or corrupt checkpoint");
+  }
+  auto decoded = sim::decodeState(state);
+  if (!decoded) return fail(path.string() + ": corrupt checkpoint (" + decoded.message() + ")");
+  c.state = std::move(decoded).value();
+  return c;
+}
+
+}  // namespace strata::scenario

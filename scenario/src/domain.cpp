@@ -1,0 +1,825 @@
+#include <strata/scenario/domain.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <memory>
+#include <queue>
+#include <set>
+
+#include <strata/core/memory.hpp>
+#include <strata/core/progress.hpp>
+#include <strata/gis/dem_io.hpp>
+#include <strata/gis/geodesy.hpp>
+#include <strata/gis/mosaic.hpp>
+#include <strata/terrain/material.hpp>
+#include <strata/terrain/tile_store.hpp>
+
+namespace strata::scenario {
+namespace {
+
+using terrain::findMaterial;
+using terrain::LayerKind;
+using terrain::Material;
+using terrain::TileStore;
+
+// "file:line: key 'k': message" for a place read from the scenario.
+Error placeError(const Scenario& s, const Place& p, const std::string& message) {
+  return fail(s.file.string() + ":" + std::to_string(p.line) + ": key '" + oneLine(p.key) + "': " + oneLine(message));
+}
+
+// Converts places of the scenario to pixel coordinates of a georef (fractional, (0,0) = top-left
+// corner of the top-left cell).
+class PixelMapper {
+ public:
+  static Result<PixelMapper> create(const gis::Georef& g) {
+    if (!g.transform.isNorthUp()) return fail("the DEM is not north-up (rotated geotransforms are not supported)");
+    PixelMapper m;
+    m.g_ = g;
+    if (!g.geographic) {
+      if (g.body.name != gis::Body::wgs84().name) {
+        m.lonLatError_ = "lon/lat places on a projected CRS of " + g.body.name + " are not supported; use *_xy";
+      } else {
+        auto t = gis::CrsTransform::create("EPSG:4326", g.crsWkt);
+        if (!t) return t.error();
+        m.toCrs_ = std::make_shared<gis::CrsTransform>(std::move(t).value());
+      }
+    }
+    return m;
+  }
+
+  // Pixel coordinates of a place's points.
+  Result<std::vector<std::array<double, 2>>> pixels(const Scenario& s, const Place& p) const {
+    std::vector<std::array<double, 2>> out;
+    for (auto pt : p.points) {
+      double x = pt[0], y = pt[1];
+      if (p.frame == CoordFrame::LonLat) {
+        if (!lonLatError_.empty()) return placeError(s, p, lonLatError_);
+        if (g_.geographic) {
+          // Longitudes 0..360 and -180..180 both: move x into the DEM's longitude range.
+          const double west = g_.transform.c[0], east = west + g_.width * g_.transform.c[1];
+          while (x < west && x + 360 <= east + 1e-9) x += 360;
+          while (x > east && x - 360 >= west - 1e-9) x -= 360;
+        } else if (!toCrs_->transform(1, &x, &y)) {
+          return placeError(
+              s, p, "cannot transform [" + std::to_string(pt[0]) + ", " + std::to_string(pt[1]) + "] to the DEM's CRS");
+        }
+      }
+      out.push_back({(x - g_.transform.c[0]) / g_.transform.c[1], (y - g_.transform.c[3]) / g_.transform.c[5]});
+    }
+    return out;
+  }
+
+ private:
+  gis::Georef g_;
+  std::shared_ptr<gis::CrsTransform> toCrs_;
+  std::string lonLatError_;
+};
+
+std::string describeExtent(const gis::Georef& g) {
+  char buf[160];
+  const double x0 = g.transform.c[0], y0 = g.transform.c[3];
+  const double x1 = x0 + g.width * g.transform.c[1], y1 = y0 + g.height * g.transform.c[5];
+  std::snprintf(buf, sizeof buf, "[%.8g, %.8g, %.8g, %.8g]", std::min(x0, x1), std::min(y0, y1), std::max(x0, x1),
+                std::max(y0, y1));
+  return buf;
+}
+
+// A material layer read from a tile store: its thickness (m) on the region and its material.
+struct StoredLayer {
+  gis::Raster thickness;
+  int material = 0;  ///< index into TerrainSource::materials()
+};
+
+// Where the bed (and stored layers) come from: DEM files read through GDAL, or a tile store read
+// at its base level (level 0, full resolution). The region's window, the resampling and
+// everything after are the same for both.
+class TerrainSource {
+ public:
+  static Result<TerrainSource> open(const Scenario& s) {
+    TerrainSource t;
+    if (s.terrain.store.empty()) {
+      t.path_ = s.terrain.dems.front();
+      STRATA_TRY(auto info, gis::probeDem(t.path_));
+      t.georef_ = info.georef;
+      return t;
+    }
+    t.path_ = s.terrain.store;
+    const std::string key = s.file.string() + ": key 'terrain.store': ";
+    auto store = TileStore::open(t.path_);
+    if (!store) return fail(key + store.message());
+    for (size_t f = 0; f < store->desc().fields.size(); ++f) {
+      const auto& field = store->desc().fields[f];
+      if (field.kind == LayerKind::Bedrock && t.bedField_ < 0) t.bedField_ = int(f);
+      if (field.kind == LayerKind::Material) {
+        if (findMaterial(store->desc().materials, field.material) < 0) {
+          return fail(key + t.path_ + ": field '" + field.name + "' has material \"" + field.material +
+                      "\", which the store's material table lacks");
+        }
+        t.layerFields_.push_back(int(f));
+      }
+    }
+    if (t.bedField_ < 0) return fail(key + t.path_ + ": the store has no bedrock field");
+    t.georef_ = store->windowGeoref({0, 0, store->width(), store->height()}, 0);
+    t.store_ = std::make_shared<TileStore>(std::move(store).value());
+    return t;
+  }
+
+  /// How many material layers the store holds (none for DEMs).
+  int layerCount() const { return int(layerFields_.size()); }
+  /// The full base grid (the first DEM's, or the store's level 0).
+  const gis::Georef& georef() const { return georef_; }
+  const std::string& path() const { return path_; }
+  std::string kind() const { return store_ ? "store" : "DEM"; }
+  /// "DEM <path>" or "store <path>", for messages.
+  std::string name() const { return kind() + " " + path_; }
+  std::vector<Material> materials() const { return store_ ? store_->desc().materials : terrain::defaultMaterials(); }
+
+  /// The bed elevation of `w` (base-grid cells), at the source's own resolution.
+  Result<gis::Raster> readBed(const gis::CellRect& w) const {
+    if (!store_) {
+      gis::ReadOptions ro;
+      ro.window = w;
+      return gis::readDem(path_, ro);
+    }
+    return readField(bedField_, w);
+  }
+
+  /// What gis::warpToGrid resamples the bed from: the DEM file itself (GDAL reads what it needs),
+  /// or, for a store, the window already read (`nativeBed`), held in memory.
+  gis::MosaicInput resampleInput(const gis::Raster& nativeBed) const {
+    if (!store_) return {path_, std::nullopt};
+    return {"", nativeBed};
+  }
+
+  /// The store's material layers over `w`, bottom first (none for DEMs).
+  Result<std::vector<StoredLayer>> readLayers(const gis::CellRect& w) const {
+    std::vector<StoredLayer> out;
+    for (int f : layerFields_) {
+      STRATA_TRY(auto r, readField(f, w));
+      out.push_back({std::move(r), findMaterial(store_->desc().materials, store_->desc().fields[size_t(f)].material)});
+    }
+    return out;
+  }
+
+ private:
+  Result<gis::Raster> readField(int field, const gis::CellRect& w) const {
+    const gis::CellRect sw{w.x, w.y, w.width, w.height};
+    auto values = store_->readWindow(field, sw, 0);
+    if (!values) {
+      return fail(path_ + ": field '" + store_->desc().fields[size_t(field)].name + "': " + values.message());
+    }
+    return gis::Raster{store_->windowGeoref(sw, 0), std::move(values).value()};
+  }
+
+  std::string path_;
+  gis::Georef georef_;
+  std::shared_ptr<TileStore> store_;  // shared: readWindow caches tiles (non-const)
+  int bedField_ = -1;
+  std::vector<int> layerFields_;
+};
+
+}  // namespace
+
+std::vector<std::pair<int, int>> cellsAlong(const std::vector<std::array<double, 2>>& pts, int width, int height) {
+  std::vector<std::pair<int, int>> cells;
+  std::set<std::pair<int, int>> seen;
+  auto add = [&](double x, double y) {
+    // Compared as doubles first: a point far outside (or NaN) must not reach an int conversion.
+    if (!(x >= 0 && y >= 0 && x < width && y < height)) return;
+    const int cx = int(std::floor(x)), cy = int(std::floor(y));
+    if (cx >= width || cy >= height) return;
+    if (seen.insert({cx, cy}).second) cells.push_back({cx, cy});
+  };
+  if (pts.size() == 1) add(pts[0][0], pts[0][1]);
+  for (size_t i = 1; i < pts.size(); ++i) {
+    const double dx = pts[i][0] - pts[i - 1][0], dy = pts[i][1] - pts[i - 1][1];
+    // A quarter cell per sample, over at most the grid's diagonal (the part inside).
+    const double len = std::min(std::hypot(dx, dy), 2.0 * std::hypot(double(width), double(height)) + 2);
+    if (!std::isfinite(len)) continue;
+    const int n = std::max(1, int(std::ceil(4 * len)));
+    for (int k = 0; k <= n; ++k) add(pts[i - 1][0] + dx * k / n, pts[i - 1][1] + dy * k / n);
+  }
+  return cells;
+}
+
+bool insidePolygon(const std::vector<std::array<double, 2>>& poly, double x, double y) {
+  bool in = false;
+  for (size_t i = 0, j = poly.size() - 1; i < poly.size(); j = i++) {
+    const auto &a = poly[i], &b = poly[j];
+    if ((a[1] > y) != (b[1] > y) && x < (b[0] - a[0]) * (y - a[1]) / (b[1] - a[1]) + a[0]) in = !in;
+  }
+  return in;
+}
+
+namespace {
+
+// Where the region lies on the source's grid: the window of source cells it covers, how many
+// region cells a source cell becomes along each axis (region.cell_size), and the polygon in
+// source pixels (empty for a bbox or the whole grid).
+struct RegionFrame {
+  gis::CellRect window;
+  int width = 0, height = 0;  ///< the grid's cells (planGrid)
+  double scaleX = 1.0, scaleY = 1.0;
+  std::vector<std::array<double, 2>> polygonPx;
+
+  // Source pixel coordinates to region cell coordinates.
+  std::vector<std::array<double, 2>> toRegion(std::vector<std::array<double, 2>> px) const {
+    for (auto& p : px) p = {(p[0] - window.x) * scaleX, (p[1] - window.y) * scaleY};
+    return px;
+  }
+};
+
+// Step 1: the region's pixel bounding box, which must lie inside the source.
+Result<RegionFrame> regionWindow(const Scenario& s, const TerrainSource& source, const PixelMapper& mapper) {
+  const gis::Georef& full = source.georef();
+  RegionFrame f;
+  f.window = {0, 0, full.width, full.height};
+  if (s.region.kind == decltype(s.region)::Whole) return f;
+  STRATA_TRY(auto px, mapper.pixels(s, s.region.place));
+  double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300;
+  for (const auto& p : px) {
+    x0 = std::min(x0, p[0]);
+    x1 = std::max(x1, p[0]);
+    y0 = std::min(y0, p[1]);
+    y1 = std::max(y1, p[1]);
+  }
+  if (!(x0 >= -1e-3 && y0 >= -1e-3 && x1 <= full.width + 1e-3 && y1 <= full.height + 1e-3)) {  // 1e-3 px: rounding
+    return placeError(
+        s, s.region.place,
+        "the region is not inside the " + source.name() + " (extent " + describeExtent(full) + " in its CRS)");
+  }
+  auto& w = f.window;
+  w.x = std::clamp(int(std::floor(x0 + 1e-6)), 0, full.width - 1);
+  w.y = std::clamp(int(std::floor(y0 + 1e-6)), 0, full.height - 1);
+  w.width = std::clamp(int(std::ceil(x1 - 1e-6)), w.x + 1, full.width) - w.x;
+  w.height = std::clamp(int(std::ceil(y1 - 1e-6)), w.y + 1, full.height) - w.y;
+  if (w.width < 4 || w.height < 4) {
+    return placeError(s, s.region.place, "the region covers fewer than 4x4 cells of the DEM");
+  }
+  if (s.region.kind == decltype(s.region)::Polygon) f.polygonPx = px;
+  return f;
+}
+
+// Bytes a run holds per cell at its peak with `layers` material layers: the CPU backend's buffers
+// (nine 4-vectors: state, next state, Heun stage, pipe fluxes and diagonals, x and y face fluxes,
+// thermal flows, flood statistics; 8 accumulators; base, bed, tilt, outflow limit, rain; a float
+// per layer), the domain (bed, mask, area in double, base, layers, water, rain), what the run
+// reads back at each interval (depth, flood statistics, layers, terrain change), and the
+// checkpoint (the saved state, and its encoding beside it).
+double bytesPerCell(int layers) {
+  const double solver = 4.0 * (9 * 4 + 8 + 5 + layers);
+  const double domain = 4 + 1 + 8 + 4 + 4.0 * layers + 4 + 4;
+  const double readBack = 4 + 16 + 4.0 * layers + 8;
+  const double checkpoint = 2 * 4.0 * (4 + 4 + 4 + 8 + 4 + layers);
+  return solver + domain + readBack + checkpoint;
+}
+
+// The key a message about the region's size names: cell_size when given, else the region, else
+// the terrain.
+std::string sizeKey(const Scenario& s) {
+  if (s.region.cellSizeM > 0) return "region.cell_size";
+  if (s.region.kind != decltype(s.region)::Whole) return s.region.place.key;
+  return s.terrain.store.empty() ? "terrain.dem" : "terrain.store";
+}
+
+// The window's georeference (the source's, shifted to the window's corner).
+gis::Georef windowGeoref(const gis::Georef& full, const gis::CellRect& w) {
+  gis::Georef g = full;
+  g.transform.c[0] = full.transform.c[0] + w.x * full.transform.c[1];
+  g.transform.c[3] = full.transform.c[3] + w.y * full.transform.c[5];
+  g.width = w.width;
+  g.height = w.height;
+  return g;
+}
+
+// Step 2: the grid, planned before anything is read: the window at region.cell_size (sizes in
+// double, so no count overflows), at least 4 x 4 cells, and a run on it must fit in the memory
+// this process can have (`budget` bytes; 0: what the machine has available).
+Status planGrid(const Scenario& s, const TerrainSource& source, RegionFrame& frame, uint64_t budget) {
+  const gis::Georef g0 = windowGeoref(source.georef(), frame.window);
+  double width = g0.width, height = g0.height;
+  if (s.region.cellSizeM > 0) {
+    STRATA_TRY(auto a, gis::pixelToLonLat(g0, g0.width * 0.5, g0.height * 0.5));
+    STRATA_TRY(auto b, gis::pixelToLonLat(g0, g0.width * 0.5, g0.height * 0.5 + 1));
+    const double nativeM = gis::geodesicDistanceM(a, b, g0.body);
+    const double scale = nativeM / s.region.cellSizeM;
+    width = std::floor(g0.width * scale);
+    height = std::floor(g0.height * scale);
+    if (!(width >= 4 && height >= 4)) {
+      STRATA_TRY(auto west, gis::pixelToLonLat(g0, 0, g0.height * 0.5));
+      STRATA_TRY(auto east, gis::pixelToLonLat(g0, g0.width, g0.height * 0.5));
+      char msg[200];
+      std::snprintf(msg, sizeof msg,
+                    "%.6g m cells give %.0f x %.0f cells over the region (%.4g x %.4g km); at least 4 x 4 are needed",
+                    s.region.cellSizeM, std::max(0.0, width), std::max(0.0, height),
+                    gis::geodesicDistanceM(west, east, g0.body) / 1e3, g0.height * nativeM / 1e3);
+      return fail(s.at("region.cell_size") + msg);
+    }
+    frame.scaleX = width / g0.width;
+    frame.scaleY = height / g0.height;
+  }
+  const int layers = std::max<int>(1, source.layerCount() + int(s.terrain.layers.size()));
+  const double cells = width * height, nativeCells = double(g0.width) * g0.height;
+  // The window as read (and GDAL's copy while it resamples) comes on top.
+  const double bytes = cells * bytesPerCell(layers) + (s.region.cellSizeM > 0 ? 8 * nativeCells : 0);
+  const double available = budget > 0 ? double(budget) : double(availableMemoryBytes());
+  const bool tooWide = width > std::numeric_limits<int>::max() / 2 || height > std::numeric_limits<int>::max() / 2;
+  if (tooWide || (available > 0 && bytes > available)) {
+    char msg[320];
+    std::snprintf(msg, sizeof msg, "%.0f x %.0f = %.4g million cells need about %s of memory, ", width, height,
+                  cells / 1e6, formatBytes(bytes).c_str());
+    char cellSize[64] = "";
+    if (s.region.cellSizeM > 0) std::snprintf(cellSize, sizeof cellSize, "%.6g m cells: ", s.region.cellSizeM);
+    const std::string have = tooWide         ? "more than one grid can index"
+                             : available > 0 ? "and " + formatBytes(available) + " are available"
+                                             : "more than there is";
+    return fail(s.at(sizeKey(s)) + cellSize + msg + have + " (use larger cells or a smaller region)");
+  }
+  frame.width = int(width);
+  frame.height = int(height);
+  return {};
+}
+
+// Step 3: the bed over the window, resampled to region.cell_size (coarser cells take the lowest
+// of the cells they cover: averaging raises a canyon's narrow floor towards its rim and dams the
+// river, docs/scenario.md), mosaicked when the scenario lists several DEMs; and the store's
+// layers on the same grid.
+Status readBed(const Scenario& s, const TerrainSource& source, const RegionFrame& frame, ScenarioDomain& d,
+               std::vector<StoredLayer>& storeLayers) {
+  STRATA_TRY(d.bed, source.readBed(frame.window));
+  STRATA_TRY(storeLayers, source.readLayers(frame.window));
+  if (s.region.cellSizeM > 0) {
+    const auto& g0 = d.bed.georef;
+    gis::Georef target = g0;
+    target.width = frame.width;
+    target.height = frame.height;
+    target.transform.c[1] = g0.transform.c[1] * g0.width / target.width;
+    target.transform.c[5] = g0.transform.c[5] * g0.height / target.height;
+    gis::MosaicInput in = source.resampleInput(d.bed);
+    in.resampling = std::min(frame.scaleX, frame.scaleY) < 1 ? gis::Resampling::Minimum : gis::Resampling::Bilinear;
+    STRATA_TRY(d.bed, gis::warpToGrid(in, target));
+    // Stored layer thicknesses are averaged (bilinear): their volume is what matters, not a channel.
+    for (auto& layer : storeLayers) {
+      STRATA_TRY(layer.thickness, gis::warpToGrid({"", std::move(layer.thickness)}, target));
+    }
+  }
+  if (s.terrain.dems.size() > 1) {
+    std::vector<gis::MosaicInput> inputs;
+    for (const auto& p : s.terrain.dems) {
+      gis::MosaicInput in{p, std::nullopt, gis::BlendMode::Replace};
+      in.resampling = gis::Resampling::MinimumIfCoarser;  // the lowest-elevation rule, as above
+      inputs.push_back(std::move(in));
+    }
+    STRATA_TRY(auto layer, gis::buildMosaic("bedrock", d.bed.georef, inputs));
+    d.bed = std::move(layer.raster);
+  }
+  for (size_t i = 0; i < d.bed.values.size(); ++i) {
+    if (gis::isNoData(d.bed.values.data[i])) {
+      return fail(source.path() + ": the region has cells without data (nodata); choose a region the " + source.kind() +
+                  " covers");
+    }
+  }
+  return {};
+}
+
+// Step 4: the region mask: a polygon's outside becomes a wall.
+void maskRegion(const RegionFrame& frame, ScenarioDomain& d) {
+  const int w = d.bed.georef.width, h = d.bed.georef.height;
+  d.inside = gis::Grid<uint8_t>(w, h, 1);
+  if (frame.polygonPx.empty()) return;
+  const auto poly = frame.toRegion(frame.polygonPx);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) d.inside.at(x, y) = insidePolygon(poly, x + 0.5, y + 0.5) ? 1 : 0;
+  }
+}
+
+// Step 5: geodesic cell sizes and the region's area.
+Status measureRegion(ScenarioDomain& d) {
+  STRATA_TRY(auto sizes, measureCells(d.bed.georef));
+  d.cellAreaM2 = std::move(sizes.cellAreaM2);
+  d.input.dyM = sizes.dyM;
+  d.input.rowDxM = std::move(sizes.rowDxM);
+  for (size_t i = 0; i < d.inside.size(); ++i) {
+    if (d.inside.data[i]) d.totalAreaM2 += d.cellAreaM2.data[i];
+  }
+  return {};
+}
+
+// Step 6: base and layers. The datum is the region's lowest point, so float32 keeps millimetres;
+// cells outside a polygon become walls.
+Status stackLayers(const Scenario& s, const TerrainSource& source, std::vector<StoredLayer>& storeLayers,
+                   ScenarioDomain& d) {
+  const gis::Georef& g = d.bed.georef;
+  const int w = g.width, h = g.height;
+  float lo = 1e30f;
+  for (size_t i = 0; i < d.bed.values.size(); ++i) {
+    if (d.inside.data[i]) lo = std::min(lo, d.bed.values.data[i]);
+  }
+  d.input.datumM = std::floor(double(lo));
+  d.input.baseM = d.bed.values;
+  for (size_t i = 0; i < d.input.baseM.size(); ++i) {
+    if (!d.inside.data[i]) d.input.baseM.data[i] = kWallElevationM;
+  }
+  const auto table = source.materials();
+  for (auto& layer : storeLayers) {
+    gis::Grid<float> thickness = std::move(layer.thickness.values);
+    for (auto& v : thickness.data) v = gis::isNoData(v) ? 0.0f : std::max(0.0f, v);
+    d.input.layersM.push_back(std::move(thickness));
+    d.input.materials.push_back(table[size_t(layer.material)]);
+  }
+  if (d.input.layersM.empty() && s.terrain.layers.empty()) {
+    // Bare rock: one layer of zero thickness so erosion has a material to read.
+    d.input.layersM.push_back(gis::Grid<float>(w, h, 0.0f));
+    d.input.materials.push_back(table[size_t(findMaterial(table, "rock"))]);
+  }
+  for (size_t l = 0; l < s.terrain.layers.size(); ++l) {
+    const auto& spec = s.terrain.layers[l];
+    const int m = findMaterial(table, spec.material);
+    if (m < 0) {
+      std::string names;
+      for (const auto& mat : table) names += (names.empty() ? "" : ", ") + mat.name;
+      return fail(s.at("terrain.layer[" + std::to_string(l) + "].material") + "unknown material \"" + spec.material +
+                  "\" (" + names + ")");
+    }
+    gis::Grid<float> thickness(w, h, float(spec.thicknessM));
+    if (!spec.raster.empty()) {
+      STRATA_TRY(auto r, gis::warpToGrid({spec.raster, std::nullopt}, g));
+      for (size_t i = 0; i < thickness.size(); ++i) {
+        const float v = r.values.data[i];
+        thickness.data[i] = gis::isNoData(v) ? 0.0f : std::max(0.0f, v);
+      }
+    }
+    d.input.layersM.push_back(std::move(thickness));
+    d.input.materials.push_back(table[size_t(m)]);
+  }
+  return {};
+}
+
+// The region cells of a line's points, which must lie inside the region (`what` names it).
+Result<std::vector<std::pair<int, int>>> lineCells(const Scenario& s, const Place& place,
+                                                   const std::vector<std::array<double, 2>>& px,
+                                                   const ScenarioDomain& d, const std::string& what) {
+  const int w = d.inside.width, h = d.inside.height;
+  for (const auto& pt : px) {
+    if (!(pt[0] >= 0 && pt[1] >= 0 && pt[0] < w && pt[1] < h) ||
+        !d.inside.at(int(std::floor(pt[0])), int(std::floor(pt[1])))) {
+      return placeError(s, place, what + " is outside the region");
+    }
+  }
+  auto cells = cellsAlong(px, w, h);
+  std::erase_if(cells, [&](auto c) { return !d.inside.at(c.first, c.second); });
+  return cells;
+}
+
+// The region cells whose centres lie inside a polygon.
+std::vector<std::pair<int, int>> polygonCells(const std::vector<std::array<double, 2>>& px, const ScenarioDomain& d) {
+  std::vector<std::pair<int, int>> cells;
+  for (int y = 0; y < d.inside.height; ++y) {
+    for (int x = 0; x < d.inside.width; ++x) {
+      if (d.inside.at(x, y) && insidePolygon(px, x + 0.5, y + 0.5)) cells.push_back({x, y});
+    }
+  }
+  return cells;
+}
+
+// Step 8: inflows on the cells of their point or line.
+Status placeInflows(const Scenario& s, const PixelMapper& mapper, const RegionFrame& frame, ScenarioDomain& d) {
+  for (const auto& in : s.water.inflows) {
+    STRATA_TRY(auto demPx, mapper.pixels(s, in.place));
+    STRATA_TRY(auto cells, lineCells(s, in.place, frame.toRegion(demPx), d, "the source \"" + in.name + "\""));
+    d.sources.push_back(sim::Source{std::move(cells), in.hydrograph});
+    d.sourceNames.push_back(in.name);
+  }
+  return {};
+}
+
+// Step 9: fixed levels on the cells of a line or a polygon, with a stage that rises above the bed
+// of at least one of them.
+Status placeLevels(const Scenario& s, const PixelMapper& mapper, const RegionFrame& frame, ScenarioDomain& d) {
+  for (size_t i = 0; i < s.water.levels.size(); ++i) {
+    const auto& lv = s.water.levels[i];
+    STRATA_TRY(auto demPx, mapper.pixels(s, lv.place));
+    const auto px = frame.toRegion(demPx);
+    sim::LevelBoundary level{{}, lv.stage};
+    if (lv.polygon) {
+      level.cells = polygonCells(px, d);
+      if (level.cells.empty()) {
+        return placeError(s, lv.place, "the level \"" + lv.name + "\" covers no cell of the region");
+      }
+    } else {
+      STRATA_TRY(level.cells, lineCells(s, lv.place, px, d, "the level \"" + lv.name + "\""));
+    }
+    double lowestBed = 1e300, highestStage = -1e300;
+    for (auto [x, y] : level.cells) {
+      double b = d.input.baseM.at(x, y);
+      for (const auto& l : d.input.layersM) b += l.at(x, y);
+      lowestBed = std::min(lowestBed, b);
+    }
+    for (const auto& st : lv.stage.samples()) highestStage = std::max(highestStage, st[1]);
+    if (highestStage <= lowestBed) {
+      char msg[200];
+      std::snprintf(msg, sizeof msg,
+                    "the stage (at most %.2f m) never rises above the bed of the level's cells (lowest %.2f m): "
+                    "it would hold no water",
+                    highestStage, lowestBed);
+      return fail(s.at("water.level[" + std::to_string(i) + "].stage") + msg);
+    }
+    d.levels.push_back(std::move(level));
+    d.levelNames.push_back(lv.name);
+  }
+  return {};
+}
+
+// Step 10: rain, uniform for a span of time or as a raster of multipliers for the whole run.
+Status placeRain(const Scenario& s, ScenarioDomain& d) {
+  if (!s.water.rain) return {};
+  const gis::Georef& g = d.bed.georef;
+  d.rainMmPerHour = s.water.rain->rateMPerS * 3.6e6;
+  d.rainStartS = s.water.rain->startS;
+  d.rainEndS = s.water.rain->endS < 0 ? s.durationS : s.water.rain->endS;
+  if (s.water.rain->raster.empty()) return {};
+  if (s.water.rain->startS > 0 || s.water.rain->endS >= 0) {
+    return fail(s.at("water.rain.raster") +
+                "a rain raster falls for the whole run; start and end apply to a uniform rate only");
+  }
+  STRATA_TRY(auto r, gis::warpToGrid({s.water.rain->raster, std::nullopt}, g));
+  d.input.rainMmPerHour = gis::Grid<float>(g.width, g.height, 0.0f);
+  for (size_t i = 0; i < r.values.size(); ++i) {
+    const float v = r.values.data[i];
+    d.input.rainMmPerHour.data[i] = gis::isNoData(v) ? 0.0f : float(std::max(0.0f, v) * d.rainMmPerHour);
+  }
+  d.rainMmPerHour = 0;  // the raster carries the rate
+  return {};
+}
+
+// Step 11: dam breaks: water standing up to the given surface inside each polygon.
+Status placeDamBreaks(const Scenario& s, const PixelMapper& mapper, const RegionFrame& frame, ScenarioDomain& d) {
+  const int w = d.bed.georef.width, h = d.bed.georef.height;
+  for (size_t i = 0; i < s.water.damBreaks.size(); ++i) {
+    const auto& db = s.water.damBreaks[i];
+    STRATA_TRY(auto demPx, mapper.pixels(s, db.polygon));
+    const auto cells = polygonCells(frame.toRegion(demPx), d);
+    if (cells.empty()) return placeError(s, db.polygon, "the dam-break polygon covers no cell of the region");
+    if (d.input.waterDepthM.size() == 0) d.input.waterDepthM = gis::Grid<float>(w, h, 0.0f);
+    float lowestBed = std::numeric_limits<float>::max();
+    for (auto [x, y] : cells) {
+      lowestBed = std::min(lowestBed, d.bed.values.at(x, y));
+      const float depth = std::max(0.0f, float(db.surfaceElevationM) - d.bed.values.at(x, y));
+      d.input.waterDepthM.at(x, y) = std::max(d.input.waterDepthM.at(x, y), depth);
+    }
+    if (!(db.surfaceElevationM > lowestBed)) {
+      char msg[200];
+      std::snprintf(msg, sizeof msg,
+                    "the surface (%.2f m) is below the bed of every cell of the polygon (lowest %.2f m): "
+                    "the dam would hold no water",
+                    db.surfaceElevationM, double(lowestBed));
+      return fail(s.at("water.dam_break[" + std::to_string(i) + "].surface") + msg);
+    }
+  }
+  if (d.input.waterDepthM.size() > 0) {
+    for (int y = 0; y < h; ++y) {
+      for (int x = 0; x < w; ++x) d.damBreakVolumeM3 += double(d.input.waterDepthM.at(x, y)) * d.cellAreaM2.at(x, y);
+    }
+  }
+  return {};
+}
+
+// Erosion moves loose material: on bare bedrock (no layer, or layers of no thickness over the
+// region) it would run and change nothing, so it is refused.
+Status requireLooseMaterial(const Scenario& s, const ScenarioDomain& d) {
+  for (const auto& layer : d.input.layersM) {
+    for (size_t i = 0; i < layer.size(); ++i) {
+      if (d.inside.data[i] && layer.data[i] > 0) return {};
+    }
+  }
+  return fail(s.at("terrain") +
+              "erosion needs loose material, and the terrain has none over the region (add a [[terrain.layer]] with "
+              "a material and a thickness, docs/scenario.md)");
+}
+
+// The solver's own check of its parameters. The scenario's ranges are narrower, so it cannot fail
+// on what a file holds; should it, the message names the scenario key, not the solver's field.
+Status checkModelParams(const Scenario& s, const sim::SimParams& p) {
+  const auto status = sim::validateParams(p);
+  if (status.ok()) return {};
+  static const std::pair<const char*, const char*> kKeys[] = {
+      {"cflAlpha", "model.cfl"},
+      {"maxDtS", "model.max_step"},
+      {"manningN", "model.manning_n"},
+      {"evaporationMmPerHour", "water.evaporation"},
+      {"rainMmPerHour", "water.rain.rate"},
+      {"capacityK", "erosion.capacity"},
+      {"erosionRate", "erosion.erosion_rate"},
+      {"depositionRate", "erosion.deposition_rate"},
+  };
+  const std::string& m = status.message();
+  for (const auto& [field, key] : kKeys) {
+    const std::string name = std::string("sim params: ") + field + " = ";
+    if (m.rfind(name, 0) == 0) {
+      const auto must = m.find(": must be");
+      return fail(s.at(key) + "the model refuses it" + (must == std::string::npos ? "" : m.substr(must)));
+    }
+  }
+  return fail(s.file.string() + ": the model refuses these parameters (" + m + ")");
+}
+
+// [terrain] breach_inflows. At a canyon's own DEM resolution the river's floor, narrower than a
+// cell, is averaged with the walls: the grid holds dams across the river that the real one does
+// not have, and a flood ponds behind them. From each inflow, the path to an open edge whose highest
+// cell is lowest (a 4-neighbour priority flood, ties broken by length) is given the non-increasing
+// elevation profile closest to its own (isotonic regression): dams on it are cut, pits on it
+// filled, and it never climbs (a form of least-cost breaching, cf. Lindsay 2016). Cells off the
+// path are left as they are.
+Status breachInflowPaths(const Scenario& s, ScenarioDomain& d) {
+  if (!s.terrain.breachInflows) return {};
+  const int w = d.bed.georef.width, h = d.bed.georef.height;
+  const auto& open = s.model.boundaries;  // W E S N
+  auto outlet = [&](int x, int y) {
+    return (x == 0 && open[0] == Boundary::Open) || (x == w - 1 && open[1] == Boundary::Open) ||
+           (y == h - 1 && open[2] == Boundary::Open) || (y == 0 && open[3] == Boundary::Open);
+  };
+  auto& z = d.input.baseM;
+  for (size_t k = 0; k < d.sources.size(); ++k) {
+    struct Entry {
+      float top;
+      int length;
+      int cell;
+      bool operator>(const Entry& o) const { return top != o.top ? top > o.top : length > o.length; }
+    };
+    std::priority_queue<Entry, std::vector<Entry>, std::greater<>> queue;
+    std::vector<int> from(size_t(w) * size_t(h), -2);  // -2 unseen, -1 a start
+    for (auto [x, y] : d.sources[k].cells) {
+      const int c = y * w + x;
+      if (from[size_t(c)] == -2) queue.push({z.data[size_t(c)], 0, c});
+      from[size_t(c)] = -1;
+    }
+    int end = -1;
+    while (!queue.empty() && end < 0) {
+      const Entry e = queue.top();
+      queue.pop();
+      const int x = e.cell % w, y = e.cell / w;
+      if (outlet(x, y)) end = e.cell;
+      const int next[4][2] = {{x - 1, y}, {x + 1, y}, {x, y - 1}, {x, y + 1}};
+      for (const auto& n : next) {
+        if (n[0] < 0 || n[0] >= w || n[1] < 0 || n[1] >= h) continue;
+        const size_t c = size_t(n[1]) * size_t(w) + size_t(n[0]);
+        if (from[c] != -2 || !d.inside.data[c]) continue;
+        from[c] = e.cell;
+        queue.push({std::max(e.top, z.data[c]), e.length + 1, int(c)});
+      }
+    }
+    if (end < 0) {
+      return fail(s.at("terrain.breach_inflows") + "no open edge can be reached from the inflow \"" + d.sourceNames[k] +
+                  "\" (open an edge in model.boundary)");
+    }
+    std::vector<int> path;
+    for (int c = end; c >= 0; c = from[size_t(c)]) path.push_back(c);
+    std::reverse(path.begin(), path.end());
+    // The non-increasing profile closest to the path's (least squares: pool adjacent violators),
+    // so a dam is cut and a pit on the path is filled by about as much, not a trench dug down to
+    // the deepest pit.
+    struct Pool {
+      double sum;
+      int count;
+      double mean() const { return sum / count; }
+    };
+    std::vector<Pool> pools;
+    for (const int c : path) {
+      pools.push_back({double(z.data[size_t(c)]), 1});
+      while (pools.size() > 1 && pools.back().mean() > pools[pools.size() - 2].mean()) {
+        pools[pools.size() - 2].sum += pools.back().sum;
+        pools[pools.size() - 2].count += pools.back().count;
+        pools.pop_back();
+      }
+    }
+    size_t at = 0;
+    for (const auto& pool : pools) {
+      const float level = float(pool.mean());
+      for (int i = 0; i < pool.count; ++i, ++at) {
+        const size_t c = size_t(path[at]);
+        const double change = double(level) - double(z.data[c]);
+        if (change == 0) continue;
+        ++d.breach.cells;
+        (change < 0 ? d.breach.maxCutM : d.breach.maxFillM) =
+            std::max(change < 0 ? d.breach.maxCutM : d.breach.maxFillM, std::abs(change));
+        (change < 0 ? d.breach.cutM3 : d.breach.fillM3) += std::abs(change) * d.cellAreaM2.data[c];
+        z.data[c] = level;
+        d.bed.values.data[c] = level;
+      }
+    }
+    ++d.breach.paths;
+  }
+  return {};
+}
+
+// [terrain] fill_depressions: every cell not draining to an open edge is raised to the level at
+// which it would spill (priority flood from the open edges, Barnes et al. 2014), so that no water
+// is lost filling the pits a coarse DEM has where the real ground has none. Cells outside a
+// polygon region are walls and are not crossed.
+Status fillDepressions(const Scenario& s, ScenarioDomain& d) {
+  if (!s.terrain.fillDepressions) return {};
+  const int w = d.bed.georef.width, h = d.bed.georef.height;
+  const auto& open = s.model.boundaries;  // W E S N
+  auto& z = d.input.baseM;
+  using Entry = std::pair<float, int>;
+  std::priority_queue<Entry, std::vector<Entry>, std::greater<>> queue;
+  std::vector<uint8_t> seen(size_t(w) * size_t(h), 0);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const size_t c = size_t(y) * size_t(w) + size_t(x);
+      const bool edge = (x == 0 && open[0] == Boundary::Open) || (x == w - 1 && open[1] == Boundary::Open) ||
+                        (y == h - 1 && open[2] == Boundary::Open) || (y == 0 && open[3] == Boundary::Open);
+      if (edge && d.inside.data[c]) {
+        seen[c] = 1;
+        queue.push({z.data[c], int(c)});
+      }
+    }
+  }
+  if (queue.empty()) return fail(s.at("terrain.fill_depressions") + "no edge is open (model.boundary): nothing drains");
+  while (!queue.empty()) {
+    const auto [level, cell] = queue.top();
+    queue.pop();
+    const int x = cell % w, y = cell / w;
+    const int next[4][2] = {{x - 1, y}, {x + 1, y}, {x, y - 1}, {x, y + 1}};
+    for (const auto& n : next) {
+      if (n[0] < 0 || n[0] >= w || n[1] < 0 || n[1] >= h) continue;
+      const size_t c = size_t(n[1]) * size_t(w) + size_t(n[0]);
+      if (seen[c] || !d.inside.data[c]) continue;
+      seen[c] = 1;
+      if (z.data[c] < level) {
+        d.filled.cells += 1;
+        d.filled.maxM = std::max(d.filled.maxM, double(level) - double(z.data[c]));
+        d.filled.volumeM3 += (double(level) - double(z.data[c])) * d.cellAreaM2.data[c];
+        z.data[c] = level;
+        d.bed.values.data[c] = level;
+      }
+      queue.push({z.data[c], int(c)});
+    }
+  }
+  return {};
+}
+
+}  // namespace
+
+Result<CellSizes> measureCells(const gis::Georef& g) {
+  CellSizes c;
+  const int w = g.width, h = g.height;
+  STRATA_TRY(c.cellAreaM2, gis::cellAreasM2(g));
+  STRATA_TRY(auto top, gis::pixelToLonLat(g, w * 0.5, 0));
+  STRATA_TRY(auto bottom, gis::pixelToLonLat(g, w * 0.5, h));
+  c.dyM = gis::geodesicDistanceM(top, bottom, g.body) / h;
+  c.rowDxM.resize(size_t(h));
+  for (int y = 0; y < h; ++y) c.rowDxM[size_t(y)] = c.cellAreaM2.at(w / 2, y) / c.dyM;
+  return c;
+}
+
+sim::SimParams modelParams(const Scenario& s) {
+  sim::SimParams p;
+  p.waterModel = s.model.kind;
+  p.cflAlpha = float(s.model.cfl);
+  // The CFL step (W10) is capped (docs/scenario.md, max_step).
+  p.maxDtS = float(s.model.maxStepS);
+  p.manningN = float(s.model.manningN);
+  p.slopeLimiter = s.model.sharpSlopes ? sim::SlopeLimiter::kMonotonizedCentral : sim::SlopeLimiter::kMinmod;
+  const uint32_t bits[4] = {sim::kEdgeWest, sim::kEdgeEast, sim::kEdgeSouth, sim::kEdgeNorth};
+  p.openEdges = 0;
+  for (int e = 0; e < 4; ++e) {
+    if (s.model.boundaries[size_t(e)] == Boundary::Open) p.openEdges |= bits[e];
+  }
+  p.evaporationMmPerHour = float(s.water.evaporationMPerS * 3.6e6);
+  if (s.erosion.enabled) {
+    p.erosionEnabled = true;
+    p.thermalEnabled = s.erosion.thermal;
+    p.capacityK = float(s.erosion.capacity);
+    p.erosionRate = float(s.erosion.erosionRate);
+    p.depositionRate = float(s.erosion.depositionRate);
+  }
+  return p;
+}
+
+Result<ScenarioDomain> buildDomain(const Scenario& s, uint64_t memoryBudgetBytes) {
+  STRATA_TRY(auto source, TerrainSource::open(s));
+  STRATA_TRY(auto mapper, PixelMapper::create(source.georef()));
+  STRATA_TRY(auto frame, regionWindow(s, source, mapper));
+  STRATA_TRY_STATUS(planGrid(s, source, frame, memoryBudgetBytes));
+  ScenarioDomain d;
+  std::vector<StoredLayer> storeLayers;
+  STRATA_TRY_STATUS(readBed(s, source, frame, d, storeLayers));
+  maskRegion(frame, d);
+  STRATA_TRY_STATUS(measureRegion(d));
+  STRATA_TRY_STATUS(stackLayers(s, source, storeLayers, d));
+  if (s.erosion.enabled) STRATA_TRY_STATUS(requireLooseMaterial(s, d));
+  d.params = modelParams(s);
+  STRATA_TRY_STATUS(checkModelParams(s, d.params));
+  STRATA_TRY_STATUS(placeInflows(s, mapper, frame, d));
+  STRATA_TRY_STATUS(breachInflowPaths(s, d));
+  STRATA_TRY_STATUS(fillDepressions(s, d));
+  STRATA_TRY_STATUS(placeLevels(s, mapper, frame, d));
+  STRATA_TRY_STATUS(placeRain(s, d));
+  STRATA_TRY_STATUS(placeDamBreaks(s, mapper, frame, d));
+  return d;
+}
+
+}  // namespace strata::scenario

@@ -1,0 +1,289 @@
+#include <strata/scenario/report.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+
+#include <strata/core/files.hpp>
+#include <strata/core/log.hpp>
+#include <strata/core/process.hpp>
+#include <strata/core/progress.hpp>
+#include <strata/gis/dem_io.hpp>
+#include <strata/gis/geodesy.hpp>
+
+namespace strata::scenario {
+
+/// The plotting scripts under scenario/plots, compiled in (StrataEmbedText.cmake): an installed
+/// strata needs no file of the source tree.
+std::string_view embeddedText(std::string_view name);
+
+namespace fs = std::filesystem;
+namespace {
+
+std::string fmt(const char* f, double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, f, v);
+  return buf;
+}
+
+std::string millions(double m3) { return fmt("%.1f", m3 / 1e6) + " million m³"; }
+
+std::string hours(double s) { return fmt("%.2f h", s / 3600.0); }
+
+// "36.0586 N, 112.0030 W" for a cell centre.
+std::string where(const gis::Georef& g, int x, int y) {
+  auto ll = gis::pixelToLonLat(g, x + 0.5, y + 0.5);
+  if (!ll) return "cell (" + std::to_string(x) + ", " + std::to_string(y) + ")";
+  const double lon = ll->lonDeg > 180 ? ll->lonDeg - 360 : ll->lonDeg;
+  return fmt("%.4f", std::abs(ll->latDeg)) + (ll->latDeg >= 0 ? " N, " : " S, ") + fmt("%.4f", std::abs(lon)) +
+         (lon >= 0 ? " E" : " W");
+}
+
+struct Extreme {
+  double value = -1;
+  int x = 0, y = 0;
+};
+
+Extreme maxOf(const gis::Grid<float>& g, const gis::Grid<uint8_t>& inside) {
+  Extreme e;
+  for (int y = 0; y < g.height; ++y) {
+    for (int x = 0; x < g.width; ++x) {
+      const float v = g.at(x, y);
+      if (inside.at(x, y) && std::isfinite(v) && v > e.value) e = {double(v), x, y};
+    }
+  }
+  return e;
+}
+
+// Runs an embedded plotting script with Debian's Python (where python3-matplotlib is): the
+// script on standard input, the paths as arguments (no shell: any file name works).
+Status runPlotScript(const std::string& script, const std::vector<std::string>& args) {
+  const std::string_view text = embeddedText(script);
+  STRATA_CHECK(!text.empty()) << script << " is not embedded";
+  std::vector<std::string> argv{"/usr/bin/python3", "-"};
+  argv.insert(argv.end(), args.begin(), args.end());
+  auto out = runProcess(argv, text);
+  if (!out) return fail("report: " + script + ": " + out.message());
+  return {};
+}
+
+}  // namespace
+
+Result<std::vector<std::string>> writePlots(const fs::path& runDir, const gis::Raster& bed, bool completed) {
+  (void)completed;
+  STRATA_TRY_STATUS(gis::writeGeoTiff((runDir / "maps" / "elevation.tif").string(), bed));
+  std::error_code ec;
+  fs::create_directories(runDir / "plots", ec);
+  STRATA_TRY_STATUS(runPlotScript("plot_series.py", {(runDir / "series.csv").string(), (runDir / "plots").string()}));
+  STRATA_TRY_STATUS(runPlotScript("plot_maps.py", {runDir.string()}));
+  std::vector<std::string> files{"maps/elevation.tif"};
+  for (const auto& e : fs::directory_iterator(runDir / "plots")) {
+    if (e.path().extension() == ".png") files.push_back("plots/" + e.path().filename().string());
+  }
+  std::sort(files.begin() + 1, files.end());
+  return files;
+}
+
+// Where the material went: a volume table per layer and the balance (docs/scenario.md, "Erosion
+// outputs").
+std::string materialSection(const MaterialBudget& b) {
+  std::string md = "## Material\n\n";
+  md += "| layer (bottom first) | material | at the start | at the end | change | exposed at the start / end |\n";
+  md += "|---|---|---|---|---|---|\n";
+  double exposedStart = 0;
+  for (double a : b.exposedInitialM2) exposedStart += a;
+  auto share = [&](double a) { return exposedStart > 0 ? fmt("%.1f%%", 100 * a / exposedStart) : std::string("-"); };
+  for (size_t l = 0; l < b.layers.size(); ++l) {
+    md += "| " + std::to_string(l + 1) + " | " + b.layers[l] + " | " + fmt("%.6g", b.initialM3[l]) + " m³ | " +
+          fmt("%.6g", b.finalM3[l]) + " m³ | " + fmt("%+.6g", b.finalM3[l] - b.initialM3[l]) + " m³ | " +
+          share(b.exposedInitialM2[l]) + " / " + share(b.exposedFinalM2[l]) + " |\n";
+  }
+  const double balance = b.balanceM3();
+  md += "\n| balance | m³ |\n|---|---|\n";
+  md += "| eroded (net cut, summed over the cells that lost material) | " + fmt("%.6g", b.erodedM3) + " |\n";
+  md += "| deposited (net fill, summed over the cells that gained) | " + fmt("%.6g", b.depositedM3) + " |\n";
+  md += "| suspended in the water at the end | " + fmt("%.6g", b.suspendedM3) + " |\n";
+  md += "| carried out through open edges | " + fmt("%.6g", b.outflowM3) + " |\n";
+  md += "| deposited + suspended + carried out − eroded (0 up to float rounding) | " + fmt("%.3g", balance) + " (" +
+        fmt("%.2e", b.initialM3Total > 0 ? balance / b.initialM3Total : 0.0) + " of all material) |\n\n";
+  md +=
+      "`maps/exposed_material.tif` holds the layer number − 1 of the topmost material (0 = layer 1); "
+      "`maps/layer_K.tif` each layer's thickness at the end (m).\n\n";
+  return md;
+}
+
+Status writeReport(const fs::path& runDir, const ReportInput& in) {
+  const auto& s = in.scenario;
+  const auto& d = in.domain;
+  const auto& sum = in.summary;
+  const auto& g = d.bed.georef;
+  std::string md;
+  md += "# " + s.name + "\n\n";
+  if (!s.description.empty()) md += s.description + "\n\n";
+  {
+    char date[64];
+    const std::time_t now = std::time(nullptr);
+    std::strftime(date, sizeof date, "%Y-%m-%d %H:%M UTC", std::gmtime(&now));
+    md += "Run " + std::string(date) + " on " + in.backend + ": " + formatDuration(sum.simulatedS) + " simulated in " +
+          formatDuration(sum.wallS) + " of wall time, " + std::to_string(sum.steps) + " steps";
+    if (sum.steps > 0) md += fmt(" (mean step %.2f s)", sum.simulatedS / double(sum.steps));
+    md += ".";
+    if (!sum.completed) md += " **The run was stopped before the end; the numbers are those of the last interval.**";
+    md += "\n\n";
+  }
+
+  // --- Scenario
+  md += "## Scenario\n\n";
+  float lo = 1e30f, hi = -1e30f;
+  for (size_t i = 0; i < d.bed.values.size(); ++i) {
+    if (!d.inside.data[i]) continue;
+    lo = std::min(lo, d.bed.values.data[i]);
+    hi = std::max(hi, d.bed.values.data[i]);
+  }
+  md += "| | |\n|---|---|\n";
+  const std::string terrain =
+      s.terrain.store.empty() ? "`" + s.terrain.dems.front() + "`" : "tile store `" + s.terrain.store + "`";
+  md += "| terrain | " + terrain + " (" + g.crsName + (g.epsg ? ", EPSG:" + std::to_string(*g.epsg) : "") + ", " +
+        g.body.name + ") |\n";
+  md += "| region | " + std::to_string(g.width) + " x " + std::to_string(g.height) + " cells of about " +
+        fmt("%.0f", d.input.rowDxM[d.input.rowDxM.size() / 2]) + " x " + fmt("%.0f", d.input.dyM) + " m, " +
+        fmt("%.0f", d.totalAreaM2 / 1e6) + " km², elevations " + fmt("%.0f", lo) + " to " + fmt("%.0f", hi) + " m |\n";
+  md += std::string("| model | ") +
+        (s.model.kind == sim::WaterModel::kFiniteVolume ? "flood mode (finite-volume shallow water, Manning friction)"
+                                                        : "virtual pipes") +
+        ", Manning n = " + fmt("%.3f", s.model.manningN) + " s/m^(1/3), CFL " + fmt("%.2f", s.model.cfl) +
+        (s.model.kind == sim::WaterModel::kFiniteVolume ? (s.model.sharpSlopes ? ", MC slopes" : ", minmod slopes")
+                                                        : "") +
+        " |\n";
+  const char* edges[4] = {"west", "east", "south", "north"};
+  std::string bounds;
+  for (int e = 0; e < 4; ++e) {
+    bounds += std::string(bounds.empty() ? "" : ", ") + edges[e] + " " +
+              (s.model.boundaries[size_t(e)] == strata::scenario::Boundary::Open ? "open" : "closed");
+  }
+  md += "| edges | " + bounds + " |\n";
+  if (d.breach.paths > 0) {
+    md += "| breached | " + std::to_string(d.breach.paths) +
+          " inflow path(s) to an open edge given the closest profile that never climbs ([terrain] breach_inflows): " +
+          std::to_string(d.breach.cells) + " cells changed, cut by up to " + fmt("%.0f", d.breach.maxCutM) +
+          " m and filled by up to " + fmt("%.0f", d.breach.maxFillM) + " m (" + millions(d.breach.cutM3) + " cut, " +
+          millions(d.breach.fillM3) + " filled) |\n";
+  }
+  if (s.terrain.fillDepressions) {
+    md += "| depressions filled | " + std::to_string(d.filled.cells) +
+          " cells that drained to no open edge raised to their spill level ([terrain] fill_depressions), by up to " +
+          fmt("%.0f", d.filled.maxM) + " m, " + millions(d.filled.volumeM3) + " in all |\n";
+  }
+  for (size_t i = 0; i < s.water.inflows.size(); ++i) {
+    const auto& f = s.water.inflows[i];
+    const double peak = f.hydrograph.maxOver(0, s.durationS);
+    const auto& c = d.sources[i].cells.front();
+    md += "| inflow \"" + f.name + "\" | at " + where(g, c.first, c.second) + ", peak " + fmt("%.0f", peak) +
+          " m³/s, " + millions(f.hydrograph.integral(0, s.durationS)) + " in the run |\n";
+  }
+  if (const auto& u = in.summary.spinUp; u.seconds > 0) {
+    md += "| base flow | " + fmt("%.0f", u.baseFlowM3S) + " m³/s (the inflows at t = 0), run for a spin-up of " +
+          formatDuration(u.seconds) + " before t = 0 (" + std::to_string(u.steps) +
+          " steps): at t = 0 the region held " + millions(u.storedM3) + "; over the spin-up's last tenth " +
+          fmt("%.0f", u.outflowM3S) + " m³/s left it and the stored water changed by " +
+          fmt("%+.0f", u.storageRateM3S) +
+          " m³/s. Every result below is of the run from t = 0: the river's water at t = 0 is the initial water, and "
+          "cells wet at t = 0 count as flooded from the start |\n";
+  }
+  if (s.water.rain) md += "| rain | " + fmt("%.1f", s.water.rain->rateMPerS * 3.6e6) + " mm/h |\n";
+  if (d.damBreakVolumeM3 > 0) md += "| dam break | " + millions(d.damBreakVolumeM3) + " released at t = 0 |\n";
+  md += "| duration | " + formatDuration(s.durationS) + ", outputs every " + formatDuration(s.outputIntervalS) + " |\n";
+  md += "| wet threshold | " + fmt("%.2f", s.outputs.wetThresholdM) + " m |\n\n";
+
+  // --- Results
+  md += "## What happened\n\n";
+  if (sum.series.empty()) {
+    md += "No interval finished.\n";
+  } else {
+    const auto& last = sum.series.back();
+    const auto peakW = *std::max_element(sum.series.begin(), sum.series.end(),
+                                         [](const auto& a, const auto& b) { return a.waterM3 < b.waterM3; });
+    const auto peakA = *std::max_element(sum.series.begin(), sum.series.end(), [](const auto& a, const auto& b) {
+      return a.floodedAreaKm2 < b.floodedAreaKm2;
+    });
+    const auto deep = maxOf(in.flood.maxDepthM, d.inside);
+    const auto fast = maxOf(in.flood.maxSpeedMS, d.inside);
+    double everWet = 0;
+    for (size_t i = 0; i < in.flood.maxDepthM.size(); ++i) {
+      if (d.inside.data[i] && in.flood.maxDepthM.data[i] > s.outputs.wetThresholdM) everWet += d.cellAreaM2.data[i];
+    }
+    const double supplied = last.inflowM3 + last.rainM3 + d.damBreakVolumeM3 + sum.spinUp.storedM3;
+    md += "| quantity | value |\n|---|---|\n";
+    md +=
+        "| water that entered | " + millions(last.inflowM3 + last.rainM3) + " (inflow " + millions(last.inflowM3) +
+        ", rain " + millions(last.rainM3) + ")" +
+        (d.damBreakVolumeM3 > 0 ? " + dam " + millions(d.damBreakVolumeM3) : "") +
+        (sum.spinUp.seconds > 0 ? ", after the " + millions(sum.spinUp.storedM3) + " of the base flow at t = 0" : "") +
+        " |\n";
+    md += "| most water in the region | " + millions(peakW.waterM3) + " at " + hours(peakW.timeS) + " |\n";
+    md += "| largest flooded area | " + fmt("%.1f", peakA.floodedAreaKm2) + " km² at " + hours(peakA.timeS) + " (" +
+          fmt("%.1f", 100 * peakA.floodedAreaKm2 * 1e6 / d.totalAreaM2) + "% of the region) |\n";
+    md += "| area flooded at some time | " + fmt("%.1f", everWet / 1e6) + " km² |\n";
+    md += "| deepest water | " + fmt("%.1f", deep.value) + " m at " + where(g, deep.x, deep.y) + " |\n";
+    md += "| fastest water | " + fmt("%.1f", fast.value) + " m/s at " + where(g, fast.x, fast.y) + " |\n";
+    if (!d.sources.empty()) {
+      // How far the water got: the wet cell farthest (geodesic) from the first inflow.
+      const auto& c0 = d.sources.front().cells.front();
+      auto from = gis::pixelToLonLat(g, c0.first + 0.5, c0.second + 0.5);
+      double farM = 0;
+      int fx = c0.first, fy = c0.second;
+      for (int y = 0; from && y < g.height; ++y) {
+        for (int x = 0; x < g.width; ++x) {
+          if (!(in.flood.maxDepthM.at(x, y) > s.outputs.wetThresholdM)) continue;
+          auto to = gis::pixelToLonLat(g, x + 0.5, y + 0.5);
+          const double m = to ? gis::geodesicDistanceM(*from, *to, g.body) : 0;
+          if (m > farM) {
+            farM = m;
+            fx = x;
+            fy = y;
+          }
+        }
+      }
+      const double arrival = in.flood.arrivalS.at(fx, fy);
+      md += "| farthest reach | " + fmt("%.1f", farM / 1e3) + " km (straight line) from \"" + d.sourceNames.front() +
+            "\", at " + where(g, fx, fy) + (arrival >= 0 ? ", reached at " + hours(arrival) : "") + " |\n";
+    }
+    md += "| water that left through the edges | " + millions(last.outflowM3) +
+          (supplied > 0 ? " (" + fmt("%.0f", 100 * last.outflowM3 / supplied) + "% of what entered" +
+                              (sum.spinUp.seconds > 0 ? " or was there at t = 0)" : ")")
+                        : "") +
+          " |\n";
+    md += "| water in the region at the end | " + millions(last.waterM3) + ", " + fmt("%.1f", last.floodedAreaKm2) +
+          " km² flooded |\n";
+    md += "| volume balance error at the end | " + fmt("%.2e", last.balanceErrorRel) +
+          " (in − out − stored, relative to what entered) |\n";
+    if (s.erosion.enabled) {
+      md += "| ground eroded / deposited | " + fmt("%.0f", last.erodedM3) + " / " + fmt("%.0f", last.depositedM3) +
+            " m³ |\n";
+    }
+    md += "\n";
+  }
+
+  if (sum.material) md += materialSection(*sum.material);
+
+  // --- Maps and plots
+  md += "## Maps\n\nGeoTIFFs in the region's CRS (`maps/`), drawn over a hillshade:\n\n";
+  for (const auto& m : s.outputs.maps) {
+    if (fs::exists(runDir / "plots" / (m + ".png"))) md += "![" + m + "](plots/" + m + ".png)\n";
+  }
+  md += "\n## Time series\n\n`series.csv`, one row per output interval:\n\n";
+  for (const char* p : {"water", "area", "balance", "sediment"}) {
+    if (fs::exists(runDir / "plots" / (std::string(p) + ".png")))
+      md += "![" + std::string(p) + "](plots/" + p + ".png)\n";
+  }
+  if (!in.pictures.empty()) {
+    md += "\n## Pictures\n\n";
+    for (const auto& p : in.pictures) md += "![" + p + "](" + p + ")\n";
+  }
+  md += "\n## Files\n\n";
+  for (const auto& f : sum.files) md += "- `" + f + "`\n";
+  return writeFileAtomic(runDir / "report.md", md);
+}
+
+}  // namespace strata::scenario

@@ -1,0 +1,618 @@
+#include <strata/scenario/run.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <memory>
+#include <optional>
+#include <sstream>
+
+#include <strata/core/file_lock.hpp>
+#include <strata/core/files.hpp>
+#include <strata/core/interrupt.hpp>
+#include <strata/core/log.hpp>
+#include <strata/core/progress.hpp>
+#include <strata/gis/dem_io.hpp>
+#include <strata/gl/context.hpp>
+#include <strata/render/image_io.hpp>
+#include <strata/render/terrain_renderer.hpp>
+#include <strata/scenario/domain.hpp>
+#include <strata/scenario/report.hpp>
+#include <strata/sim/cpu_solver.hpp>
+#include <strata/sim/gl_solver.hpp>
+
+#include "checkpoint.hpp"
+
+namespace strata::scenario {
+namespace fs = std::filesystem;
+namespace {
+
+std::string slurp(const fs::path& p) {
+  std::ifstream f(p, std::ios::binary);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+// Total material thickness per cell (m), for terrain change.
+gis::Grid<float> materialThickness(const std::vector<gis::Grid<float>>& layers) {
+  gis::Grid<float> t(layers.front().width, layers.front().height, 0.0f);
+  for (const auto& l : layers) {
+    for (size_t i = 0; i < t.size(); ++i) t.data[i] += l.data[i];
+  }
+  return t;
+}
+
+// The layer_thickness map of layer k (1 = the bottom one).
+std::string layerMapFile(int k) { return "maps/layer_" + std::to_string(k) + ".tif"; }
+constexpr int kMaxLayerMaps = 64;  // layers beyond this get no map (the report still lists them)
+
+// The files a run writes, relative to its folder: what --overwrite may remove and what makes a
+// folder "hold an earlier run".
+std::vector<std::string> runFolderFiles() {
+  std::vector<std::string> files{"scenario.toml", "series.csv", "checkpoint.bin", "report.md", "maps/elevation.tif"};
+  for (const auto& m : knownOutputMaps()) {
+    if (m == "layer_thickness") continue;  // one file per layer, below
+    files.push_back("maps/" + m + ".tif");
+    files.push_back("plots/" + m + ".png");
+  }
+  for (int k = 1; k <= kMaxLayerMaps; ++k) files.push_back(layerMapFile(k));
+  for (const char* p : {"water", "area", "balance", "sediment"}) files.push_back("plots/" + std::string(p) + ".png");
+  for (const char* p : {"before", "peak", "after"}) files.push_back("pictures/" + std::string(p) + ".png");
+  return files;
+}
+
+// Whether `name` is a temporary of the run file `file` (a file name): file.tmp-PID-N
+// (writeFileAtomic), file.tmp-PID-N.png (pictures), file.tmpPID (GeoTIFFs), stem.tmp.png (plots).
+bool isTemporaryOf(const std::string& name, const std::string& file) {
+  const std::string stem = fs::path(file).stem().string();
+  if (file.ends_with(".png") && name == stem + ".tmp.png") return true;
+  if (!name.starts_with(file + ".tmp")) return false;
+  std::string_view rest(name);
+  rest.remove_prefix(file.size() + 4);
+  if (rest.ends_with(".png")) rest.remove_suffix(4);
+  auto digits = [](std::string_view v) {
+    return !v.empty() && std::all_of(v.begin(), v.end(), [](char c) { return c >= '0' && c <= '9'; });
+  };
+  if (digits(rest)) return true;  // .tmpPID
+  if (!rest.starts_with("-")) return false;
+  rest.remove_prefix(1);
+  const auto dash = rest.find('-');
+  return dash != std::string_view::npos && digits(rest.substr(0, dash)) && digits(rest.substr(dash + 1));
+}
+
+// A run's name as progress lines and logs show it: at most 60 characters, no control characters
+// (the report holds it whole).
+std::string displayName(const std::string& name) {
+  std::string out;
+  for (char c : name.substr(0, 60)) out += (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) ? ' ' : c;
+  if (name.size() > 60) out += "...";
+  return out;
+}
+
+// Takes the run folder for this run: creates it, locks it (one writer per folder), refuses to mix
+// with an earlier run's outputs unless resuming or overwriting (which removes those outputs, and
+// nothing else), then removes the temporaries a killed run left.
+Result<FileLock> takeRunFolder(const RunOptions& opt) {
+  const auto& dir = opt.outDir;
+  if (opt.resume && opt.overwrite) return fail(dir.string() + ": resume or overwrite a run folder, not both");
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) return fail(dir.string() + ": cannot create the run folder: " + ec.message());
+  auto lock = FileLock::acquire(dir / "run.lock");
+  if (!lock) return fail(dir.string() + ": another run is writing into this run folder (" + lock.message() + ")");
+  const auto outputs = opt.resume ? std::vector<std::string>() : runFolderOutputs(dir);
+  if (!outputs.empty() && !opt.overwrite) {
+    std::string list;
+    for (size_t i = 0; i < outputs.size() && i < 4; ++i) list += (i ? ", " : "") + outputs[i];
+    if (outputs.size() > 4) list += ", ...";
+    return fail(dir.string() + ": holds the outputs of an earlier run (" + list +
+                "); continue it with --resume or replace them with --overwrite");
+  }
+  for (const auto& f : outputs) {
+    if (!fs::remove(dir / f, ec) && ec) return fail((dir / f).string() + ": cannot remove: " + ec.message());
+  }
+  for (const auto& t : runFolderTemporaries(dir)) fs::remove(dir / t, ec);
+  return lock;
+}
+
+// What runs the simulation: a GL context when the GL backend or the pictures need one, and the
+// solver. `auto` takes the GL backend on a hardware GPU and the CPU backend when the only GL is
+// a software rasteriser (llvmpipe is slower than the CPU backend) or there is none.
+struct Engine {
+  std::optional<gl::HeadlessContext> context;
+  std::unique_ptr<sim::Solver> solver;
+};
+
+Result<Engine> startEngine(Backend backend, const ScenarioDomain& d, bool pictures) {
+  Engine e;
+  if (backend != Backend::kCpu || pictures) {
+    auto ctx = gl::HeadlessContext::create();
+    if (ctx) {
+      e.context.emplace(std::move(ctx).value());
+    } else if (backend == Backend::kGpu) {
+      return fail("the GPU backend needs a GL 4.5 context: " + ctx.message());
+    } else if (pictures) {
+      return fail("pictures need a GL 4.5 context (run with --no-pictures without one): " + ctx.message());
+    }
+  }
+  const bool gpu =
+      backend == Backend::kGpu || (backend == Backend::kAuto && e.context && !e.context->info().isSoftware());
+  if (gpu) {
+    STRATA_TRY(auto s, sim::GlSolver::create(d.input, d.params));
+    e.solver = std::make_unique<sim::GlSolver>(std::move(s));
+  } else {
+    STRATA_TRY(auto s, sim::CpuSolver::create(d.input, d.params));
+    e.solver = std::make_unique<sim::CpuSolver>(std::move(s));
+  }
+  for (const auto& src : d.sources) STRATA_TRY_STATUS(e.solver->addSource(src));
+  for (const auto& level : d.levels) STRATA_TRY_STATUS(e.solver->addLevel(level));
+  return e;
+}
+
+// Oblique pictures of the region with its water, drawn by the concentric-ring renderer: from a
+// little behind the first inflow (or the region's centre), looking across the region towards its
+// centre, about a quarter of the region's north-south extent above its highest point.
+class Pictures {
+ public:
+  static Result<Pictures> create(const ScenarioDomain& d) {
+    Pictures p;
+    const auto& g = d.bed.georef;
+    STRATA_TRY(p.scene_, render::TerrainScene::create(d.bed));
+    STRATA_TRY(p.ring_, render::RingRenderer::create({.circles = 160}));
+    STRATA_TRY(p.target_, render::OffscreenTarget::create(kWidth, kHeight));
+    const double cx = 0.5 * g.width, cy = 0.5 * g.height;
+    double tx = cx, ty = cy;
+    if (!d.sources.empty()) {
+      tx = d.sources.front().cells.front().first + 0.5;
+      ty = d.sources.front().cells.front().second + 0.5;
+    }
+    // Cell (column, row) offsets in metres: east, north.
+    const double dxM = d.input.rowDxM[d.input.rowDxM.size() / 2], dyM = d.input.dyM;
+    double east = (cx - tx) * dxM, north = (ty - cy) * dyM;
+    if (std::hypot(east, north) < 1) north = 1;  // no inflow: look north from the centre
+    const double camX = std::clamp(tx - 0.15 * (cx - tx), 0.5, g.width - 0.5);
+    const double camY = std::clamp(ty - 0.15 * (cy - ty), 0.5, g.height - 0.5);
+    p.camera_.lon = g.transform.x(camX, camY);
+    p.camera_.lat = g.transform.y(camX, camY);
+    p.camera_.heightM = p.scene_.maxElevationM() + 0.25 * dyM * g.height;
+    p.camera_.headingDeg = std::atan2(east, north) * 180 / M_PI;
+    p.camera_.pitchDeg = -40;
+    p.camera_.fovYDeg = 50;
+    p.shading_.waterDepthScaleM = 15;
+    return p;
+  }
+
+  /// Draws the terrain with `depthM` of water and writes `file` (PNG).
+  Status draw(const gis::Grid<float>& depthM, const fs::path& file) {
+    STRATA_TRY_STATUS(scene_.setWaterDepth(depthM));
+    STRATA_TRY_STATUS(ring_->draw(scene_, camera_, shading_, target_));
+    const auto tmp = temporaryPathFor(file).string() + ".png";
+    STRATA_TRY_STATUS(render::writeImage8(tmp, kWidth, kHeight, 4, target_.colour()));
+    return commitTemporary(tmp, file);
+  }
+
+ private:
+  static constexpr int kWidth = 960, kHeight = 540;
+  render::TerrainScene scene_;
+  std::unique_ptr<render::RingRenderer> ring_;
+  render::OffscreenTarget target_;
+  render::CameraPose camera_;
+  render::Shading shading_;
+};
+
+// The run in progress: the scenario, its domain, the solver and what has been written so far.
+class Run {
+ public:
+  Run(const Scenario& s, const RunOptions& opt, ScenarioDomain d, Engine e)
+      : s_(s),
+        opt_(opt),
+        d_(std::move(d)),
+        e_(std::move(e)),
+        initialMaterial_(materialThickness(solver().readLayers())) {}
+
+  sim::Solver& solver() { return *e_.solver; }
+
+  // Uniform rain while it falls, [start, end).
+  double rainAt(double t) const { return t >= d_.rainStartS && t < d_.rainEndS ? d_.rainMmPerHour : 0.0; }
+
+  Status setRain(double t) {
+    if (float(rainAt(t)) == solver().params().rainMmPerHour) return {};
+    auto p = solver().params();
+    p.rainMmPerHour = float(rainAt(t));
+    return solver().setParams(p);
+  }
+
+  // Advances to `endS`, step by step, switching rain at its times; false if interrupted (the
+  // interval is then abandoned: a resumed run replays it from the last checkpoint, bit for bit).
+  // The last step before `endS` (and before a rain edge) is shortened to land on it; the step W10
+  // chose is kept apart (chosenDtS), since a shortened one says nothing about the flow.
+  Result<bool> advanceTo(double endS) {
+    auto& sv = solver();
+    while (sv.timeS() < endS - 1e-9 * std::max(1.0, endS)) {
+      double next = endS;
+      for (double edge : {d_.rainStartS, d_.rainEndS}) {
+        if (edge > sv.timeS() + 1e-9 && edge < next) next = edge;
+      }
+      STRATA_TRY_STATUS(setRain(sv.timeS()));
+      while (sv.timeS() < next - 1e-9 * std::max(1.0, next)) {
+        chosenDtS_ = sv.nextDt();
+        minChosenDtS_ = std::min(minChosenDtS_, chosenDtS_);
+        sv.stepWithDt(std::min(chosenDtS_, next - sv.timeS()));
+        if (interrupted()) return false;
+      }
+    }
+    return true;
+  }
+
+  // The spin-up: from -seconds to 0 with every source and level at its t = 0 value (a series
+  // holds its first sample before it) and no rain (it starts at t >= 0); then the budgets and the
+  // flood statistics start over, so that every output is of the run from t = 0.
+  Result<SpinUpSummary> spinUp(double seconds, const std::string& name) {
+    auto& sv = solver();
+    SpinUpSummary u;
+    u.seconds = seconds;
+    for (const auto& src : d_.sources) u.baseFlowM3S += src.dischargeM3S.at(0.0);
+    sv.startClockAt(-seconds);
+    Progress progress("spin-up " + name, seconds);
+    // Progress 20 times; the stats also where the last tenth starts (equilibrium is judged there).
+    constexpr int kReports = 20;
+    const double tailStart = -0.1 * seconds;
+    sim::SimStats atTail;
+    for (int c = 1; c <= kReports; ++c) {
+      const double t = c == kReports ? 0.0 : -seconds + seconds * c / kReports;
+      for (const double stop : {std::min(t, tailStart), t}) {
+        STRATA_TRY(const bool done, advanceTo(stop));
+        if (!done) return fail("interrupted during the spin-up (before t = 0: nothing to resume from)");
+        if (atTail.steps == 0 && sv.timeS() >= tailStart - 1e-9 * seconds) atTail = sv.stats();
+      }
+      progress.update(seconds + sv.timeS(), "t = -" + formatDuration(-sv.timeS()));
+    }
+    const auto end = sv.stats();
+    const double dt = end.timeS - atTail.timeS;
+    if (dt > 0) {
+      u.outflowM3S = (end.outflowM3 - atTail.outflowM3) / dt;
+      u.storageRateM3S = (end.storedWaterM3 - atTail.storedWaterM3) / dt;
+    }
+    u.storedM3 = end.storedWaterM3;
+    u.steps = end.steps;
+    progress.finish(std::to_string(end.steps) + " steps");
+    sv.restartBudgets();
+    sv.enableFloodStats(float(s_.outputs.wetThresholdM));
+    return u;
+  }
+
+  /// The step W10 chose last (before any shortening to land on an output time or a rain edge).
+  double chosenDtS() const { return chosenDtS_; }
+
+  // The series row of the interval that just ended.
+  SeriesRow row(const gis::Grid<float>& depth) {
+    const auto st = solver().stats();
+    SeriesRow r;
+    r.timeS = st.timeS;
+    r.steps = st.steps;
+    // The shortest step W10 chose in the interval (a step shortened to land on the output time
+    // or a rain edge says nothing about the flow).
+    r.dtS = minChosenDtS_ < 1e300 ? minChosenDtS_ : st.lastDtS;
+    minChosenDtS_ = 1e300;
+    r.waterM3 = st.storedWaterM3;
+    r.inflowM3 = st.inflowM3;
+    r.rainM3 = st.rainM3;
+    r.outflowM3 = st.outflowM3;
+    r.evaporationM3 = st.evaporatedM3;
+    const double supplied = st.initialWaterM3 + st.rainM3 + st.inflowM3;
+    r.balanceErrorRel = supplied > 0 ? st.waterBalanceM3() / supplied : 0.0;
+    r.maxDepthM = st.maxDepthM;
+    double area = 0;
+    for (size_t i = 0; i < depth.size(); ++i) {
+      if (d_.inside.data[i] && depth.data[i] > s_.outputs.wetThresholdM) area += d_.cellAreaM2.data[i];
+    }
+    r.floodedAreaKm2 = area / 1e6;
+    r.sedimentM3 = st.suspendedM3;
+    if (s_.erosion.enabled) {
+      change_ = materialThickness(solver().readLayers());
+      for (size_t i = 0; i < change_.size(); ++i) {
+        change_.data[i] -= initialMaterial_.data[i];
+        const double v = double(change_.data[i]) * d_.cellAreaM2.data[i];
+        (v < 0 ? r.erodedM3 : r.depositedM3) += std::abs(v);
+      }
+    }
+    return r;
+  }
+
+  // The maps the scenario asks for, as GeoTIFFs in the region's CRS.
+  Status writeMaps(const gis::Grid<float>& depth) {
+    const auto flood = solver().readFloodStats();
+    auto writeMap = [&](const std::string& name, const gis::Grid<float>& values, bool wetOnly) -> Status {
+      if (std::find(s_.outputs.maps.begin(), s_.outputs.maps.end(), name) == s_.outputs.maps.end()) return {};
+      gis::Raster r{d_.bed.georef, values};
+      for (size_t i = 0; i < r.values.size(); ++i) {
+        if (!d_.inside.data[i] || (wetOnly && !(flood.maxDepthM.data[i] > s_.outputs.wetThresholdM))) {
+          r.values.data[i] = gis::kNoData;
+        }
+      }
+      return gis::writeGeoTiff((opt_.outDir / ("maps/" + name + ".tif")).string(), r);
+    };
+    STRATA_TRY_STATUS(writeMap("max_depth", flood.maxDepthM, false));
+    STRATA_TRY_STATUS(writeMap("max_speed", flood.maxSpeedMS, false));
+    STRATA_TRY_STATUS(writeMap("arrival_time", flood.arrivalS, true));
+    STRATA_TRY_STATUS(writeMap("inundation_duration", flood.wetDurationS, false));
+    STRATA_TRY_STATUS(writeMap("final_depth", depth, false));
+    if (s_.erosion.enabled) STRATA_TRY_STATUS(writeErosionMaps(writeMap));
+    return {};
+  }
+
+  // terrain_change (net cut and fill, m), exposed_material (index of the topmost layer with
+  // material, bottom = 0; none: no data), suspended_sediment (m of material in the water) and
+  // layer_thickness (maps/layer_K.tif, K = 1 the bottom layer, each naming its material).
+  template <class WriteMap>
+  Status writeErosionMaps(WriteMap&& writeMap) {
+    STRATA_TRY_STATUS(writeMap("terrain_change", change_, false));
+    const auto layers = solver().readLayers();
+    const int L = int(layers.size());
+    gis::Grid<float> top(layers.front().width, layers.front().height, gis::kNoData);
+    for (size_t i = 0; i < top.size(); ++i) {
+      for (int l = 0; l < L; ++l) {
+        if (layers[size_t(l)].data[i] > 0.0f) top.data[i] = float(l);
+      }
+    }
+    STRATA_TRY_STATUS(writeMap("exposed_material", top, false));
+    STRATA_TRY_STATUS(writeMap("suspended_sediment", solver().readSuspended(), false));
+    if (std::find(s_.outputs.maps.begin(), s_.outputs.maps.end(), "layer_thickness") == s_.outputs.maps.end()) {
+      return {};
+    }
+    for (int l = 0; l < std::min(L, kMaxLayerMaps); ++l) {
+      gis::Raster r{d_.bed.georef, layers[size_t(l)]};
+      for (size_t i = 0; i < r.values.size(); ++i) {
+        if (!d_.inside.data[i]) r.values.data[i] = gis::kNoData;
+      }
+      gis::WriteOptions o;
+      o.metadata = {{"STRATA_LAYER", std::to_string(l + 1)},
+                    {"STRATA_MATERIAL", d_.input.materials[size_t(l)].name},
+                    {"STRATA_UNITS", "m"}};
+      STRATA_TRY_STATUS(gis::writeGeoTiff((opt_.outDir / layerMapFile(l + 1)).string(), r, o));
+    }
+    return {};
+  }
+
+  // Where the material went (the report's balance): per layer, and the solver's totals.
+  MaterialBudget materialBudget() {
+    MaterialBudget b;
+    const auto layers = solver().readLayers();
+    const auto st = solver().stats();
+    const int w = layers.front().width, h = layers.front().height;
+    for (size_t l = 0; l < layers.size(); ++l) {
+      b.layers.push_back(d_.input.materials[l].name);
+      b.initialM3.push_back(0);
+      b.finalM3.push_back(0);
+      b.exposedInitialM2.push_back(0);
+      b.exposedFinalM2.push_back(0);
+    }
+    for (int y = 0; y < h; ++y) {
+      const double area = solver().grid().area(y);  // as the solver's totals (float32 dy)
+      for (int x = 0; x < w; ++x) {
+        int topBefore = -1, topAfter = -1;
+        double change = 0;
+        for (size_t l = 0; l < layers.size(); ++l) {
+          const double before = d_.input.layersM[l].at(x, y), after = layers[l].at(x, y);
+          b.initialM3[l] += before * area;
+          b.finalM3[l] += after * area;
+          change += after - before;
+          if (before > 0) topBefore = int(l);
+          if (after > 0) topAfter = int(l);
+        }
+        (change < 0 ? b.erodedM3 : b.depositedM3) += std::abs(change) * area;
+        if (topBefore >= 0) b.exposedInitialM2[size_t(topBefore)] += area;
+        if (topAfter >= 0) b.exposedFinalM2[size_t(topAfter)] += area;
+      }
+    }
+    b.suspendedM3 = st.suspendedM3;
+    b.outflowM3 = st.sedimentOutflowM3;
+    b.initialM3Total = st.initialMaterialM3;
+    return b;
+  }
+
+  const ScenarioDomain& domain() const { return d_; }
+  // The maps the scenario asks for, as written (by this session or, resumed, by an earlier one).
+  std::vector<std::string> mapFiles() const {
+    std::vector<std::string> files;
+    for (const auto& m : s_.outputs.maps) {
+      if (fs::exists(opt_.outDir / "maps" / (m + ".tif"))) files.push_back("maps/" + m + ".tif");
+    }
+    return files;
+  }
+  std::string backendName() const { return e_.solver->backendName(); }
+
+ private:
+  const Scenario& s_;
+  const RunOptions& opt_;
+  ScenarioDomain d_;
+  Engine e_;
+  gis::Grid<float> initialMaterial_, change_;
+  double chosenDtS_ = 0, minChosenDtS_ = 1e300;
+};
+
+}  // namespace
+
+std::vector<std::string> runFolderOutputs(const fs::path& runDir) {
+  std::vector<std::string> out;
+  for (const auto& f : runFolderFiles()) {
+    if (fs::exists(runDir / f)) out.push_back(f);
+  }
+  return out;
+}
+
+std::vector<std::string> runFolderTemporaries(const fs::path& runDir) {
+  std::vector<std::string> out;
+  const auto files = runFolderFiles();
+  for (const char* sub : {"", "maps", "plots", "pictures"}) {
+    std::error_code ec;
+    for (const auto& e : fs::directory_iterator(runDir / sub, ec)) {
+      const std::string name = e.path().filename().string();
+      const std::string rel = std::string(sub) + (*sub ? "/" : "");
+      const bool ours = std::any_of(files.begin(), files.end(), [&](const std::string& f) {
+        return fs::path(f).parent_path().string() == sub && isTemporaryOf(name, fs::path(f).filename().string());
+      });
+      if (ours && e.is_regular_file(ec)) out.push_back(rel + name);
+    }
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+std::string seriesCsv(const std::vector<SeriesRow>& rows) {
+  std::string out =
+      "time_s,steps,dt_s,water_volume_m3,flooded_area_km2,inflow_m3,rain_m3,outflow_m3,evaporation_m3,"
+      "balance_error_rel,max_depth_m,sediment_m3,eroded_m3,deposited_m3\n";
+  char buf[512];
+  for (const auto& r : rows) {
+    std::snprintf(buf, sizeof buf, "%.3f,%lld,%.6g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.6g,%.6g,%.9g,%.9g,%.9g\n", r.timeS,
+                  r.steps, r.dtS, r.waterM3, r.floodedAreaKm2, r.inflowM3, r.rainM3, r.outflowM3, r.evaporationM3,
+                  r.balanceErrorRel, r.maxDepthM, r.sedimentM3, r.erodedM3, r.depositedM3);
+    out += buf;
+  }
+  return out;
+}
+
+Result<RunSummary> runScenario(const Scenario& s, const RunOptions& opt) {
+  const auto wallStart = std::chrono::steady_clock::now();
+  // Derived sizes first: the interval count (64-bit, bounded; the parser checked it for files,
+  // a scenario built in code is checked here) and, in buildDomain, the grid against memory.
+  const double intervalCount = std::ceil(s.durationS / s.outputIntervalS - 1e-9);
+  if (!(s.durationS > 0 && intervalCount >= 1 && intervalCount <= double(kMaxOutputIntervals))) {
+    char msg[160];
+    std::snprintf(msg, sizeof msg, "%.3g output intervals over the duration (1 to %lld)", intervalCount,
+                  kMaxOutputIntervals);
+    return fail(s.at("time.output_interval") + msg);
+  }
+  const int intervals = int(intervalCount);
+  STRATA_TRY(auto domain, buildDomain(s, opt.memoryBudgetBytes));
+  const auto& g = domain.bed.georef;
+  const std::string name = displayName(s.name);
+  log::info("flood") << name << ": " << g.width << " x " << g.height << " cells, " << domain.totalAreaM2 / 1e6
+                     << " km^2, " << domain.sources.size() << " inflow(s), " << domain.levels.size()
+                     << " fixed level(s), " << formatDuration(s.durationS) << " simulated";
+
+  STRATA_TRY(const FileLock lock, takeRunFolder(opt));
+  std::error_code ec;
+  fs::create_directories(opt.outDir / "maps", ec);
+  if (ec) return fail(opt.outDir.string() + ": cannot create the run folder: " + ec.message());
+  const std::string scenarioText = slurp(s.file);
+  const CheckpointOwner owner{opt.command, fnv1a(scenarioText)};
+  const fs::path checkpointPath = opt.outDir / "checkpoint.bin";
+
+  STRATA_TRY(auto engine, startEngine(opt.backend.value_or(s.model.backend), domain, opt.pictures));
+  engine.solver->enableFloodStats(float(s.outputs.wetThresholdM));
+  Run run(s, opt, std::move(domain), std::move(engine));
+  log::info("flood") << "running on " << run.backendName();
+
+  installInterruptHandler();
+  SpinUpSummary spinUp;
+  if (s.spinUpS > 0 && !opt.resume) {
+    STRATA_TRY(spinUp, run.spinUp(s.spinUpS, name));
+  }
+
+  std::optional<Pictures> pictures;
+  if (opt.pictures) {
+    fs::create_directories(opt.outDir / "pictures", ec);
+    STRATA_TRY(auto p, Pictures::create(run.domain()));
+    pictures.emplace(std::move(p));
+    if (!opt.resume)
+      STRATA_TRY_STATUS(pictures->draw(run.solver().readWaterDepth(), opt.outDir / "pictures" / "before.png"));
+  }
+
+  RunSummary summary;
+  summary.backend = run.backendName();
+  int interval = 0;
+  double earlierWallS = 0;  // of the sessions before a resume
+  if (opt.resume) {
+    if (!fs::exists(checkpointPath)) return fail(checkpointPath.string() + ": no checkpoint to resume from");
+    STRATA_TRY(auto c, decodeCheckpoint(checkpointPath, owner));
+    if (c.interval > intervals) return fail(checkpointPath.string() + ": more intervals than the scenario has");
+    STRATA_TRY_STATUS(run.solver().restoreState(c.state));
+    STRATA_TRY_STATUS(run.setRain(c.state.counters.timeS));
+    interval = c.interval;
+    earlierWallS = c.wallS;
+    spinUp = c.spinUp;
+    summary.series = std::move(c.series);
+    log::info("flood") << "resuming at " << formatDuration(run.solver().timeS()) << " (interval " << interval << ")";
+  } else {
+    STRATA_TRY_STATUS(writeFileAtomic(opt.outDir / "scenario.toml", scenarioText));
+  }
+  summary.spinUp = spinUp;
+
+  auto wallSoFar = [&] {
+    return earlierWallS + std::chrono::duration<double>(std::chrono::steady_clock::now() - wallStart).count();
+  };
+  Progress progress("flood " + name, s.durationS);
+  while (interval < intervals) {
+    const double t0 = interval * s.outputIntervalS, t1 = std::min(s.durationS, (interval + 1) * s.outputIntervalS);
+    // Progress a few times an interval (a bar on a terminal, log lines otherwise).
+    constexpr int kReports = 20;
+    bool stopped = false;
+    for (int c = 0; c < kReports && !stopped; ++c) {
+      STRATA_TRY(const bool done, run.advanceTo(t0 + (t1 - t0) * (c + 1) / kReports));
+      stopped = !done;
+      const auto& sv = run.solver();
+      char note[96];
+      const auto counters = sv.counterStats();
+      std::snprintf(note, sizeof note, "t = %s, %lld steps, dt %.2f s", formatDuration(sv.timeS()).c_str(),
+                    counters.steps, run.chosenDtS());
+      progress.update(sv.timeS(), note);
+    }
+    if (stopped) break;
+
+    // The interval is complete: its row, maps, pictures and checkpoint.
+    const auto depth = run.solver().readWaterDepth();
+    const SeriesRow row = run.row(depth);
+    summary.series.push_back(row);
+    ++interval;
+    if (pictures) {
+      // The peak picture is redrawn whenever the stored water reaches a new high at an interval.
+      const bool peak = std::all_of(summary.series.begin(), summary.series.end(),
+                                    [&](const SeriesRow& r) { return r.waterM3 <= row.waterM3; });
+      if (peak) STRATA_TRY_STATUS(pictures->draw(depth, opt.outDir / "pictures" / "peak.png"));
+      if (interval == intervals) STRATA_TRY_STATUS(pictures->draw(depth, opt.outDir / "pictures" / "after.png"));
+    }
+    STRATA_TRY_STATUS(writeFileAtomic(opt.outDir / "series.csv", seriesCsv(summary.series)));
+    STRATA_TRY_STATUS(run.writeMaps(depth));
+    const Checkpoint c{interval, wallSoFar(), summary.series, spinUp, run.solver().saveState()};
+    STRATA_TRY_STATUS(writeFileAtomic(checkpointPath, encodeCheckpoint(owner, c)));
+    if (opt.stopAfterIntervals >= 0 && interval >= opt.stopAfterIntervals && interval < intervals) break;
+  }
+  const auto st = run.solver().stats();
+  summary.completed = interval >= intervals;
+  summary.simulatedS = st.timeS;
+  summary.steps = st.steps;
+  summary.wallS = wallSoFar();
+  if (summary.completed) {
+    progress.finish(std::to_string(st.steps) + " steps");
+  } else {
+    log::warn("flood") << "stopped at " << formatDuration(summary.series.empty() ? 0 : summary.series.back().timeS)
+                       << "; outputs are those of that interval; continue with --resume";
+  }
+  summary.files = {"scenario.toml", "series.csv", "checkpoint.bin"};
+  const auto maps = run.mapFiles();
+  summary.files.insert(summary.files.end(), maps.begin(), maps.end());
+  for (const char* p : {"pictures/before.png", "pictures/peak.png", "pictures/after.png"}) {
+    if (fs::exists(opt.outDir / p)) summary.files.push_back(p);
+  }
+  if (s.erosion.enabled) {
+    summary.material = run.materialBudget();
+    for (int k = 1; k <= kMaxLayerMaps; ++k) {
+      if (fs::exists(opt.outDir / layerMapFile(k))) summary.files.push_back(layerMapFile(k));
+    }
+  }
+  if (opt.plots) {
+    STRATA_TRY(auto plots, writePlots(opt.outDir, run.domain().bed, summary.completed));
+    summary.files.insert(summary.files.end(), plots.begin(), plots.end());
+  }
+  STRATA_TRY_STATUS(
+      writeReport(opt.outDir, ReportInput{s, run.domain(), summary, run.solver().readFloodStats(), run.backendName()}));
+  summary.files.push_back("report.md");
+  return summary;
+}
+
+}  // namespace strata::scenario

@@ -1,0 +1,959 @@
+#include <strata/scenario/scenario.hpp>
+
+#include <toml++/toml.h>
+
+#include <algorithm>
+#include <cctype>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include <strata/core/progress.hpp>
+
+namespace strata::scenario {
+namespace {
+
+struct Unit {
+  const char* name;
+  const char* dimension;
+  double toSi;
+};
+
+// Units a scenario may use, by dimension. "rate" is a depth per time (rain, evaporation).
+constexpr Unit kUnits[] = {
+    {"s", "time", 1.0},
+    {"min", "time", 60.0},
+    {"h", "time", 3600.0},
+    {"d", "time", 86400.0},
+    {"m", "length", 1.0},
+    {"km", "length", 1000.0},
+    {"mm", "length", 1e-3},
+    {"cm", "length", 1e-2},
+    {"m/s", "rate", 1.0},
+    {"mm/h", "rate", 1e-3 / 3600},
+    {"mm/d", "rate", 1e-3 / 86400},
+    {"m/h", "rate", 1.0 / 3600},
+    {"m3/s", "discharge", 1.0},
+    {"m^3/s", "discharge", 1.0},
+    {"m/s", "speed", 1.0},
+    {"km/h", "speed", 1.0 / 3.6},
+};
+
+std::string unitsOf(std::string_view dimension) {
+  std::string out;
+  for (const auto& u : kUnits) {
+    if (dimension == u.dimension) out += (out.empty() ? "" : ", ") + std::string(u.name);
+  }
+  return out;
+}
+
+// What a number may be: [lo, hi] (lo excluded when loOpen), `hiText` the upper bound as a user
+// writes it ("10 km"). Every number is also checked finite (TOML has nan and inf literals).
+struct Range {
+  double lo = -std::numeric_limits<double>::infinity();
+  double hi = std::numeric_limits<double>::infinity();
+  bool loOpen = false;
+  const char* hiText = "";
+};
+constexpr Range kAny{};
+constexpr Range kPositive{0, std::numeric_limits<double>::infinity(), true, ""};
+constexpr Range kNotNegative{0, std::numeric_limits<double>::infinity(), false, ""};
+
+// What `v` (outside `r`) violates: "must be positive", "must not be negative", "must be at most 10 km".
+std::string rangeText(const Range& r, double v) {
+  if (v > r.hi) return std::string("must be at most ") + r.hiText;
+  if (r.lo == 0) return r.loOpen ? "must be positive" : "must not be negative";
+  return std::string("must be at least -") + r.hiText;
+}
+
+bool inRange(double v, const Range& r) { return (r.loOpen ? v > r.lo : v >= r.lo) && v <= r.hi; }
+
+// "nan", "inf", "-inf" as TOML writes them.
+std::string nonFinite(double v) { return std::isnan(v) ? "nan" : (v > 0 ? "inf" : "-inf"); }
+
+// Errors carry "file:line: key 'path': message". Every key read is recorded with its line
+// (Scenario::keyLines) for checks that come later.
+struct Reader {
+  std::string file;
+  std::filesystem::path baseDir;
+  std::map<std::string, int>* lines = nullptr;
+
+  void note(const toml::node& node, const std::string& key) const {
+    if (lines) lines->emplace(key, int(node.source().begin.line));
+  }
+  Error error(const toml::node& node, const std::string& key, const std::string& message) const {
+    return errorAt(int(node.source().begin.line), key, message);
+  }
+  Error errorAt(int line, const std::string& key, const std::string& message) const {
+    return fail(file + ":" + std::to_string(line) + ": key '" + oneLine(key) + "': " + oneLine(message));
+  }
+
+  // Refuses keys outside `allowed` (catches typos such as "duraton").
+  Status onlyKeys(const toml::table& table, const std::string& prefix,
+                  std::initializer_list<const char*> allowed) const {
+    if (!prefix.empty()) note(table, prefix);
+    for (auto&& [k, v] : table) {
+      const std::string key(k.str());
+      if (std::none_of(allowed.begin(), allowed.end(), [&](const char* a) { return key == a; })) {
+        std::string list;
+        for (const char* a : allowed) list += (list.empty() ? "" : ", ") + std::string(a);
+        return error(v, prefix.empty() ? key : prefix + "." + key, "unknown key (expected one of: " + list + ")");
+      }
+    }
+    return {};
+  }
+
+  // A finite value within `range`.
+  Status check(const toml::node& node, const std::string& key, double v, const Range& range) const {
+    if (!std::isfinite(v)) return error(node, key, "not a finite number (" + nonFinite(v) + ")");
+    if (!inRange(v, range)) return error(node, key, rangeText(range, v));
+    return {};
+  }
+
+  Result<double> quantity(const toml::node& node, const std::string& key, std::string_view dimension,
+                          const Range& range = kAny) const {
+    note(node, key);
+    double v = 0;
+    if (auto n = node.value<double>(); n && (node.is_integer() || node.is_floating_point())) {
+      v = *n;
+    } else if (auto s = node.value<std::string>()) {
+      auto q = parseQuantity(*s, dimension);
+      if (!q) return error(node, key, q.message());
+      v = *q;
+    } else {
+      return error(node, key,
+                   "expected a " + std::string(dimension) + " such as \"10 " +
+                       std::string(unitsOf(dimension).substr(0, unitsOf(dimension).find(','))) + "\"");
+    }
+    STRATA_TRY_STATUS(check(node, key, v, range));
+    return v;
+  }
+
+  Result<double> number(const toml::node& node, const std::string& key, const Range& range = kAny) const {
+    note(node, key);
+    auto n = node.value<double>();
+    if (!n || !(node.is_integer() || node.is_floating_point())) return error(node, key, "expected a number");
+    STRATA_TRY_STATUS(check(node, key, *n, range));
+    return *n;
+  }
+
+  Result<std::string> string(const toml::node& node, const std::string& key) const {
+    note(node, key);
+    if (auto s = node.value<std::string>()) return *s;
+    return error(node, key, "expected a string");
+  }
+
+  Result<bool> boolean(const toml::node& node, const std::string& key) const {
+    note(node, key);
+    if (auto b = node.value<bool>()) return *b;
+    return error(node, key, "expected true or false");
+  }
+
+  std::string path(const std::string& p) const {
+    const std::filesystem::path fp(p);
+    return (fp.is_absolute() ? fp : (baseDir / fp)).lexically_normal().string();
+  }
+
+  // [x, y] pairs: a single pair or an array of pairs, finite; lon/lat in range.
+  Result<Place> place(const toml::node& node, const std::string& key, CoordFrame frame, bool single) const {
+    note(node, key);
+    Place out;
+    out.frame = frame;
+    out.line = int(node.source().begin.line);
+    out.key = key;
+    const auto* arr = node.as_array();
+    if (!arr) return error(node, key, single ? "expected [x, y]" : "expected [[x, y], ...]");
+    auto pair = [&](const toml::node& n) -> Result<std::array<double, 2>> {
+      const auto* p = n.as_array();
+      if (!p || p->size() != 2 || !(*p)[0].is_number() || !(*p)[1].is_number()) {
+        return error(n, key, "expected a coordinate pair [x, y] of numbers");
+      }
+      const std::array<double, 2> xy{(*p)[0].value<double>().value(), (*p)[1].value<double>().value()};
+      for (double v : xy) {
+        if (!std::isfinite(v)) return error(n, key, "not a finite number (" + nonFinite(v) + ")");
+      }
+      return xy;
+    };
+    if (single) {
+      STRATA_TRY(auto p, pair(node));
+      out.points.push_back(p);
+    } else {
+      for (const auto& n : *arr) {
+        STRATA_TRY(auto p, pair(n));
+        out.points.push_back(p);
+      }
+    }
+    if (frame == CoordFrame::LonLat) {
+      for (const auto& p : out.points) {
+        if (p[0] < -180 || p[0] > 360 || p[1] < -90 || p[1] > 90) {
+          return error(node, key,
+                       "longitude/latitude out of range: [" + std::to_string(p[0]) + ", " + std::to_string(p[1]) + "]");
+        }
+      }
+    }
+    return out;
+  }
+
+  // One of `<base>_lonlat` / `<base>_xy` from a table.
+  Result<std::optional<Place>> placeKey(const toml::table& t, const std::string& prefix, const std::string& base,
+                                        bool single) const {
+    const auto* ll = t.get(base + "_lonlat");
+    const auto* xy = t.get(base + "_xy");
+    if (ll && xy)
+      return error(*xy, prefix + "." + base + "_xy", "give either " + base + "_lonlat or " + base + "_xy, not both");
+    if (!ll && !xy) return std::optional<Place>();
+    STRATA_TRY(auto p, place(ll ? *ll : *xy, prefix + "." + base + (ll ? "_lonlat" : "_xy"),
+                             ll ? CoordFrame::LonLat : CoordFrame::DemCrs, single));
+    return std::optional<Place>(std::move(p));
+  }
+};
+
+// A curve of [time, value] pairs under `key`, with optional `<key>_units` = [time unit, value
+// unit] (defaults "s" and `valueUnit`); times strictly increasing and not negative, values finite
+// and within `range` (in SI units).
+struct CurveSpec {
+  const char* key;        // "hydrograph", "stage"
+  const char* valueName;  // "discharge", "water surface elevation"
+  const char* dimension;  // of the value, for parseQuantity
+  const char* valueUnit;  // default unit of the value
+  Range range;            // of the value in SI units
+};
+
+Result<TimeSeries> readCurve(const Reader& r, const toml::table& t, const std::string& prefix, const CurveSpec& c) {
+  const std::string key = prefix + "." + c.key, unitsKey = key + "_units";
+  const std::string pairText = std::string("[time, ") + c.valueName + "]";
+  const auto* pts = t.get(c.key);
+  if (!pts) return r.errorAt(int(t.source().begin.line), key, "missing (pairs " + pairText + ")");
+  r.note(*pts, key);
+  std::string timeUnit = "s", valueUnit = c.valueUnit;
+  const auto* u = t.get(std::string(c.key) + "_units");
+  if (u) {
+    r.note(*u, unitsKey);
+    const auto* a = u->as_array();
+    if (!a || a->size() != 2 || !(*a)[0].is_string() || !(*a)[1].is_string()) {
+      return r.error(
+          *u, unitsKey,
+          std::string("expected [time unit, ") + c.dimension + " unit], e.g. [\"h\", \"" + c.valueUnit + "\"]");
+    }
+    timeUnit = (*a)[0].value<std::string>().value();
+    valueUnit = (*a)[1].value<std::string>().value();
+  }
+  auto tScale = parseQuantity("1 " + timeUnit, "time");
+  if (!tScale) return r.error(u ? *u : *pts, unitsKey, tScale.message());
+  auto vScale = parseQuantity("1 " + valueUnit, c.dimension);
+  if (!vScale) return r.error(u ? *u : *pts, unitsKey, vScale.message());
+  const auto* arr = pts->as_array();
+  if (!arr || arr->empty()) return r.error(*pts, key, "expected [" + pairText + ", ...]");
+  std::vector<TimeSeries::Sample> out;
+  for (const auto& n : *arr) {
+    const auto* p = n.as_array();
+    if (!p || p->size() != 2 || !(*p)[0].is_number() || !(*p)[1].is_number()) {
+      return r.error(n, key, "expected a pair " + pairText + " of numbers");
+    }
+    const double rawT = (*p)[0].value<double>().value(), rawV = (*p)[1].value<double>().value();
+    for (double raw : {rawT, rawV}) {
+      if (!std::isfinite(raw)) return r.error(n, key, "not a finite number (" + nonFinite(raw) + ")");
+    }
+    const double ts = rawT * *tScale, v = rawV * *vScale;
+    if (!std::isfinite(ts) || !std::isfinite(v)) return r.error(n, key, "not a finite number once in SI units");
+    if (c.range.lo == 0 && v < 0) {
+      return r.error(n, key, std::string("negative ") + c.valueName + " " + std::to_string(v) + " " + c.valueUnit);
+    }
+    if (!inRange(v, c.range)) return r.error(n, key, std::string("a ") + c.valueName + " " + rangeText(c.range, v));
+    if (!out.empty() && ts <= out.back()[0]) return r.error(n, key, "times must increase strictly");
+    if (ts < 0) return r.error(n, key, "negative time");
+    out.push_back({ts, v});
+  }
+  return TimeSeries(std::move(out));
+}
+
+// Bounds of what a scenario may ask for (docs/scenario.md, "Ranges"): finite, physically
+// meaningful, and small enough that every derived quantity (float depths, step counts) is too.
+constexpr Range kThickness{0, 1e4, false, "10 km"};
+constexpr Range kElevation{-1e5, 1e5, false, "100 km"};  // water surfaces: any body's relief is within
+constexpr Range kDischarge{0, 1e8, false, "1e8 m3/s"};
+constexpr Range kRate{0, 10.0 / 3600, false, "10 m/h"};  // rain, evaporation
+constexpr Range kManning{0, 1, false, "1"};
+constexpr Range kMaxStep{0, 86400, true, "1 d"};
+constexpr Range kErosionConstant{0, 100, false, "100"};
+constexpr Range kDuration{0, 3650 * 86400.0, true, "3650 d"};
+constexpr Range kSpinUp{0, 365 * 86400.0, false, "365 d"};
+constexpr Range kWetThreshold{0, 100, true, "100 m"};
+
+Result<TimeSeries> readHydrograph(const Reader& r, const toml::table& t, const std::string& prefix) {
+  return readCurve(r, t, prefix, {"hydrograph", "discharge", "discharge", "m3/s", kDischarge});
+}
+
+Status readTerrain(const Reader& r, const toml::table& root, Scenario& s) {
+  const auto* t = root["terrain"].as_table();
+  if (!t) return fail(r.file + ": missing [terrain] (dem = \"file.tif\" or store = \"folder\")");
+  STRATA_TRY_STATUS(r.onlyKeys(*t, "terrain", {"dem", "store", "layer", "breach_inflows", "fill_depressions"}));
+  if (const auto* b = t->get("breach_inflows")) {
+    STRATA_TRY(s.terrain.breachInflows, r.boolean(*b, "terrain.breach_inflows"));
+  }
+  if (const auto* f = t->get("fill_depressions")) {
+    STRATA_TRY(s.terrain.fillDepressions, r.boolean(*f, "terrain.fill_depressions"));
+  }
+  if (const auto* d = t->get("dem")) {
+    if (auto one = d->value<std::string>()) {
+      s.terrain.dems.push_back(r.path(*one));
+    } else if (const auto* a = d->as_array()) {
+      for (const auto& n : *a) {
+        STRATA_TRY(auto p, r.string(n, "terrain.dem"));
+        s.terrain.dems.push_back(r.path(p));
+      }
+    } else {
+      return r.error(*d, "terrain.dem", "expected a file name or a list of file names");
+    }
+  }
+  if (const auto* st = t->get("store")) {
+    STRATA_TRY(auto p, r.string(*st, "terrain.store"));
+    s.terrain.store = r.path(p);
+  }
+  if (s.terrain.dems.empty() == s.terrain.store.empty()) {
+    return r.errorAt(int(t->source().begin.line), "terrain", "give exactly one of dem or store");
+  }
+  if (const auto* layers = t->get("layer")) {
+    const auto* arr = layers->as_array();
+    if (!arr) return r.error(*layers, "terrain.layer", "expected [[terrain.layer]] tables");
+    for (size_t i = 0; i < arr->size(); ++i) {
+      const std::string key = "terrain.layer[" + std::to_string(i) + "]";
+      const auto* lt = (*arr)[i].as_table();
+      if (!lt) return r.error((*arr)[i], key, "expected a table");
+      STRATA_TRY_STATUS(r.onlyKeys(*lt, key, {"material", "thickness", "raster"}));
+      LayerSpec l;
+      if (!lt->get("material")) return r.error(*lt, key + ".material", "missing");
+      STRATA_TRY(l.material, r.string(*lt->get("material"), key + ".material"));
+      if (const auto* th = lt->get("thickness")) {
+        STRATA_TRY(l.thicknessM, r.quantity(*th, key + ".thickness", "length"));
+        if (l.thicknessM < 0) return r.error(*th, key + ".thickness", "negative thickness");
+        STRATA_TRY_STATUS(r.check(*th, key + ".thickness", l.thicknessM, kThickness));
+      }
+      if (const auto* ra = lt->get("raster")) {
+        STRATA_TRY(auto p, r.string(*ra, key + ".raster"));
+        l.raster = r.path(p);
+      }
+      s.terrain.layers.push_back(std::move(l));
+    }
+  }
+  return {};
+}
+
+Status readRegion(const Reader& r, const toml::table& root, Scenario& s) {
+  const auto* t = root["region"].as_table();
+  if (!t) return {};  // the whole DEM
+  STRATA_TRY_STATUS(r.onlyKeys(*t, "region", {"bbox_lonlat", "bbox_xy", "polygon_lonlat", "polygon_xy", "cell_size"}));
+  STRATA_TRY(auto poly, r.placeKey(*t, "region", "polygon", false));
+  const auto* bll = t->get("bbox_lonlat");
+  const auto* bxy = t->get("bbox_xy");
+  if (bll && bxy) return r.error(*bxy, "region.bbox_xy", "give either bbox_lonlat or bbox_xy, not both");
+  if ((bll || bxy) && poly) return r.errorAt(poly->line, poly->key, "give either a bbox or a polygon, not both");
+  if (bll || bxy) {
+    // Written [west, south, east, north].
+    const toml::node& node = bll ? *bll : *bxy;
+    const std::string key = bll ? "region.bbox_lonlat" : "region.bbox_xy";
+    const auto* a = node.as_array();
+    if (!a || a->size() != 4 || std::any_of(a->begin(), a->end(), [](const toml::node& n) { return !n.is_number(); })) {
+      return r.error(node, key, "expected [west, south, east, north]");
+    }
+    r.note(node, key);
+    const double w = (*a)[0].value<double>().value(), so = (*a)[1].value<double>().value(),
+                 e = (*a)[2].value<double>().value(), n = (*a)[3].value<double>().value();
+    for (double v : {w, so, e, n}) {
+      if (!std::isfinite(v)) return r.error(node, key, "not a finite number (" + nonFinite(v) + ")");
+    }
+    if (!(w < e) || !(so < n)) return r.error(node, key, "west must be < east and south < north");
+    if (bll && (w < -180 || e > 360 || so < -90 || n > 90)) {
+      return r.error(node, key, "longitude/latitude out of range");
+    }
+    s.region.kind = decltype(s.region)::BBox;
+    s.region.place =
+        Place{bll ? CoordFrame::LonLat : CoordFrame::DemCrs, {{w, so}, {e, n}}, int(node.source().begin.line), key};
+  }
+  if (poly) {
+    if (poly->points.size() < 3) return r.errorAt(poly->line, poly->key, "a polygon needs at least 3 points");
+    s.region.kind = decltype(s.region)::Polygon;
+    s.region.place = *poly;
+  }
+  if (const auto* c = t->get("cell_size")) {
+    STRATA_TRY(s.region.cellSizeM, r.quantity(*c, "region.cell_size", "length", kPositive));
+  }
+  return {};
+}
+
+Status readModel(const Reader& r, const toml::table& root, Scenario& s) {
+  const auto* t = root["model"].as_table();
+  if (!t) return {};
+  STRATA_TRY_STATUS(r.onlyKeys(*t, "model", {"kind", "manning_n", "cfl", "max_step", "slopes", "boundary", "backend"}));
+  if (const auto* k = t->get("kind")) {
+    STRATA_TRY(auto v, r.string(*k, "model.kind"));
+    if (v == "flood") {
+      s.model.kind = sim::WaterModel::kFiniteVolume;
+    } else if (v == "pipe") {
+      s.model.kind = sim::WaterModel::kVirtualPipes;
+    } else {
+      return r.error(*k, "model.kind", "expected \"flood\" or \"pipe\", got \"" + v + "\"");
+    }
+  }
+  if (const auto* b = t->get("backend")) {
+    STRATA_TRY(auto v, r.string(*b, "model.backend"));
+    auto backend = parseBackend(v);
+    if (!backend) return r.error(*b, "model.backend", backend.message());
+    s.model.backend = *backend;
+  }
+  if (const auto* n = t->get("manning_n")) {
+    STRATA_TRY(s.model.manningN, r.number(*n, "model.manning_n"));
+    if (!inRange(s.model.manningN, kManning)) {
+      return r.error(*n, "model.manning_n", "Manning's n in s/m^(1/3) is between 0 and ~0.2 for natural channels");
+    }
+  }
+  if (const auto* c = t->get("cfl")) {
+    STRATA_TRY(s.model.cfl, r.number(*c, "model.cfl"));
+    if (!(s.model.cfl > 0 && s.model.cfl <= 1)) return r.error(*c, "model.cfl", "must be in (0, 1]");
+    if (s.model.kind == sim::WaterModel::kFiniteVolume && s.model.cfl > 0.5) {
+      return r.error(*c, "model.cfl", "flood mode needs cfl <= 0.5 (positivity of the finite-volume scheme)");
+    }
+  }
+  if (const auto* m = t->get("max_step")) {
+    STRATA_TRY(s.model.maxStepS, r.quantity(*m, "model.max_step", "time", kMaxStep));
+  }
+  if (const auto* l = t->get("slopes")) {
+    STRATA_TRY(auto v, r.string(*l, "model.slopes"));
+    if (v != "minmod" && v != "mc")
+      return r.error(*l, "model.slopes", "expected \"minmod\" or \"mc\", got \"" + v + "\"");
+    s.model.sharpSlopes = v == "mc";
+  }
+  if (const auto* b = t->get("boundary")) {
+    auto parse = [&](const toml::node& n, const std::string& key) -> Result<Boundary> {
+      STRATA_TRY(auto v, r.string(n, key));
+      if (v == "open") return Boundary::Open;
+      if (v == "closed") return Boundary::Closed;
+      return r.error(n, key, "expected \"open\" or \"closed\", got \"" + v + "\"");
+    };
+    if (b->is_string()) {
+      STRATA_TRY(auto all, parse(*b, "model.boundary"));
+      s.model.boundaries = {all, all, all, all};
+    } else if (const auto* bt = b->as_table()) {
+      STRATA_TRY_STATUS(r.onlyKeys(*bt, "model.boundary", {"west", "east", "south", "north"}));
+      const char* names[4] = {"west", "east", "south", "north"};
+      for (int i = 0; i < 4; ++i) {
+        if (const auto* e = bt->get(names[i])) {
+          STRATA_TRY(s.model.boundaries[size_t(i)], parse(*e, std::string("model.boundary.") + names[i]));
+        }
+      }
+    } else {
+      return r.error(*b, "model.boundary", "expected \"open\", \"closed\" or { west = ..., east = ... }");
+    }
+  }
+  return {};
+}
+
+Status readErosion(const Reader& r, const toml::table& root, Scenario& s) {
+  const auto* t = root["erosion"].as_table();
+  if (!t) return {};
+  STRATA_TRY_STATUS(r.onlyKeys(
+      *t, "erosion", {"enabled", "capacity", "erosion_rate", "deposition_rate", "dissolution_rate", "thermal"}));
+  if (const auto* e = t->get("enabled")) {
+    STRATA_TRY(s.erosion.enabled, r.boolean(*e, "erosion.enabled"));
+  }
+  if (const auto* e = t->get("thermal")) {
+    STRATA_TRY(s.erosion.thermal, r.boolean(*e, "erosion.thermal"));
+  }
+  const std::pair<const char*, double*> numbers[] = {{"capacity", &s.erosion.capacity},
+                                                     {"erosion_rate", &s.erosion.erosionRate},
+                                                     {"deposition_rate", &s.erosion.depositionRate},
+                                                     {"dissolution_rate", &s.erosion.dissolutionRate}};
+  for (const auto& [name, out] : numbers) {
+    if (const auto* n = t->get(name)) {
+      STRATA_TRY(*out, r.number(*n, std::string("erosion.") + name, kErosionConstant));
+    }
+  }
+  return {};
+}
+
+Status readWater(const Reader& r, const toml::table& root, Scenario& s) {
+  const auto* t = root["water"].as_table();
+  if (!t) return {};
+  STRATA_TRY_STATUS(r.onlyKeys(*t, "water", {"inflow", "rain", "dam_break", "level", "evaporation"}));
+  if (const auto* e = t->get("evaporation")) {
+    STRATA_TRY(s.water.evaporationMPerS, r.quantity(*e, "water.evaporation", "rate", kRate));
+  }
+  if (const auto* in = t->get("inflow")) {
+    const auto* arr = in->as_array();
+    if (!arr) return r.error(*in, "water.inflow", "expected [[water.inflow]] tables");
+    for (size_t i = 0; i < arr->size(); ++i) {
+      const std::string key = "water.inflow[" + std::to_string(i) + "]";
+      const auto* it = (*arr)[i].as_table();
+      if (!it) return r.error((*arr)[i], key, "expected a table");
+      STRATA_TRY_STATUS(r.onlyKeys(
+          *it, key, {"name", "at_lonlat", "at_xy", "line_lonlat", "line_xy", "hydrograph", "hydrograph_units"}));
+      Inflow f;
+      f.name = it->get("name") ? it->get("name")->value_or(std::string()) : "inflow " + std::to_string(i + 1);
+      STRATA_TRY(auto at, r.placeKey(*it, key, "at", true));
+      STRATA_TRY(auto line, r.placeKey(*it, key, "line", false));
+      if (at && line) return r.errorAt(line->line, line->key, "give a point (at_...) or a line (line_...), not both");
+      if (!at && !line)
+        return r.errorAt(int(it->source().begin.line), key, "missing at_lonlat / at_xy / line_lonlat / line_xy");
+      f.place = at ? *at : *line;
+      if (line && line->points.size() < 2) return r.errorAt(line->line, line->key, "a line needs at least 2 points");
+      STRATA_TRY(f.hydrograph, readHydrograph(r, *it, key));
+      s.water.inflows.push_back(std::move(f));
+    }
+  }
+  if (const auto* rn = t->get("rain")) {
+    const auto* rt = rn->as_table();
+    if (!rt) return r.error(*rn, "water.rain", "expected a table");
+    STRATA_TRY_STATUS(r.onlyKeys(*rt, "water.rain", {"rate", "raster", "start", "end"}));
+    Rain rain;
+    if (!rt->get("rate")) return r.errorAt(int(rt->source().begin.line), "water.rain.rate", "missing");
+    STRATA_TRY(rain.rateMPerS, r.quantity(*rt->get("rate"), "water.rain.rate", "rate", kRate));
+    if (const auto* ra = rt->get("raster")) {
+      STRATA_TRY(auto p, r.string(*ra, "water.rain.raster"));
+      rain.raster = r.path(p);
+    }
+    if (const auto* st = rt->get("start")) {
+      STRATA_TRY(rain.startS, r.quantity(*st, "water.rain.start", "time"));
+      if (rain.startS < 0) return r.error(*st, "water.rain.start", "negative time");
+      if (rain.startS >= s.durationS) {
+        return r.error(*st, "water.rain.start",
+                       "the rain starts after the run ends (time.duration is " + formatDuration(s.durationS) + ")");
+      }
+    }
+    if (const auto* en = rt->get("end")) {
+      STRATA_TRY(rain.endS, r.quantity(*en, "water.rain.end", "time"));
+    }
+    if (rt->get("end") && rain.endS <= rain.startS)
+      return r.error(*rt->get("end"), "water.rain.end", "must be after start");
+    s.water.rain = rain;
+  }
+  if (const auto* db = t->get("dam_break")) {
+    const auto* arr = db->as_array();
+    if (!arr) return r.error(*db, "water.dam_break", "expected [[water.dam_break]] tables");
+    for (size_t i = 0; i < arr->size(); ++i) {
+      const std::string key = "water.dam_break[" + std::to_string(i) + "]";
+      const auto* dt = (*arr)[i].as_table();
+      if (!dt) return r.error((*arr)[i], key, "expected a table");
+      STRATA_TRY_STATUS(r.onlyKeys(*dt, key, {"polygon_lonlat", "polygon_xy", "surface"}));
+      DamBreak d;
+      STRATA_TRY(auto poly, r.placeKey(*dt, key, "polygon", false));
+      if (!poly || poly->points.size() < 3)
+        return r.errorAt(int(dt->source().begin.line), key + ".polygon_lonlat",
+                         "a polygon of at least 3 points is needed");
+      d.polygon = *poly;
+      if (!dt->get("surface"))
+        return r.errorAt(int(dt->source().begin.line), key + ".surface", "missing (water surface elevation)");
+      STRATA_TRY(d.surfaceElevationM, r.quantity(*dt->get("surface"), key + ".surface", "length", kElevation));
+      s.water.damBreaks.push_back(std::move(d));
+    }
+  }
+  if (const auto* lv = t->get("level")) {
+    const auto* arr = lv->as_array();
+    if (!arr) return r.error(*lv, "water.level", "expected [[water.level]] tables");
+    for (size_t i = 0; i < arr->size(); ++i) {
+      const std::string key = "water.level[" + std::to_string(i) + "]";
+      const auto* lt = (*arr)[i].as_table();
+      if (!lt) return r.error((*arr)[i], key, "expected a table");
+      STRATA_TRY_STATUS(r.onlyKeys(
+          *lt, key, {"name", "line_lonlat", "line_xy", "polygon_lonlat", "polygon_xy", "stage", "stage_units"}));
+      Level l;
+      l.name = lt->get("name") ? lt->get("name")->value_or(std::string()) : "level " + std::to_string(i + 1);
+      STRATA_TRY(auto line, r.placeKey(*lt, key, "line", false));
+      STRATA_TRY(auto poly, r.placeKey(*lt, key, "polygon", false));
+      if (line && poly) return r.errorAt(poly->line, poly->key, "give a line (line_...) or a polygon, not both");
+      if (!line && !poly) {
+        return r.errorAt(int(lt->source().begin.line), key,
+                         "missing line_lonlat / line_xy / polygon_lonlat / polygon_xy");
+      }
+      if (line && line->points.size() < 2) return r.errorAt(line->line, line->key, "a line needs at least 2 points");
+      if (poly && poly->points.size() < 3) return r.errorAt(poly->line, poly->key, "a polygon needs at least 3 points");
+      l.place = line ? *line : *poly;
+      l.polygon = bool(poly);
+      STRATA_TRY(l.stage, readCurve(r, *lt, key, {"stage", "water surface elevation", "length", "m", kElevation}));
+      l.stageLine = int(lt->get("stage")->source().begin.line);
+      s.water.levels.push_back(std::move(l));
+    }
+  }
+  return {};
+}
+
+Status readTime(const Reader& r, const toml::table& root, Scenario& s) {
+  const auto* t = root["time"].as_table();
+  if (!t) return fail(r.file + ": missing [time] (duration = \"6 h\", output_interval = \"30 min\")");
+  STRATA_TRY_STATUS(r.onlyKeys(*t, "time", {"duration", "output_interval", "spin_up"}));
+  const auto* d = t->get("duration");
+  if (!d) return r.errorAt(int(t->source().begin.line), "time.duration", "missing");
+  STRATA_TRY(s.durationS, r.quantity(*d, "time.duration", "time", kDuration));
+  if (const auto* u = t->get("spin_up")) {
+    STRATA_TRY(s.spinUpS, r.quantity(*u, "time.spin_up", "time", kSpinUp));
+  }
+  s.outputIntervalS = s.durationS / 10;
+  if (const auto* o = t->get("output_interval")) {
+    STRATA_TRY(s.outputIntervalS, r.quantity(*o, "time.output_interval", "time", kPositive));
+    if (s.outputIntervalS > s.durationS) return r.error(*o, "time.output_interval", "longer than the duration");
+    // Every interval writes the maps, the series and a checkpoint.
+    const double n = std::ceil(s.durationS / s.outputIntervalS - 1e-9);
+    if (!(n <= double(kMaxOutputIntervals))) {
+      char msg[160];
+      std::snprintf(msg, sizeof msg, "gives %.3g output intervals over the duration (at most %lld)", n,
+                    kMaxOutputIntervals);
+      return r.error(*o, "time.output_interval", msg);
+    }
+  }
+  return {};
+}
+
+Status readOutputs(const Reader& r, const toml::table& root, Scenario& s) {
+  const auto* t = root["outputs"].as_table();
+  if ((!t || !t->get("maps")) && s.erosion.enabled) {
+    s.outputs.maps.insert(s.outputs.maps.end(), erosionOutputMaps().begin(), erosionOutputMaps().end());
+  }
+  if (!t) return {};
+  STRATA_TRY_STATUS(r.onlyKeys(*t, "outputs", {"maps", "wet_threshold", "pictures", "plots"}));
+  if (const auto* m = t->get("maps")) {
+    const auto* arr = m->as_array();
+    if (!arr) return r.error(*m, "outputs.maps", "expected a list of map names");
+    s.outputs.maps.clear();
+    for (const auto& n : *arr) {
+      STRATA_TRY(auto name, r.string(n, "outputs.maps"));
+      const auto& known = knownOutputMaps();
+      if (std::find(known.begin(), known.end(), name) == known.end()) {
+        std::string list;
+        for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
+        return r.error(n, "outputs.maps", "unknown map \"" + name + "\" (known: " + list + ")");
+      }
+      s.outputs.maps.push_back(name);
+    }
+  }
+  if (const auto* w = t->get("wet_threshold")) {
+    STRATA_TRY(s.outputs.wetThresholdM, r.quantity(*w, "outputs.wet_threshold", "length", kWetThreshold));
+  }
+  if (const auto* p = t->get("pictures")) {
+    STRATA_TRY(s.outputs.pictures, r.boolean(*p, "outputs.pictures"));
+  }
+  if (const auto* p = t->get("plots")) {
+    STRATA_TRY(s.outputs.plots, r.boolean(*p, "outputs.plots"));
+  }
+  return {};
+}
+
+// Debian 12's toml++ (3.3.0) has defects that text can reach (found by fuzzing
+// scripts/fuzz.sh's scenario target, and upstream issue marzer/tomlplusplus#190): a code point in
+// U+00A1..U+0499, U+2C5E..U+3057 or U+FB06..U+FEFE where it looks for whitespace reaches
+// __builtin_unreachable() in is_non_ascii_horizontal_whitespace (undefined behaviour: outside
+// strings, or first on the line after a line-ending backslash of a multi-line string), and a
+// table header starting with neither a bare-key character nor a quote ("[!]") fails an assertion
+// in parse_key, a date-time with no time after its 'T' ("1979-05-27T:") one in parse_time, and a
+// '}' where an array's value is expected ("a = [1, }]") one in parse_value (release builds return
+// an error there; Debug and fuzzing builds abort). The text is checked
+// first and such input refused with its line; all of it is invalid TOML anyway except the
+// line-ending backslash case. Control characters (TOML
+// allows tab and line breaks only) are refused here too, with a clearer message than toml++'s.
+// "U+00E9" for the UTF-8 code point starting at `i` (or "byte 0xC3" when it is not one).
+std::string codePoint(std::string_view text, size_t i) {
+  const auto b = static_cast<unsigned char>(text[i]);
+  const int n = b >= 0xF0 ? 4 : b >= 0xE0 ? 3 : b >= 0xC0 ? 2 : 1;
+  uint32_t cp = n == 1 ? b : b & (0x7F >> n);
+  char buf[24];
+  for (int k = 1; k < n; ++k) {
+    if (i + size_t(k) >= text.size() || (static_cast<unsigned char>(text[i + size_t(k)]) & 0xC0) != 0x80) {
+      std::snprintf(buf, sizeof buf, "byte 0x%02X", b);
+      return buf;
+    }
+    cp = (cp << 6) | (static_cast<unsigned char>(text[i + size_t(k)]) & 0x3F);
+  }
+  std::snprintf(buf, sizeof buf, "U+%04X", cp);
+  return buf;
+}
+
+Status checkTomlText(std::string_view text, const std::string& file) {
+  // What the reader is in: between tokens (keys, brackets, '=', ','), a comment, a string, or a
+  // bare value (a number, date, boolean: toml++ reads it up to whitespace, ']', '}', ',' or '#',
+  // quotes and brackets included).
+  enum class State { Normal, Comment, Basic, Literal, MultiBasic, MultiLiteral, Bare };
+  State state = State::Normal;
+  int line = 1;
+  bool lineStart = true;           // only whitespace so far on this line
+  bool expectValue = false;        // a value comes next (after '=', '[' or an array's ',')
+  std::string open;                // brackets of the value being read, innermost last
+  bool afterBackslashEnd = false;  // multi-line basic string: skipping whitespace after a line-ending '\'
+  size_t bareStart = 0;            // where the bare value began
+  auto refuse = [&](const std::string& what) { return fail(file + ":" + std::to_string(line) + ": " + what); };
+  auto outside = [&](size_t i) {
+    return refuse(codePoint(text, i) + " outside a string or a comment (TOML allows ASCII only there)");
+  };
+  auto digit = [&](size_t k) { return k < text.size() && std::isdigit(static_cast<unsigned char>(text[k])) != 0; };
+  // YYYY-MM-DD at `i`.
+  auto isDate = [&](size_t i) {
+    return digit(i) && digit(i + 1) && digit(i + 2) && digit(i + 3) && text[i + 4] == '-' && digit(i + 5) &&
+           digit(i + 6) && text[i + 7] == '-' && digit(i + 8) && digit(i + 9);
+  };
+  auto quotes = [&](size_t i, char q) {
+    size_t n = 0;
+    while (i + n < text.size() && text[i + n] == q) ++n;
+    return n;
+  };
+  for (size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    const auto u = static_cast<unsigned char>(c);
+    if ((u < 0x20 && c != '\t' && c != '\n' && !(c == '\r' && i + 1 < text.size() && text[i + 1] == '\n')) ||
+        u == 0x7F) {
+      return refuse(codePoint(text, i) + ": a control character (TOML allows tab and line breaks only)");
+    }
+    if (state == State::Bare &&
+        (c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == ']' || c == '}' || c == ',' || c == '#')) {
+      state = State::Normal;  // the terminator is read again as a token
+      expectValue = false;
+    }
+    if (c == '\n') {
+      ++line;
+      if (state == State::Comment || state == State::Basic || state == State::Literal) state = State::Normal;
+      if (state == State::Normal) {
+        lineStart = true;
+        if (open.empty()) expectValue = false;
+      }
+      continue;
+    }
+    switch (state) {
+      case State::Normal:
+        if (u >= 0x80) return outside(i);
+        if (c == '#') {
+          state = State::Comment;
+        } else if ((c == '"' || c == '\'') &&
+                   (i == 0 || std::string_view(" \t\r\n=[{,.").find(text[i - 1]) != std::string_view::npos)) {
+          // A string starts where a key or a value can; a quote glued to a key is read by toml++
+          // as the end of that key.
+          const size_t n = quotes(i, c);
+          state = n >= 3 ? (c == '"' ? State::MultiBasic : State::MultiLiteral)
+                         : (c == '"' ? State::Basic : State::Literal);
+          if (n == 2) state = State::Normal;  // an empty string
+          i += (n >= 3 ? 3 : n) - 1;
+          expectValue = false;
+        } else if (c == '=') {
+          expectValue = true;
+        } else if (c == '[' && lineStart && open.empty() && !expectValue) {
+          // A table header: its first key starts with a bare-key character or a quote.
+          size_t k = i + (i + 1 < text.size() && text[i + 1] == '[' ? 2 : 1);
+          while (k < text.size() && (text[k] == ' ' || text[k] == '\t')) ++k;
+          const char first = k < text.size() ? text[k] : ']';
+          const auto f = static_cast<unsigned char>(first);
+          if (first == '\n' || first == '\r') return refuse("a table name is missing after '['");
+          // (Control and non-ASCII characters are refused when the loop reaches them.)
+          if (f >= 0x21 && f < 0x7F && !std::isalnum(f) && first != '_' && first != '-' && first != '"' &&
+              first != '\'' && first != ']') {
+            return refuse(std::string("'") + first +
+                          "' starts a table name (TOML allows ASCII letters, digits, _ and -, or a quoted name)");
+          }
+          i = k - 1;
+        } else if (c == '[' || c == '{') {
+          open += c;
+          expectValue = c == '[';
+        } else if (c == ']' || c == '}') {
+          if (!open.empty()) {
+            // A '}' where an array's value is expected fails an assertion (parse_value).
+            if (c == '}' && open.back() == '[') return refuse("'}' inside an array (no inline table to close)");
+            open.pop_back();
+          }
+          expectValue = false;
+        } else if (c == ',') {
+          expectValue = !open.empty() && open.back() == '[';
+        } else if (expectValue && c != ' ' && c != '\t' && c != '\r') {
+          state = State::Bare;
+          bareStart = i;
+        }
+        if (c != ' ' && c != '\t' && c != '\r') lineStart = false;
+        break;
+      case State::Bare:
+        if (u >= 0x80) return outside(i);
+        if ((c == 'T' || c == 't') && i == bareStart + 10 && isDate(bareStart) && !digit(i + 1)) {
+          // A date, its 'T' and no time: toml++ fails an assertion (is_decimal_digit in parse_time).
+          return refuse(std::string("a date-time with '") + c + "' and no time after it (expected HH:MM:SS)");
+        }
+        break;
+      case State::Comment: break;
+      case State::Basic:
+        if (c == '\\') {
+          ++i;  // the escaped character (a line break there is toml++'s error to report)
+          if (i < text.size() && text[i] == '\n') --i;
+        } else if (c == '"') {
+          state = State::Normal;
+        }
+        break;
+      case State::Literal:
+        if (c == '\'') state = State::Normal;
+        break;
+      case State::MultiBasic:
+        if (afterBackslashEnd) {
+          if (c == ' ' || c == '\t' || c == '\r') break;
+          afterBackslashEnd = false;
+          if (u >= 0x80) {
+            return refuse(codePoint(text, i) +
+                          " first after a line-ending backslash: the TOML reader (toml++ 3.3.0) cannot read it there; "
+                          "start the line with an ASCII character or join the lines");
+          }
+        }
+        if (c == '\\') {
+          size_t k = i + 1;
+          while (k < text.size() && (text[k] == ' ' || text[k] == '\t' || text[k] == '\r')) ++k;
+          if (k < text.size() && text[k] == '\n') {
+            afterBackslashEnd = true;  // skips whitespace and line breaks up to the next character
+            i = k - 1;
+          } else if (k < text.size() && static_cast<unsigned char>(text[k]) >= 0x80) {
+            // toml++ asks whether the escaped character (or the one after the backslash's
+            // spaces) is whitespace: undefined behaviour for these; no TOML escape anyway.
+            return refuse(codePoint(text, k) + " after a backslash in a multi-line string (not an escape TOML knows)");
+          } else {
+            ++i;  // an escape sequence
+            if (i < text.size() && text[i] == '\n') --i;
+          }
+        } else if (c == '"' && quotes(i, '"') >= 3) {
+          i += std::min<size_t>(quotes(i, '"'), 5) - 1;  // up to two quotes belong to the string
+          state = State::Normal;
+          lineStart = false;
+        }
+        break;
+      case State::MultiLiteral:
+        if (c == '\'' && quotes(i, '\'') >= 3) {
+          i += std::min<size_t>(quotes(i, '\''), 5) - 1;
+          state = State::Normal;
+          lineStart = false;
+        }
+        break;
+    }
+  }
+  return {};
+}
+
+}  // namespace
+
+std::string oneLine(std::string_view text) {
+  std::string out;
+  for (char c : text) {
+    const auto u = static_cast<unsigned char>(c);
+    if (c == '\n') {
+      out += "\\n";
+    } else if (c == '\t') {
+      out += "\\t";
+    } else if (c == '\r') {
+      out += "\\r";
+    } else if (u < 0x20 || u == 0x7F) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\x%02X", u);
+      out += buf;
+    } else {
+      out += c;
+    }
+  }
+  return out;
+}
+
+std::string Scenario::at(const std::string& key) const {
+  const auto it = keyLines.find(key);
+  return file.string() + (it == keyLines.end() ? "" : ":" + std::to_string(it->second)) + ": key '" + oneLine(key) +
+         "': ";
+}
+
+const std::vector<std::string>& erosionOutputMaps() {
+  static const std::vector<std::string> kMaps{"terrain_change", "exposed_material", "suspended_sediment",
+                                              "layer_thickness"};
+  return kMaps;
+}
+
+const std::vector<std::string>& knownOutputMaps() {
+  static const std::vector<std::string> kMaps{"max_depth",           "max_speed",          "arrival_time",
+                                              "inundation_duration", "final_depth",        "terrain_change",
+                                              "exposed_material",    "suspended_sediment", "layer_thickness"};
+  return kMaps;
+}
+
+Result<double> parseQuantity(std::string_view text, std::string_view dimension) {
+  const auto begin = text.find_first_not_of(" \t");
+  if (begin == std::string_view::npos) return fail("empty value");
+  text.remove_prefix(begin);
+  double value = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (ec != std::errc() || !std::isfinite(value))
+    return fail("\"" + std::string(text) + "\" does not start with a number");
+  std::string_view unit(end, size_t(text.data() + text.size() - end));
+  while (!unit.empty() && (unit.front() == ' ' || unit.front() == '\t')) unit.remove_prefix(1);
+  while (!unit.empty() && (unit.back() == ' ' || unit.back() == '\t')) unit.remove_suffix(1);
+  if (unit.empty()) return fail("\"" + std::string(text) + "\" has no unit (use one of " + unitsOf(dimension) + ")");
+  for (const auto& u : kUnits) {
+    if (unit == u.name && dimension == u.dimension) {
+      if (!std::isfinite(value * u.toSi)) return fail("\"" + std::string(text) + "\" is too large");
+      return value * u.toSi;
+    }
+  }
+  for (const auto& u : kUnits) {
+    if (unit == u.name) {
+      return fail("unit '" + std::string(unit) + "' is a " + u.dimension + ", not a " + std::string(dimension) +
+                  " (use one of " + unitsOf(dimension) + ")");
+    }
+  }
+  return fail("unknown unit '" + std::string(unit) + "' (use one of " + unitsOf(dimension) + ")");
+}
+
+Result<Backend> parseBackend(std::string_view name) {
+  if (name == "auto") return Backend::kAuto;
+  if (name == "cpu") return Backend::kCpu;
+  if (name == "gpu") return Backend::kGpu;
+  return fail("expected \"auto\", \"cpu\" or \"gpu\", got \"" + std::string(name) + "\"");
+}
+
+Result<Scenario> parseScenario(std::string_view text, const std::filesystem::path& fileName) {
+  Scenario s;
+  Reader r{fileName.string(), fileName.parent_path(), &s.keyLines};
+  STRATA_TRY_STATUS(checkTomlText(text, r.file));
+  toml::table root;
+  try {
+    root = toml::parse(text, fileName.string());
+  } catch (const toml::parse_error& e) {
+    return fail(r.file + ":" + std::to_string(e.source().begin.line) + ": " + oneLine(e.description()));
+  }
+  STRATA_TRY_STATUS(r.onlyKeys(
+      root, "", {"name", "description", "terrain", "region", "model", "erosion", "water", "time", "outputs"}));
+  s.file = fileName;
+  if (const auto* n = root.get("name")) {
+    STRATA_TRY(s.name, r.string(*n, "name"));
+  }
+  if (const auto* d = root.get("description")) {
+    STRATA_TRY(s.description, r.string(*d, "description"));
+  }
+  if (s.name.empty()) s.name = fileName.stem().string();
+  STRATA_TRY_STATUS(readTerrain(r, root, s));
+  STRATA_TRY_STATUS(readRegion(r, root, s));
+  STRATA_TRY_STATUS(readModel(r, root, s));
+  STRATA_TRY_STATUS(readErosion(r, root, s));
+  STRATA_TRY_STATUS(readTime(r, root, s));  // before [water]: rain must start within the run
+  STRATA_TRY_STATUS(readWater(r, root, s));
+  STRATA_TRY_STATUS(readOutputs(r, root, s));
+  if (s.water.inflows.empty() && !s.water.rain && s.water.damBreaks.empty() && s.water.levels.empty()) {
+    return fail(r.file + ": [water] has no source: add an inflow, rain, a dam_break or a level");
+  }
+  if (s.spinUpS > 0 && !s.water.damBreaks.empty()) {
+    return fail(s.at("time.spin_up") +
+                "a dam break releases its water at t = 0 and the spin-up runs before it: use one or the other");
+  }
+  for (const auto& m : erosionOutputMaps()) {
+    if (std::find(s.outputs.maps.begin(), s.outputs.maps.end(), m) != s.outputs.maps.end() && !s.erosion.enabled) {
+      return fail(r.file + ": outputs.maps asks for " + m + " but erosion is not enabled");
+    }
+  }
+  return s;
+}
+
+Result<Scenario> loadScenario(const std::filesystem::path& file) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(file, ec)) return fail(file.string() + ": no such scenario file");
+  std::ifstream in(file);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  if (!in && !in.eof()) return fail(file.string() + ": cannot read");
+  return parseScenario(ss.str(), file);
+}
+
+}  // namespace strata::scenario

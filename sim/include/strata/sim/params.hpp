@@ -1,0 +1,67 @@
+#pragma once
+// What a user chooses about a water / erosion run: the model and its constants (docs/sim-water.md,
+// docs/sim-erosion.md; equation numbers W1.., E1.. refer to them). Plain values: the grid is in
+// SimInput, the solver's state in the solver, and the GL backend derives its std430 block from
+// these in one place (sim/gl_layout.hpp).
+
+#include <cstdint>
+
+#include <strata/core/result.hpp>
+
+namespace strata::sim {
+
+/// Which shallow-water model moves the water.
+enum class WaterModel : int32_t {
+  kVirtualPipes = 0,  ///< Mei et al. 2007 / Stava et al. 2008 outflow pipes (W1-W4)
+  kFiniteVolume = 1,  ///< flood mode: Godunov finite volumes, HLL + hydrostatic reconstruction (W13-W24)
+};
+
+/// Flood mode's slope limiter (W21).
+enum class SlopeLimiter : int32_t {
+  kMinmod = 0,  ///< the smaller one-sided slope: the most diffusive, robust on steep real terrain (the default)
+  kMonotonizedCentral = 1,  ///< van Leer's MC: sharper fronts and smooth flow (Ritter front lag as dx^0.5, not dx^0.3)
+};
+
+/// Bits of SimParams::openEdges: an open edge lets water flow out freely (and counts it);
+/// a closed one is a wall.
+enum EdgeBits : uint32_t { kEdgeWest = 1u, kEdgeEast = 2u, kEdgeNorth = 4u, kEdgeSouth = 8u };
+
+/// The model and its constants. setParams() may change any of them mid-run but the water model
+/// and diagonal pipes, which decide what the solver allocates.
+struct SimParams {
+  WaterModel waterModel = WaterModel::kVirtualPipes;
+  SlopeLimiter slopeLimiter = SlopeLimiter::kMinmod;  ///< flood mode's W21 slopes
+  uint32_t openEdges = 0;                             ///< EdgeBits; 0 = closed box
+  bool erosionEnabled = false;                        ///< erosion, deposition, dissolution and transport (E1-E6)
+  bool thermalEnabled = false;                        ///< thermal weathering and bank slippage (E7-E8)
+  bool diagonalPipes = false;         ///< pipes model with 8 pipes (diagonals too), no axis-aligned gullies (W1b)
+  float gravityMS2 = 9.81f;           ///< g (m/s^2)
+  float maxDtS = 0.05f;               ///< fixed step, or the upper bound of the adaptive one (s)
+  float cflAlpha = 0.0f;              ///< > 0: dt = min(maxDtS, alpha * min(dx,dy) / max(|u| + sqrt(g h))) (W10)
+  float dryDepthM = 1e-6f;            ///< below this depth a cell or face counts as dry (m)
+  float pipeAreaM2 = 1.0f;            ///< cross-section of a virtual pipe (m^2) (W1)
+  float manningN = 0.0f;              ///< Manning's n (s m^-1/3), flood mode; 0 = frictionless (W19)
+  float rainMmPerHour = 0.0f;         ///< uniform rain (mm/h), added to the rain raster
+  float evaporationMmPerHour = 0.0f;  ///< evaporation from wet cells (mm/h) (W11)
+  float capacityK = 0.0f;             ///< sediment capacity constant Kc (s) (E1)
+  float erosionRate = 0.0f;           ///< Ks: fraction of the capacity deficit picked up per second (1/s) (E2)
+  float depositionRate = 0.0f;        ///< Kd: fraction of the excess dropped per second (1/s) (E3)
+  float deepWaterM = 1.0f;            ///< capacity falls linearly to 0 at this depth (m) (E1)
+  float minSinTilt = 0.05f;           ///< floor of sin(tilt) so flat beds still carry sediment (E1)
+  float slowWaterMS = 0.1f;           ///< dissolution acts where |v| is below this (m/s) (E4)
+  float thermalRate = 0.5f;           ///< cap on the share of the talus excess moved in one step, in (0,1] (E7)
+  float wetTalusScale = 0.5f;         ///< talus tangent multiplier for banks above flowing water (E8)
+  float bankDepthM = 0.1f;            ///< water deeper than this (and faster than slowWaterMS) undercuts a bank (E8)
+  float bankSlipRatePerS = 0.01f;     ///< rate at which an undercut bank slips (1/s) (E8)
+  float maxErosionPerStepM = 0.01f;   ///< cap on material moved by E2/E4 in one step (m)
+};
+
+/// Checks the parameters (finite, ranges, the model's own constraints); the message names the
+/// parameter and the problem.
+Status validateParams(const SimParams& params);
+
+/// `next` with what is fixed at creation (water model, diagonal pipes) taken from `current`: what
+/// setParams() applies mid-run.
+SimParams runtimeParams(const SimParams& current, const SimParams& next);
+
+}  // namespace strata::sim

@@ -1,0 +1,120 @@
+#version 450
+// Flood mode: W18 conservative update from the face fluxes, W23 centred bed-slope source,
+// W24 force noise floor, W25 outflow limits (corrector). final = 0: Heun predictor U1 = U0 - dt L(U0) into `stage`;
+// final = 1: U0 - dt (L(U0) + L(U1)) / 2 into stateOut (W22), then W19 Manning friction,
+// E5 sediment transport, E0 tilt.
+#include "sim.glsl"
+#include "sim_accum.glsl"
+layout(local_size_x = 16, local_size_y = 16) in;
+layout(std430, binding = SLOT_BED) readonly buffer Bed { float bed[]; };
+layout(std430, binding = SLOT_STATE_IN) readonly buffer StateIn { vec4 state[]; };
+layout(std430, binding = SLOT_STATE_OUT) writeonly buffer StateOut { vec4 stateOut[]; };
+layout(std430, binding = SLOT_STAGE) buffer Stage { vec4 stage[]; };
+layout(std430, binding = SLOT_FACE_X) readonly buffer FaceX { vec4 faceX[]; };
+layout(std430, binding = SLOT_FACE_Y) readonly buffer FaceY { vec4 faceY[]; };
+layout(std430, binding = SLOT_TILT) writeonly buffer Tilt { float tilt[]; };
+layout(std430, binding = SLOT_FV_LIMIT) readonly buffer Limit { float limit_[]; };  // W25, from fv_limit.comp
+uniform int final_;
+vec4 stateAt(int which, int i) { return which == 0 ? state[i] : stage[i]; }
+#include "sim_fv.glsl"
+#include "sim_tilt.glsl"
+
+// W23: centred bed-slope source and the pressure on slanted sides of unequal-width rows.
+vec2 bedSource(int which, ivec2 p) {
+  const float g = P.gravityMS2, wN = faceWidthY(p.y), wS = faceWidthY(p.y + 1);
+  const Side W = faceSide(which, p, 0), E = faceSide(which, p, 1), N = faceSide(which, p, 2), S = faceSide(which, p, 3);
+  const float sx = -g * 0.5 * (W.h + E.h) * ((E.eta - W.eta) - (E.h - W.h)) * P.dyM;
+  const float sy = -g * 0.5 * (N.h + S.h) * ((S.eta - N.eta) - (S.h - N.h)) * (0.5 * (wN + wS)) +
+                   0.5 * g * (0.5 * (N.h * N.h + S.h * S.h)) * (wS - wN);
+  return vec2(sx, sy);
+}
+
+// W25: the share of a face's mass flux its upwind cell can give (l: left / top cell, r: right /
+// bottom); only outflow crosses an edge, so an upwind cell outside the grid never limits.
+float limitOfFace(float massFlux, ivec2 l, ivec2 r) {
+  const ivec2 up = massFlux > 0.0 ? l : r;
+  return insideGrid(up) ? limit_[cellOf(up)] : 1.0;
+}
+
+// Volume rate leaving cell q through its four faces (m^3/s), with W25's limits (corrector only).
+float outflowTotal(ivec2 q) {
+  const int w = P.width;
+  float fW = faceX[q.y * (w + 1) + q.x].x, fE = faceX[q.y * (w + 1) + q.x + 1].x;
+  float fN = faceY[q.y * w + q.x].x, fS = faceY[(q.y + 1) * w + q.x].x;
+  fW *= limitOfFace(fW, q - ivec2(1, 0), q);
+  fE *= limitOfFace(fE, q, q + ivec2(1, 0));
+  fN *= limitOfFace(fN, q - ivec2(0, 1), q);
+  fS *= limitOfFace(fS, q, q + ivec2(0, 1));
+  return (max(-fW, 0.0) + max(fE, 0.0)) * P.dyM + max(-fN, 0.0) * faceWidthY(q.y) + max(fS, 0.0) * faceWidthY(q.y + 1);
+}
+
+void main() {
+  const ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+  if (!insideGrid(p)) return;
+  const int i = cellOf(p), w = P.width;
+  const float dt = P.dtS, g = P.gravityMS2, dry = P.dryDepthM, n2 = P.manningN * P.manningN;
+  const float A = cellArea(p.y), wN = faceWidthY(p.y), wS = faceWidthY(p.y + 1), dy = P.dyM;
+  vec4 W = faceX[p.y * (w + 1) + p.x], E = faceX[p.y * (w + 1) + p.x + 1];
+  vec4 N = faceY[p.y * w + p.x], S = faceY[(p.y + 1) * w + p.x];
+  if (final_ != 0) {  // W25: the mass (and, with it, the tangential momentum) each upwind cell can give
+    const float kW = limitOfFace(W.x, p - ivec2(1, 0), p), kE = limitOfFace(E.x, p, p + ivec2(1, 0));
+    const float kN = limitOfFace(N.x, p - ivec2(0, 1), p), kS = limitOfFace(S.x, p, p + ivec2(0, 1));
+    W.xw *= kW;
+    E.xw *= kE;
+    N.xw *= kN;
+    S.xw *= kS;
+  }
+  const vec4 s0 = state[i];
+  const float h = s0.x, s = s0.y, hu = s0.z, hv = s0.w;
+  vec2 src = bedSource(0, p);
+  if (final_ != 0) src = 0.5 * (src + bedSource(1, p));
+  const float k = dt / A;
+  float hNew = h - k * ((E.x - W.x) * dy + S.x * wS - N.x * wN);
+  float fx = src.x - ((E.y - W.z) * dy + S.w * wS - N.w * wN);
+  float fy = src.y - (S.y * wS - N.z * wN + (E.w - W.w) * dy);
+  const float magX = abs(E.y * dy) + abs(W.z * dy) + abs(S.w * wS) + abs(N.w * wN) + abs(src.x);
+  const float magY = abs(S.y * wS) + abs(N.z * wN) + abs(E.w * dy) + abs(W.w * dy) + abs(src.y);
+  if (abs(fx) <= kForceNoise * magX) fx = 0.0;
+  if (abs(fy) <= kForceNoise * magY) fy = 0.0;
+  float huNew = hu + k * fx;
+  float hvNew = hv + k * fy;
+  hNew = max(hNew, 0.0);
+  if (hNew <= dry) {
+    huNew = 0.0;
+    hvNew = 0.0;
+  }
+  if (final_ == 0) {
+    stage[i] = vec4(hNew, s, huNew, hvNew);
+    return;
+  }
+  if (hNew > dry && n2 > 0.0) {
+    const float speed = sqrt(huNew * huNew + hvNew * hvNew) / hNew;
+    const float c = 1.0 + dt * g * n2 * speed / pow(hNew, 4.0 / 3.0);
+    huNew /= c;
+    hvNew /= c;
+  }
+  // E5: suspended sediment moves with the water volume crossing each face, upwind.
+  const float denI = max(h * A, outflowTotal(p) * dt);
+  float sNew = s;
+  const float vols[4] = float[4](-W.x * dy * dt, E.x * dy * dt, -N.x * wN * dt, S.x * wS * dt);
+  const bool edge[4] = bool[4](p.x == 0, p.x == w - 1, p.y == 0, p.y == P.height - 1);
+  for (int d = 0; d < 4; ++d) {
+    const float volOut = vols[d];
+    if (volOut > 0.0) {
+      const float moved = denI > 0.0 ? s * A * volOut / denI : 0.0;
+      sNew -= moved / A;
+      if (edge[d]) {
+        kahanAdd(8 * i, volOut);
+        kahanAdd(8 * i + 4, moved);
+      }
+    } else if (volOut < 0.0 && !edge[d]) {
+      const ivec2 q = p + kDir[d];
+      const int j = cellOf(q);
+      const float Aj = cellArea(q.y);
+      const float denJ = max(state[j].x * Aj, outflowTotal(q) * dt);
+      if (denJ > 0.0) sNew += state[j].y * Aj * (-volOut) / denJ / A;
+    }
+  }
+  stateOut[i] = vec4(hNew, sNew, huNew, hvNew);
+  tilt[i] = sinTilt(p);
+}

@@ -1,0 +1,14 @@
+#version 450
+// W12: inflow of springs and inflow lines; one invocation per entry, each cell listed once.
+#include "sim.glsl"
+layout(local_size_x = 64) in;
+layout(std430, binding = SLOT_STATE_IN) buffer StateIn { vec4 state[]; };
+layout(std430, binding = SLOT_SOURCES) readonly buffer Sources { SourceEntry entries[]; };
+uniform uint entryCount;
+void main() {
+  const uint k = gl_GlobalInvocationID.x;
+  if (k >= entryCount) return;
+  const SourceEntry e = entries[k];
+  const int y = int(e.cell) / P.width;
+  state[e.cell].x += e.rateM3S * P.dtS / cellArea(y);
+}

@@ -1,0 +1,79 @@
+// The water / erosion simulation as the compute kernels see it. SimParams, SimMaterial and
+// SourceEntry mirror strata::terrain::sim (terrain/include/strata/terrain/sim/sim_params.hpp,
+// sim_host.hpp); tests/render/gpu_layouts_test.cpp checks that they agree. Buffer bindings are
+// fixed here; render/src/sim/simulation.cpp binds them. Equation numbers (W.., E..) refer to
+// docs/sim-water.md and docs/sim-erosion.md; terrain/src/sim/cpu_simulation.cpp is the same
+// code in C++.
+struct SimParams {
+  int width;
+  int height;
+  int layerCount;
+  int waterModel;
+  uint openEdges;
+  uint erosionEnabled;
+  uint thermalEnabled;
+  uint diagonalPipes;
+  float dyM;
+  float gravityMS2;
+  float dtS;
+  float maxDtS;
+  float cflAlpha;
+  float dryDepthM;
+  float pipeAreaM2;
+  float manningN;
+  float rainMmPerHour;
+  float evaporationMmPerHour;
+  float capacityK;
+  float erosionRate;
+  float depositionRate;
+  float deepWaterM;
+  float minSinTilt;
+  float slowWaterMS;
+  float thermalRate;
+  float wetTalusScale;
+  float maxErosionPerStepM;
+  int slopeLimiter;  // SlopeLimiter: 0 minmod, 1 MC (W21)
+  float bankDepthM;
+  float bankSlipRatePerS;
+  float pad0;
+  float pad1;
+};
+
+struct SimMaterial {
+  float erodibility;
+  float dissolutionRate;
+  float tanTalus;
+  float weatheringRatePerS;
+};
+
+struct SourceEntry {
+  uint cell;
+  float rateM3S;
+};
+
+struct LevelEntry {
+  uint cell;
+  float stageM;
+};
+
+layout(std430, binding = SLOT_PARAMS) readonly buffer SimParamsBlock { SimParams P; };
+layout(std430, binding = SLOT_ROW_DX) readonly buffer RowDxBlock { float rowDx[]; };
+
+const ivec2 kDir[4] = ivec2[4](ivec2(-1, 0), ivec2(1, 0), ivec2(0, -1), ivec2(0, 1));  // W, E, N, S
+// Diagonal pipes (W1b): NW, NE, SW, SE; the opposite of k is 3 - k.
+const ivec2 kDiag[4] = ivec2[4](ivec2(-1, -1), ivec2(1, -1), ivec2(-1, 1), ivec2(1, 1));
+const float kMmPerHourToMS = 1.0 / 3.6e6;
+const float kHeadNoise = 4.0 * 1.1920929e-7;   // W1a
+const float kForceNoise = 16.0 * 1.1920929e-7; // W24
+
+bool insideGrid(ivec2 p) { return p.x >= 0 && p.y >= 0 && p.x < P.width && p.y < P.height; }
+int cellOf(ivec2 p) { return p.y * P.width + p.x; }
+float cellDx(int y) { return rowDx[y]; }
+float cellArea(int y) { return rowDx[y] * P.dyM; }
+// Width of the y-face between rows yFace - 1 and yFace (the mean of the two rows' dx).
+float faceWidthY(int yFace) {
+  if (yFace <= 0) return rowDx[0];
+  if (yFace >= P.height) return rowDx[P.height - 1];
+  return 0.5 * (rowDx[yFace - 1] + rowDx[yFace]);
+}
+float velocityOf(float h, float q) { return h > P.dryDepthM ? q / h : 0.0; }

@@ -1,0 +1,437 @@
+// The CPU backend's erosion passes (docs/sim-erosion.md): erosion, deposition and dissolution
+// (E1-E4, E6), then thermal weathering (E7, E8) as two passes, the flux a cell sheds to each
+// neighbour and what it receives. One function per pass; each cell's arithmetic is the matching
+// kernel's under sim/shaders/, written with selects instead of branches so a row's cells run as
+// vectors (for up to kVectorLayers layers, a compile-time count; more layers take the same code
+// with the count at run time).
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+#include "cpu_impl.hpp"
+#include "cpu_rows.hpp"
+
+namespace strata::sim::cpu {
+
+// A row's layer stacks: layer l of cell x at lay[l * stride + x], bottom to top.
+struct Stack {
+  float* lay;
+  size_t stride;
+  int count;
+  float& at(int l, int x) const { return lay[size_t(l) * stride + size_t(x)]; }
+};
+
+struct ErosionConst {
+  float dt, dry, deepWater, capacityK, minSinTilt, erosionRate, depositionRate, slowWater, maxPerStep;
+  const float *erodibility, *dissolutionRate;  // per layer
+};
+
+struct ThermalConst {
+  int w, h;
+  float dt, wetTalusScale, dy, bankDepth, slowWater, slipShare;
+  const float *tanTalus, *share;  // per layer; share: stepShare of its weathering rate this step
+};
+
+// One row of thermal_flux.comp's inputs: row y and its neighbours above and below (row y itself
+// at an edge), and its four outflows.
+struct ThermalRow {
+  int y;
+  float dx;
+  const float *h, *hN, *hS, *hu, *huN, *huS, *hv, *hvN, *hvS, *b, *bN, *bS;
+  float* out[4];
+};
+
+namespace {
+
+constexpr int kVectorLayers = 8;
+
+// Calls f(std::integral_constant<int, L>) for L layers up to kVectorLayers, else with 0 (the
+// count at run time).
+template <class F>
+void withLayerCount(int layers, F&& f) {
+  switch (layers) {
+    case 1: return f(std::integral_constant<int, 1>{});
+    case 2: return f(std::integral_constant<int, 2>{});
+    case 3: return f(std::integral_constant<int, 3>{});
+    case 4: return f(std::integral_constant<int, 4>{});
+    case 5: return f(std::integral_constant<int, 5>{});
+    case 6: return f(std::integral_constant<int, 6>{});
+    case 7: return f(std::integral_constant<int, 7>{});
+    case 8: return f(std::integral_constant<int, 8>{});
+    default: return f(std::integral_constant<int, 0>{});
+  }
+}
+static_assert(kVectorLayers == 8, "withLayerCount lists the vectorised counts");
+
+// Topmost layer with material, or -1 (sim_layers.glsl's topLayer).
+template <int kL>
+inline int topLayer(const Stack& st, int x) {
+  const int n = kL > 0 ? kL : st.count;
+  int top = -1;
+  for (int l = 0; l < n; ++l) top = st.at(l, x) > 0.0f ? l : top;
+  return top;
+}
+
+// Layer `top`'s thickness at cell x, and a material constant of layer `top` (0 for -1); every
+// layer is read, whatever `top` is, so the loop over cells has no branch. (No lambda: a closure
+// holding references to a loop's locals stops `#pragma omp simd` from vectorising it.)
+template <int kL>
+inline float layerAt(const Stack& st, int x, int top) {
+  float v = 0.0f;
+  for (int l = 0; l < (kL > 0 ? kL : st.count); ++l) {
+    const float vl = st.at(l, x);
+    v = top == l ? vl : v;
+  }
+  return v;
+}
+template <int kL>
+inline float materialAt(const float* perLayer, int n, int top) {
+  float v = 0.0f;
+  for (int l = 0; l < (kL > 0 ? kL : n); ++l) {
+    const float vl = perLayer[l];
+    v = top == l ? vl : v;
+  }
+  return v;
+}
+
+// Takes `amount` off layer `top` where `apply`.
+template <int kL>
+inline void takeFrom(const Stack& st, int x, int top, float amount, bool apply) {
+  for (int l = 0; l < (kL > 0 ? kL : st.count); ++l) {
+    const float v = st.at(l, x);
+    st.at(l, x) = apply & (top == l) ? v - amount : v;
+  }
+}
+
+// E9 (docs/sim-erosion.md): what a store of `from` m really loses when `amount` (<= from) is
+// taken off it in float32: from - fl(from - amount), which is exact (Sterbenz), so the receiver
+// gets what the store lost and not a value the store could not represent (a 1e-7 m pick-up from
+// a 20 m layer used to leave the layer unchanged and create the material in the load).
+inline float exactTake(float from, float amount) {
+  const float left = from - amount;
+  return from - left;
+}
+
+// E9, the receiving side: what a store of `to` m really gains when `amount` is added, when the
+// store is the larger of the two (then fl(to + amount) - to is exact); 0 when that would exceed
+// `limit` (what the giver holds: rounding up past it would take more than there is).
+inline float exactGive(float to, float amount, float limit) {
+  const float sum = to + amount;
+  const float gained = to >= amount ? sum - to : amount;
+  return gained <= limit ? gained : 0.0f;
+}
+
+template <int kL>
+inline float stackBed(const Stack& st, float base, int x) {
+  float b = base;
+  for (int l = 0; l < (kL > 0 ? kL : st.count); ++l) b += st.at(l, x);
+  return b;
+}
+
+// sim/shaders/erode.comp for one cell.
+template <int kL>
+inline void erodeCell(const ErosionConst& c, const Stack& st, float* s, float* bed, const float* base, const float* h,
+                      const float* hu, const float* hv, const float* tilt, int x) {
+  const int n = kL > 0 ? kL : st.count, sedimentLayer = n - 1;
+  const float hx = h[x], sx = s[x];
+  const bool wet = hx > c.dry;
+  // E1: capacity from tilt and speed, falling to 0 in deep water.
+  const float speed = std::sqrt(hu[x] * hu[x] + hv[x] * hv[x]) / hx;
+  const float shallow = 1.0f - hx / c.deepWater;  // std::clamp(shallow, 0, 1), as values
+  const float depthFactor = shallow < 0.0f ? 0.0f : (1.0f < shallow ? 1.0f : shallow);
+  const float capacity = c.capacityK * maxOf(tilt[x], c.minSinTilt) * speed * depthFactor;
+  const int top = topLayer<kL>(st, x);
+  const bool pick_ = sx < capacity;
+  // E2: below capacity the water picks up the topmost layer, scaled by its erodibility.
+  const float erodibility = materialAt<kL>(c.erodibility, n, top);
+  const float topLayerM = layerAt<kL>(st, x, top);
+  const float eroded =
+      exactTake(topLayerM, minOf(minOf(c.erosionRate * (capacity - sx) * c.dt * erodibility, c.maxPerStep), topLayerM));
+  const bool erode = wet & pick_ & (top >= 0);
+  takeFrom<kL>(st, x, top, eroded, erode);
+  // E3: above it, the excess settles as the top (sediment) layer.
+  const float sed = st.at(sedimentLayer, x);
+  const float deposited = exactGive(sed, minOf(c.depositionRate * (sx - capacity) * c.dt, sx), sx);
+  const bool deposit = wet & !pick_;
+  float s1 = erode ? sx + eroded : (deposit ? sx - deposited : sx);
+  st.at(sedimentLayer, x) = deposit ? sed + deposited : sed;
+  // E4: slow water dissolves the (new) topmost layer.
+  const int top2 = topLayer<kL>(st, x);
+  const float rate = materialAt<kL>(c.dissolutionRate, n, top2);
+  const float top2M = layerAt<kL>(st, x, top2);
+  const float dissolved = exactTake(top2M, minOf(minOf(rate * hx * c.dt, c.maxPerStep), top2M));
+  const bool dissolve = wet & (speed < c.slowWater) & (top2 >= 0);
+  takeFrom<kL>(st, x, top2, dissolved, dissolve);
+  s1 = dissolve ? s1 + dissolved : s1;
+  // E6: where the water is gone its load settles.
+  const float sed2 = st.at(sedimentLayer, x);
+  st.at(sedimentLayer, x) = wet ? sed2 : sed2 + s1;
+  s[x] = wet ? s1 : 0.0f;
+  bed[x] = stackBed<kL>(st, base[x], x);
+}
+
+}  // namespace
+
+// erode.comp for the cells [x0, x1) of a row.
+STRATA_ROW_KERNEL void erosionRow(const ErosionConst& c, const Stack& st, float* s, float* bed, const float* base,
+                                  const float* h, const float* hu, const float* hv, const float* tilt, int x0, int x1) {
+  withLayerCount(st.count, [&](auto kL) {
+#pragma omp simd
+    for (int x = x0; x < x1; ++x) erodeCell<decltype(kL)::value>(c, st, s, bed, base, h, hu, hv, tilt, x);
+  });
+}
+
+// sim/shaders/erode.comp: E1-E4 (capacity, erosion, deposition, dissolution); E6 (settling when
+// dry). Purely local: each cell reads and writes only itself. Runs over the active blocks: in a
+// quiet cell (no water, no load) it changes nothing.
+void Impl::erosionPass() {
+  forRuns(water, [&](const Run& r, int) {
+    const ErosionConst c{dt,
+                         p.dryDepthM,
+                         p.deepWaterM,
+                         p.capacityK,
+                         p.minSinTilt,
+                         p.erosionRate,
+                         p.depositionRate,
+                         p.slowWaterMS,
+                         p.maxErosionPerStepM,
+                         erodibility.data(),
+                         dissolutionRate.data()};
+    Water& u = now();
+    for (int y = r.y0; y < r.y1; ++y) {
+      erosionRow(c, Stack{layers.row(y), layerStride, L}, u.s.row(y), bed.row(y), base.row(y), u.h.row(y), u.hu.row(y),
+                 u.hv.row(y), tilt.row(y), r.x0, r.x1);
+    }
+  });
+}
+
+namespace {
+
+// The share of a talus excess moved in a step of dt at `rate` (1/s), capped by thermalRate
+// (E7): thermalRate * r dt / (1 + r dt), ~ r dt for short steps, thermalRate for long ones.
+inline float stepShare(float thermalRate, float rate, float dt) {
+  const float a = rate * dt;
+  return thermalRate * (a / (1.0f + a));
+}
+
+// thermalFluxCell for the topmost layer alone (the layers below are reached only through it, so
+// where it does not shed this is the whole result; the row runs it vectorised and then the full
+// cell where anything is shed). Its arithmetic is thermalFluxCell's for that layer.
+template <bool kEdge, int kL>
+inline void thermalFluxTopCell(const ThermalConst& c, const ThermalRow& r, const Stack& st, int x) {
+  const bool in[4] = {!kEdge || x > 0, !kEdge || x < c.w - 1, !kEdge || r.y > 0, !kEdge || r.y < c.h - 1};
+  const int xw = in[0] ? x - 1 : x, xe = in[1] ? x + 1 : x;
+  const int n = kL > 0 ? kL : st.count;
+  const float hj[4] = {r.h[xw], r.h[xe], r.hN[x], r.hS[x]};
+  const float huj[4] = {r.hu[xw], r.hu[xe], r.huN[x], r.huS[x]};
+  const float hvj[4] = {r.hv[xw], r.hv[xe], r.hvN[x], r.hvS[x]};
+  const float bj[4] = {r.b[xw], r.b[xe], r.bN[x], r.bS[x]};
+  const int top = topLayer<kL>(st, x);
+  const float t = layerAt<kL>(st, x, top), tanT = materialAt<kL>(c.tanTalus, n, top);
+  const float share = materialAt<kL>(c.share, n, top);
+  float weighted[4], maxW = 0.0f, sumW = 0.0f;
+  for (int d = 0; d < 4; ++d) {
+    const float dist = d < 2 ? r.dx : c.dy;
+    const float speed = std::sqrt(huj[d] * huj[d] + hvj[d] * hvj[d]) / maxOf(hj[d], c.bankDepth);
+    const bool undercut = in[d] & (hj[d] > c.bankDepth) & (speed > c.slowWater);
+    const float noise = kHeadNoise * maxOf(std::abs(r.b[x]), std::abs(bj[d]));
+    const float e = (r.b[x] - bj[d]) - (undercut ? tanT * c.wetTalusScale : tanT) * dist;
+    const float wd = (e > noise ? e : 0.0f) * (undercut ? c.slipShare : share);
+    weighted[d] = in[d] ? wd : 0.0f;
+    maxW = maxOf(maxW, weighted[d]);
+    sumW += weighted[d];
+  }
+  const bool sheds = (top >= 0) & (sumW > 0.0f);
+  const float moved = sheds ? exactTake(t, minOf(t, 0.5f * maxW)) : 0.0f;
+  const float inv = sheds ? moved / sumW : 0.0f;
+  for (int d = 0; d < 4; ++d) r.out[d][x] = weighted[d] * inv;
+}
+
+// sim/shaders/thermal_flux.comp for one cell: E7 (each layer of the stack, from the top down,
+// sheds where the slope exceeds its own talus angle, at its own rate and no more than its own
+// thickness; a layer below is reached only through layers shed whole), E8 (a bank above flowing
+// water of real depth slips at wetTalusScale times the angle, at bankSlipRatePerS).
+template <bool kEdge, int kL>
+inline void thermalFluxCell(const ThermalConst& c, const ThermalRow& r, const Stack& st, int x) {
+  const bool in[4] = {!kEdge || x > 0, !kEdge || x < c.w - 1, !kEdge || r.y > 0, !kEdge || r.y < c.h - 1};
+  const int xw = in[0] ? x - 1 : x, xe = in[1] ? x + 1 : x;
+  const int n = kL > 0 ? kL : st.count;
+  const float hj[4] = {r.h[xw], r.h[xe], r.hN[x], r.hS[x]};
+  const float huj[4] = {r.hu[xw], r.hu[xe], r.huN[x], r.huS[x]};
+  const float hvj[4] = {r.hv[xw], r.hv[xe], r.hvN[x], r.hvS[x]};
+  const float bj[4] = {r.b[xw], r.b[xe], r.bN[x], r.bS[x]};
+  const float slipShare = c.slipShare;
+  float drop[4], noise[4], dist[4];
+  bool undercut[4];
+  for (int d = 0; d < 4; ++d) {
+    dist[d] = d < 2 ? r.dx : c.dy;
+    // E8: the neighbour holds flowing water of real depth.
+    const float speed = std::sqrt(huj[d] * huj[d] + hvj[d] * hvj[d]) / maxOf(hj[d], c.bankDepth);
+    undercut[d] = in[d] & (hj[d] > c.bankDepth) & (speed > c.slowWater);
+    drop[d] = r.b[x] - bj[d];
+    // An excess within float32 resolution of the beds is rounding, not a slope (as W1a).
+    noise[d] = kHeadNoise * maxOf(std::abs(r.b[x]), std::abs(bj[d]));
+  }
+  float out[4] = {0.0f, 0.0f, 0.0f, 0.0f}, shedAbove = 0.0f;
+  bool reach = true;  // every layer above this one is empty or shed whole
+  for (int l = n - 1; l >= 0; --l) {
+    const float t = st.at(l, x), tanT = c.tanTalus[l];
+    const float share = c.share[l];
+    float weighted[4], maxW = 0.0f, sumW = 0.0f;
+    for (int d = 0; d < 4; ++d) {
+      const float e = (drop[d] - shedAbove) - (undercut[d] ? tanT * c.wetTalusScale : tanT) * dist[d];
+      const float wd = (e > noise[d] ? e : 0.0f) * (undercut[d] ? slipShare : share);
+      weighted[d] = in[d] ? wd : 0.0f;
+      maxW = maxOf(maxW, weighted[d]);
+      sumW += weighted[d];
+    }
+    const bool sheds = reach & (t > 0.0f) & (sumW > 0.0f);
+    const float moved = sheds ? exactTake(t, minOf(t, 0.5f * maxW)) : 0.0f;
+    const float inv = sheds ? moved / sumW : 0.0f;
+    for (int d = 0; d < 4; ++d) out[d] += weighted[d] * inv;
+    shedAbove += moved;
+    reach = reach & (moved >= t);
+  }
+  for (int d = 0; d < 4; ++d) r.out[d][x] = out[d];
+}
+
+}  // namespace
+
+// thermal_flux.comp for the cells [x0, x1) of a row.
+STRATA_ROW_KERNEL void thermalFluxRow(const ThermalConst& c, const ThermalRow& r, const Stack& st, int x0, int x1) {
+  withLayerCount(st.count, [&](auto kL) {
+    constexpr int kLayers = decltype(kL)::value;
+    forRowCells(x0, x1, c.w, r.y == 0 || r.y == c.h - 1,
+                [&](auto e, int x) { thermalFluxTopCell<decltype(e)::value, kLayers>(c, r, st, x); });
+    // Where the topmost layer sheds, it may go whole and the layers below shed too: the full cell.
+    for (int x = x0; x < x1; ++x) {
+      if ((r.out[0][x] != 0.0f) | (r.out[1][x] != 0.0f) | (r.out[2][x] != 0.0f) | (r.out[3][x] != 0.0f)) {
+        thermalFluxCell<true, kLayers>(c, r, st, x);
+      }
+    }
+  });
+}
+
+ThermalConst Impl::thermalConst() {
+  thermalShare.resize(weatheringRate.size());
+  for (size_t l = 0; l < weatheringRate.size(); ++l) thermalShare[l] = stepShare(p.thermalRate, weatheringRate[l], dt);
+  return {w,
+          h,
+          dt,
+          p.wetTalusScale,
+          dy,
+          p.bankDepthM,
+          p.slowWaterMS,
+          stepShare(p.thermalRate, p.bankSlipRatePerS, dt),
+          tanTalus.data(),
+          thermalShare.data()};
+}
+
+// sim/shaders/thermal_flux.comp: E7 (talus transfer), E8 (undercut banks slip).
+// Each cell writes only its own four outflows. Runs over the blocks whose inputs (bed, layers,
+// water of the cell and its neighbours) may have changed since their last evaluation, and
+// records per block whether any of its cells sheds material.
+void Impl::thermalFluxPass() {
+  const ThermalConst c = thermalConst();
+  forRuns(thermalEval, [&](const Run& r, int) {
+    for (int bx = r.x0 / kBlock; bx * kBlock < r.x1; ++bx) thermalMoving[size_t(r.y0 / kBlock * bw + bx)] = 0;
+    const Water& u = now();
+    for (int y = r.y0; y < r.y1; ++y) {
+      const int yn = std::max(y - 1, 0), ys = std::min(y + 1, h - 1);
+      const ThermalRow row{y,
+                           rowDx[size_t(y)],
+                           u.h.row(y),
+                           u.h.row(yn),
+                           u.h.row(ys),
+                           u.hu.row(y),
+                           u.hu.row(yn),
+                           u.hu.row(ys),
+                           u.hv.row(y),
+                           u.hv.row(yn),
+                           u.hv.row(ys),
+                           bed.row(y),
+                           bed.row(yn),
+                           bed.row(ys),
+                           {thermal[0].row(y), thermal[1].row(y), thermal[2].row(y), thermal[3].row(y)}};
+      const Stack st{layers.row(y), layerStride, L};
+      thermalFluxRow(c, row, st, r.x0, r.x1);
+      // Per block of the row: does a cell of it shed?
+      for (int bx = r.x0 / kBlock; bx * kBlock < r.x1; ++bx) {
+        bool any = false;
+        for (int d = 0; d < 4; ++d) {
+          for (int x = bx * kBlock; x < std::min((bx + 1) * kBlock, r.x1); ++x) any = any || row.out[d][x] != 0.0f;
+        }
+        if (any) thermalMoving[size_t(y / kBlock * bw + bx)] = 1;
+      }
+    }
+  });
+}
+
+namespace {
+
+// sim/shaders/thermal_apply.comp for one cell: what it sheds comes off its stack top-down
+// (E7b; the last layer touched takes the float rounding remainder so the transfer is exact),
+// what its neighbours shed towards it (per their area) lands on the top layer.
+template <bool kEdge, int kL>
+inline void thermalApplyCell(const ThermalConst& c, int y, const float* const out[4], const float* outN2,
+                             const float* outS3, float area, float areaN, float areaS, const Stack& st, float* bed,
+                             const float* base, int x) {
+  const bool in[4] = {!kEdge || x > 0, !kEdge || x < c.w - 1, !kEdge || y > 0, !kEdge || y < c.h - 1};
+  const int xw = in[0] ? x - 1 : x, xe = in[1] ? x + 1 : x;
+  const int n = kL > 0 ? kL : st.count;
+  const float shed = out[0][x] + out[1][x] + out[2][x] + out[3][x];
+  // From W (its east outflow), E (west), N (south), S (north), in that order.
+  const float from[4] = {out[1][xw] * area, out[0][xe] * area, outN2[x] * areaN, outS3[x] * areaS};
+  float received = 0.0f;
+  for (int d = 0; d < 4; ++d) {
+    if (!kEdge || in[d]) received += from[d];
+  }
+  // E7b: what it sheds comes off the top of the stack, layer by layer, as the flux pass reached
+  // down (its per-layer amounts are values the layers lose exactly; the sum of the four parts
+  // may differ from them by a rounding, hence the min: no layer goes below 0).
+  float remaining = shed;
+  for (int l = n - 1; l >= 0; --l) {
+    const float layer = st.at(l, x);
+    const float take = minOf(layer, remaining);
+    st.at(l, x) = layer - take;
+    remaining -= take;
+  }
+  st.at(n - 1, x) += received / area;
+  bed[x] = stackBed<kL>(st, base[x], x);
+}
+
+}  // namespace
+
+// thermal_apply.comp for the cells [x0, x1) of a row: its outflows `out`, the south outflows of
+// the row above and the north outflows of the row below, the rows' cell areas.
+STRATA_ROW_KERNEL void thermalApplyRow(const ThermalConst& c, int y, const float* const out[4], const float* outN2,
+                                       const float* outS3, float area, float areaN, float areaS, const Stack& st,
+                                       float* bed, const float* base, int x0, int x1) {
+  withLayerCount(st.count, [&](auto kL) {
+    forRowCells(x0, x1, c.w, y == 0 || y == c.h - 1, [&](auto e, int x) {
+      thermalApplyCell<decltype(e)::value, decltype(kL)::value>(c, y, out, outN2, outS3, area, areaN, areaS, st, bed,
+                                                                base, x);
+    });
+  });
+}
+
+// sim/shaders/thermal_apply.comp: E7, the receiving side; shed material lands as the top layer.
+// Runs over the blocks with a cell that sheds and their neighbours: elsewhere nothing is shed or
+// received.
+void Impl::thermalApplyPass() {
+  const ThermalConst c = thermalConst();
+  forRuns(thermalApply, [&](const Run& r, int) {
+    for (int y = r.y0; y < r.y1; ++y) {
+      const int yn = std::max(y - 1, 0), ys = std::min(y + 1, h - 1);
+      const float* const out[4] = {thermal[0].row(y), thermal[1].row(y), thermal[2].row(y), thermal[3].row(y)};
+      const Stack st{layers.row(y), layerStride, L};
+      const float area = rowArea[size_t(y)], areaN = rowArea[size_t(yn)], areaS = rowArea[size_t(ys)];
+      const float *outN2 = thermal[3].row(yn), *outS3 = thermal[2].row(ys);
+      float* bd = bed.row(y);
+      const float* bs = base.row(y);
+      thermalApplyRow(c, y, out, outN2, outS3, area, areaN, areaS, st, bd, bs, r.x0, r.x1);
+    }
+  });
+}
+
+}  // namespace strata::sim::cpu

@@ -1,0 +1,187 @@
+#pragma once
+// The CPU backend's storage and passes (CpuSolver::Impl). Every per-cell array is a Plane: rows
+// of floats starting on 64-byte boundaries, so a pass is a loop over rows whose inner loop the
+// compiler vectorises. Each pass is the matching compute shader under sim/shaders/ in C++ (same
+// float32 operations in the same order) and keeps its ping-pong: a pass reads neighbours only from
+// arrays no cell of that pass writes, so rows run on any thread in any order and the results do
+// not depend on the thread count. The passes run over the active blocks only (docs/sim-water.md,
+// "The CPU backend"): cpu_solver.cpp chooses them, cpu_water.cpp and cpu_erosion.cpp hold the
+// passes.
+
+#include <omp.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <new>
+#include <vector>
+
+#include <strata/sim/bookkeeping.hpp>
+#include <strata/sim/params.hpp>
+
+#include "cpu_kernels.hpp"
+
+namespace strata::sim::cpu {
+
+struct ThermalConst;  // cpu_erosion.cpp
+
+/// Side of the square blocks of cells the passes skip or run (cells). Larger than what one step
+/// reaches (8 cells: flood mode's stencils and the thermal passes after it), so water that is
+/// more than one block away cannot reach a cell within a step.
+constexpr int kBlock = 16;
+/// A pass over fewer cells runs on one thread: forking costs more than it saves.
+constexpr size_t kMinParallelCells = 16384;
+
+/// `rows` rows of `width` floats (zero), each row starting on a 64-byte boundary; the row stride
+/// is a multiple of 16 floats.
+class Plane {
+ public:
+  Plane() = default;
+  Plane(int width, int rows)
+      : stride_((size_t(width) + 15) / 16 * 16),
+        rows_(rows),
+        data_(new (std::align_val_t(64)) float[stride_ * size_t(rows)]()) {}
+  bool empty() const { return !data_; }
+  size_t stride() const { return stride_; }
+  float* row(int y) { return data_.get() + size_t(y) * stride_; }
+  const float* row(int y) const { return data_.get() + size_t(y) * stride_; }
+  float& at(int x, int y) { return row(y)[x]; }
+  float at(int x, int y) const { return row(y)[x]; }
+
+ private:
+  struct Free {
+    void operator()(float* p) const { ::operator delete[](p, std::align_val_t(64)); }
+  };
+  size_t stride_ = 0;
+  int rows_ = 0;
+  std::unique_ptr<float[], Free> data_;
+};
+
+/// A water state: depth h, suspended sediment s, discharges hu, hv (sim.glsl's vec4 per cell).
+struct Water {
+  Plane h, s, hu, hv;
+};
+
+/// Flood mode's face fluxes (fv_face.comp's vec4 per face): mass flux, normal momentum flux for
+/// the left / top cell and for the right / bottom cell, tangential momentum flux.
+struct Faces {
+  Plane mass, nL, nR, t;
+};
+
+/// Rows [y0, y1) x columns [x0, x1): the cells of one block row's run of consecutive active blocks.
+struct Run {
+  int y0, y1, x0, x1;
+};
+
+/// A set of blocks and the runs of cells it covers, in row order.
+struct BlockSet {
+  std::vector<uint8_t> on;  ///< per block, row-major
+  std::vector<Run> runs;
+  size_t cells = 0;
+};
+
+struct Impl {
+  // ---- the grid and the model ----
+  int w = 0, h = 0, L = 0;
+  int bw = 0, bh = 0;  // blocks across and down
+  float dy = 1.0f;
+  SimParams p;
+  int threads = 1;
+  bool skip = true;
+  std::vector<float> erodibility, dissolutionRate, tanTalus, weatheringRate;  // per layer (MaterialConstants)
+  std::vector<float> thermalShare;    // per layer: E7's share of the excess moved this step
+  std::vector<float> rowDx, rowArea;  // per row: dx and the cell area dx * dy
+  std::vector<float> faceWidthY;      // per y-face (height + 1): the mean of the two rows' dx
+
+  // ---- per-cell state ----
+  Plane base, bed;         // datum-relative base and bed (base + layers)
+  Plane layers;            // L * h rows: layer l, row y is row l * h + y
+  size_t layerStride = 0;  // floats from one layer to the next
+  Plane rain;              // raster rain (mm/h); empty when there is none
+  Water state[2];          // ping-pong: state[cur] is the current state
+  int cur = 0;
+  Plane flux[4], fluxDiag[4];  // pipes: outflows W, E, N, S and NW, NE, SW, SE (m^3/s)
+  Plane accum[8];              // (sum, error) of water out, evaporated, sediment out, level exchange (m^3)
+  Plane tilt;                  // sin(bed tilt), for erosion (E0)
+  Plane thermal[4];            // material shed W, E, N, S (m over this cell) (E7)
+  Plane flood[4];              // max depth, max speed, arrival, wet duration
+  // flood mode's intermediates
+  Water stage;                 // the Heun predictor U1
+  Faces faceX, faceY;          // (w + 1) x h and w x (h + 1) faces
+  Plane srcX, srcY;            // W23 bed source of the step (the predictor's, then the Heun mean)
+  Plane limit;                 // W25: the share of its outflow a cell can give
+  Plane den;                   // E5: max(h A, limited outflow dt), the volume a cell's sediment share is of
+  std::vector<Plane> scratch;  // per thread: the face pass's rows of primitives and face values
+
+  float dt = 0.0f;
+  bool anySuspended = false;  // some cell may carry sediment (sediment transport can be skipped otherwise)
+  bool floodStats = false;
+  float wetThresholdM = 0.0f;
+
+  // ---- active blocks (cpu_solver.cpp) ----
+  std::vector<uint8_t> quiet;          // per block: every cell's water state (and pipe outflows) +0
+  std::vector<uint8_t> needPrev;       // the blocks last step needed
+  std::vector<uint8_t> forced;         // written from outside since the last step (writeBlock)
+  std::vector<uint8_t> evapResidual;   // some cell's evaporation sum has a nonzero compensation term
+  std::vector<uint8_t> rainBlock;      // some cell has raster rain
+  std::vector<uint8_t> thermalMoving;  // some cell sheds material (thermal flux last evaluated)
+  std::vector<uint8_t> thermalForced;  // layers written from outside since the last step
+  std::vector<uint8_t> work;           // scratch of one block set
+  bool dirty = true;                   // every block runs this step and the next (new or restored state)
+  bool thermalDirty = true;            // every block's thermal flux is evaluated this step
+  BlockSet water, sources, thermalEval, thermalApply, lastThermalApply;
+  long long cellUpdates = 0;
+
+  Impl(const SimInput& input, const SimParams& params, int threads, bool skip);
+
+  Water& now() { return state[cur]; }
+  const Water& now() const { return state[cur]; }
+  Water& next() { return state[1 - cur]; }
+  size_t cells() const { return size_t(w) * size_t(h); }
+  float bedOf(int x, int y) const;
+  void recomputeBed(int x, int y);
+
+  /// Calls f(run, thread) for every run of `set`, on the solver's threads when the set is large.
+  template <class F>
+  void forRuns(const BlockSet& set, F&& f) const {
+    const int n = int(set.runs.size());
+    const bool parallel = threads > 1 && n > 1 && set.cells >= kMinParallelCells;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads) if (parallel)
+    for (int k = 0; k < n; ++k) f(set.runs[size_t(k)], omp_get_thread_num());
+  }
+
+  // ---- one step ----
+  void step(const std::vector<SourceEntry>& sources, const std::vector<LevelEntry>& levels, float dtS, double endS);
+  void planStep(const std::vector<SourceEntry>& sources, const std::vector<LevelEntry>& levels);
+  void finishStep();
+  void fillRuns(BlockSet& set) const;
+  void dilate(std::vector<uint8_t>& on);
+  bool blockQuiet(int bx, int by) const;
+  bool blockEvapResidual(int bx, int by) const;
+  void markAll();  // state replaced: all flags recomputed, every block runs for two steps
+  void allocateFor(const SimParams& params);
+
+  // ---- passes (cpu_water.cpp) ----
+  void sourcesPass(const std::vector<SourceEntry>& entries);
+  void pipeFluxPass();
+  void pipeUpdatePass();
+  void fvFacePass(const Water& u, bool average);
+  void fvLimitPass();
+  void fvDenPass();
+  void fvUpdatePass(bool final);
+  void tiltRows(int y, int x0, int x1);  // E0 for cells [x0, x1) of row y
+  void levelPass(const std::vector<LevelEntry>& entries);
+  void floodStatsPass(float endTimeS);
+  float maxWaveSpeed() const;
+  float outflowLimited(int x, int y) const;  // W25-limited volume rate leaving a cell (m^3/s)
+  float fvSedimentEdge(int x, int y, const FaceFlux limited[4]);
+
+  // ---- passes (cpu_erosion.cpp) ----
+  void erosionPass();
+  void erodeCell(int x, int y);
+  ThermalConst thermalConst();  // E7's shares of this step in thermalShare
+  void thermalFluxPass();
+  void thermalApplyPass();
+};
+
+}  // namespace strata::sim::cpu

@@ -1,0 +1,118 @@
+#pragma once
+// Per-cell float32 arithmetic the CPU passes share (the GLSL of sim/shaders/sim.glsl,
+// sim_fv.glsl and sim_accum.glsl in C++): the same operations in the same order, written
+// without branches (both sides computed, one selected), so loops over a row vectorise and give
+// the bits the branchy form gives.
+
+#include <algorithm>
+#include <cmath>
+
+// The row kernels (the loops over a row's cells) are built twice, for baseline x86-64 (SSE2) and
+// for x86-64-v3 (AVX2), and the loader picks one for the machine (GCC's function multiversioning;
+// external linkage needed). Everything they call is inlined into them (`flatten`), so the cell
+// code is built for both. Without contraction into fused multiply-adds (-ffp-contract=off) both
+// give the same bits.
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#define STRATA_ROW_KERNEL [[gnu::target_clones("default", "arch=x86-64-v3"), gnu::flatten]]
+#else
+#define STRATA_ROW_KERNEL [[gnu::flatten]]
+#endif
+
+namespace strata::sim::cpu {
+
+constexpr float kMmPerHourToMS = 1.0f / 3.6e6f;
+// W1a: a head difference below 4 float32 ulps of the operands is rounding, not a gradient.
+constexpr float kHeadNoise = 4.0f * 1.1920929e-7f;
+// W24: a net momentum rate below 16 float32 ulps of the sum of its terms is rounding.
+constexpr float kForceNoise = 16.0f * 1.1920929e-7f;
+
+// std::min and std::max on values: the same results (including NaN and signed zeros), but no
+// reference to a temporary, which inside `#pragma omp simd` turns into a branch and stops the
+// loop from vectorising.
+inline float minOf(float a, float b) { return b < a ? b : a; }
+inline float maxOf(float a, float b) { return a < b ? b : a; }
+
+inline float velocityOf(float h, float q, float dry) {
+  const float v = q / h;
+  return h > dry ? v : 0.0f;
+}
+
+// W20: compensated (Kahan) sum into `sum` with the running error in `err`, so per-cell float
+// accumulators of outflow and evaporation stay exact to ~1e-7 over millions of steps.
+inline void kahanAdd(float& sum, float& err, float v) {
+  const float y = v - err;
+  const float t = sum + y;
+  err = (t - sum) - y;
+  sum = t;
+}
+
+// W21 slopes from the backward and forward differences a, b (0 at an extremum): minmod, the
+// smaller one; van Leer's monotonised central (MC), sign * min(2|a|, 2|b|, |a + b| / 2).
+inline float minmod(float a, float b) {
+  const float m = std::abs(a) < std::abs(b) ? a : b;
+  return a * b <= 0.0f ? 0.0f : m;
+}
+inline float mcSlope(float a, float b) {
+  const float m = std::copysign(minOf(minOf(2.0f * std::abs(a), 2.0f * std::abs(b)), 0.5f * std::abs(a + b)), a);
+  return a * b <= 0.0f ? 0.0f : m;
+}
+template <bool kMC>
+inline float limitedSlope(float a, float b) {
+  if constexpr (kMC) {
+    return mcSlope(a, b);
+  } else {
+    return minmod(a, b);
+  }
+}
+
+/// A cell's value at one of its faces (W21): depth, surface, normal and tangential velocity.
+struct Side {
+  float h, eta, un, ut;
+};
+
+/// Flood mode's flux through a face (fv_face.comp's vec4): mass, normal momentum for the left /
+/// top cell and for the right / bottom cell, tangential momentum.
+struct FaceFlux {
+  float mass, nL, nR, t;
+};
+
+// W13-W16: HLL flux of the hydrostatically reconstructed states (Audusse et al. 2004) between a
+// left / top side L and a right / bottom side R.
+inline FaceFlux hllFace(Side L, Side R, float g, float dry) {
+  const float hL = L.h, hR = R.h, unL = L.un, unR = R.un;
+  const float bL = L.eta - L.h, bR = R.eta - R.h;
+  const float dbLR = bR - bL;
+  const float hLs = maxOf(0.0f, hL - maxOf(0.0f, dbLR));  // W13
+  const float hRs = maxOf(0.0f, hR - maxOf(0.0f, -dbLR));
+  const bool wetL = hLs > dry, wetR = hRs > dry;
+  const float cL = std::sqrt(g * hLs), cR = std::sqrt(g * hRs);
+  // W15: wave speeds, Toro's dry-bed variants (left dry / right dry / both wet).
+  const float sLdryL = unR - 2.0f * cR, sRdryL = unR + cR;
+  const float sLdryR = unL - cL, sRdryR = unL + 2.0f * cL;
+  const float sLwet = minOf(unL - cL, unR - cR), sRwet = maxOf(unL + cL, unR + cR);
+  const float sL = !wetL ? sLdryL : (!wetR ? sLdryR : sLwet);
+  const float sR = !wetL ? sRdryL : (!wetR ? sRdryR : sRwet);
+  const float qL = hLs * unL, qR = hRs * unR;
+  const float fLn = qL * unL + 0.5f * g * hLs * hLs, fRn = qR * unR + 0.5f * g * hRs * hRs;
+  const float inv = 1.0f / (sR - sL);  // W14
+  const float hStar = (sR * qL - sL * qR + sL * sR * (hRs - hLs)) * inv;
+  const float nStar = (sR * fLn - sL * fRn + sL * sR * (qR - qL)) * inv;
+  const bool wet = wetL || wetR;
+  const float fhWet = sL >= 0.0f ? qL : (sR <= 0.0f ? qR : hStar);
+  const float fnWet = sL >= 0.0f ? fLn : (sR <= 0.0f ? fRn : nStar);
+  const float fh = wet ? fhWet : 0.0f, fn = wet ? fnWet : 0.0f;
+  const float ft = wet ? (fh > 0.0f ? fh * L.ut : fh * R.ut) : 0.0f;
+  // W16: hydrostatic correction.
+  return {fh, fn + 0.5f * g * (hL * hL - hLs * hLs), fn + 0.5f * g * (hR * hR - hRs * hRs), ft};
+}
+
+// W17: a wall mirrors the normal velocity; an open edge copies the cell and lets water out only.
+inline FaceFlux edgeFlux(Side inside, bool ghostOnRight, bool open, float g, float dry) {
+  Side ghost = inside;
+  ghost.un = open ? (ghostOnRight ? maxOf(inside.un, 0.0f) : minOf(inside.un, 0.0f)) : -inside.un;
+  FaceFlux f = ghostOnRight ? hllFace(inside, ghost, g, dry) : hllFace(ghost, inside, g, dry);
+  if (open) f.mass = ghostOnRight ? maxOf(f.mass, 0.0f) : minOf(f.mass, 0.0f);
+  return f;
+}
+
+}  // namespace strata::sim::cpu

@@ -1,0 +1,650 @@
+// The CPU backend: storage, the order of the passes in a step, the choice of the blocks they run
+// on, and the conversions between its planes and the Solver interface's per-cell arrays.
+#include <strata/sim/cpu_solver.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <string>
+
+#include "cpu_impl.hpp"
+
+namespace strata::sim {
+namespace cpu {
+namespace {
+
+uint32_t bitsOf(float v) {
+  uint32_t b;
+  std::memcpy(&b, &v, 4);
+  return b;
+}
+
+}  // namespace
+
+// Whether a value in [x0, x1) of a row has a bit set (-0 counts).
+STRATA_ROW_KERNEL bool anyBitsRow(const float* row, int x0, int x1) {
+  uint32_t any = 0;
+#pragma omp simd reduction(| : any)
+  for (int x = x0; x < x1; ++x) any |= bitsOf(row[x]);
+  return any != 0;
+}
+
+namespace {
+
+// Whether a value in [x0, x1) x [y0, y1) of `plane` has a bit set, row by row.
+bool anyBits(const Plane& plane, int x0, int x1, int y0, int y1) {
+  for (int y = y0; y < y1; ++y) {
+    if (anyBitsRow(plane.row(y), x0, x1)) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+Impl::Impl(const SimInput& input, const SimParams& params, int threadCount, bool skipQuiet)
+    : p(params), threads(threadCount > 0 ? threadCount : omp_get_max_threads()), skip(skipQuiet) {
+  const CellGrid grid = CellGrid::of(input);
+  w = grid.width;
+  h = grid.height;
+  L = grid.layers;
+  dy = float(input.dyM);
+  bw = (w + kBlock - 1) / kBlock;
+  bh = (h + kBlock - 1) / kBlock;
+  for (const auto& m : input.materials) {
+    const MaterialConstants c = materialConstants(m);
+    erodibility.push_back(c.erodibility);
+    dissolutionRate.push_back(c.dissolutionRate);
+    tanTalus.push_back(c.tanTalus);
+    weatheringRate.push_back(c.weatheringRatePerS);
+  }
+  for (int y = 0; y < h; ++y) {
+    rowDx.push_back(float(grid.rowDxM[size_t(y)]));
+    rowArea.push_back(rowDx.back() * dy);
+  }
+  for (int y = 0; y <= h; ++y) {
+    faceWidthY.push_back(y <= 0   ? rowDx[0]
+                         : y >= h ? rowDx[size_t(h) - 1]
+                                  : 0.5f * (rowDx[size_t(y) - 1] + rowDx[size_t(y)]));
+  }
+  base = Plane(w, h);
+  bed = Plane(w, h);
+  layers = Plane(w, L * h);
+  layerStride = layers.stride() * size_t(h);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      base.at(x, y) = float(double(input.baseM.at(x, y)) - input.datumM);
+      for (int l = 0; l < L; ++l) layers.at(x, l * h + y) = input.layersM[size_t(l)].at(x, y);
+      recomputeBed(x, y);
+    }
+  }
+  const bool flood = p.waterModel == WaterModel::kFiniteVolume;
+  for (auto& s : state) s = Water{Plane(w, h), Plane(w, h), Plane(w, h), Plane(w, h)};
+  if (input.waterDepthM.size() > 0) {
+    for (int y = 0; y < h; ++y) {
+      for (int x = 0; x < w; ++x) state[0].h.at(x, y) = input.waterDepthM.at(x, y);
+    }
+  }
+  if (input.rainMmPerHour.size() > 0 && std::any_of(input.rainMmPerHour.data.begin(), input.rainMmPerHour.data.end(),
+                                                    [](float r) { return r != 0.0f; })) {
+    rain = Plane(w, h);
+    for (int y = 0; y < h; ++y) {
+      for (int x = 0; x < w; ++x) rain.at(x, y) = input.rainMmPerHour.at(x, y);
+    }
+  }
+  for (auto& a : accum) a = Plane(w, h);
+  if (flood) {
+    stage = Water{Plane(w, h), Plane(w, h), Plane(w, h), Plane(w, h)};
+    faceX = Faces{Plane(w + 1, h), Plane(w + 1, h), Plane(w + 1, h), Plane(w + 1, h)};
+    faceY = Faces{Plane(w, h + 1), Plane(w, h + 1), Plane(w, h + 1), Plane(w, h + 1)};
+    srcX = Plane(w, h);
+    srcY = Plane(w, h);
+    limit = Plane(w, h);
+    for (int t = 0; t < threads; ++t) scratch.emplace_back(w + 2 * 16, 40);
+  } else {
+    for (auto& f : flux) f = Plane(w, h);
+    if (p.diagonalPipes) {
+      for (auto& f : fluxDiag) f = Plane(w, h);
+    }
+  }
+  const size_t blocks = size_t(bw) * size_t(bh);
+  for (auto* v : {&quiet, &needPrev, &forced, &evapResidual, &rainBlock, &thermalMoving, &thermalForced, &work}) {
+    v->assign(blocks, 0);
+  }
+  for (auto* set : {&water, &sources, &thermalEval, &thermalApply, &lastThermalApply}) {
+    set->on.assign(blocks, 0);
+    set->runs.reserve(blocks);
+  }
+  for (int by = 0; by < bh; ++by) {
+    for (int bx = 0; bx < bw; ++bx) {
+      bool any = false;
+      for (int y = by * kBlock; y < std::min(h, (by + 1) * kBlock) && !rain.empty(); ++y) {
+        for (int x = bx * kBlock; x < std::min(w, (bx + 1) * kBlock); ++x) any = any || rain.at(x, y) != 0.0f;
+      }
+      rainBlock[size_t(by * bw + bx)] = any;
+    }
+  }
+  allocateFor(p);
+  markAll();
+}
+
+// Planes that depend on the run-time parameters (erosion and thermal weathering may be switched
+// on mid-run): allocated once, never in a step.
+void Impl::allocateFor(const SimParams& params) {
+  anySuspended = anySuspended || params.erosionEnabled;
+  if (params.erosionEnabled && tilt.empty()) tilt = Plane(w, h);
+  if (params.thermalEnabled && thermal[0].empty()) {
+    for (auto& t : thermal) t = Plane(w, h);
+  }
+  if (params.waterModel == WaterModel::kFiniteVolume && anySuspended && den.empty()) den = Plane(w, h);
+}
+
+float Impl::bedOf(int x, int y) const {
+  float b = base.at(x, y);
+  const float* lay = layers.row(y) + x;
+  for (int l = 0; l < L; ++l) b += lay[size_t(l) * layerStride];
+  return b;
+}
+
+void Impl::recomputeBed(int x, int y) { bed.at(x, y) = bedOf(x, y); }
+
+// The state was replaced (creation, restore): every flag is recomputed and every block runs in
+// the next two steps, which brings the ping-pong buffers and the intermediates of every block
+// back in line with the state.
+void Impl::markAll() {
+  dirty = true;
+  thermalDirty = true;
+  for (int by = 0; by < bh; ++by) {
+    for (int bx = 0; bx < bw; ++bx) {
+      quiet[size_t(by * bw + bx)] = blockQuiet(bx, by);
+      evapResidual[size_t(by * bw + bx)] = blockEvapResidual(bx, by);
+    }
+  }
+  for (int y = 0; y < h && !anySuspended; ++y) {
+    for (int x = 0; x < w; ++x) anySuspended = anySuspended || bitsOf(now().s.at(x, y)) != 0;
+  }
+  allocateFor(p);
+}
+
+// A block is quiet when all its cells' water state (and pipe outflows) are +0: with quiet
+// neighbours, no rain, source or level, a step maps such a cell to itself, bit for bit
+// (docs/sim-water.md, "The CPU backend").
+bool Impl::blockQuiet(int bx, int by) const {
+  const int x0 = bx * kBlock, x1 = std::min(w, x0 + kBlock), y0 = by * kBlock, y1 = std::min(h, y0 + kBlock);
+  const Water& u = now();
+  // Depth first: a wet block is found on its first row.
+  for (const Plane* plane : {&u.h, &u.hu, &u.hv, &u.s}) {
+    if (anyBits(*plane, x0, x1, y0, y1)) return false;
+  }
+  for (int d = 0; d < 4; ++d) {
+    if (!flux[d].empty() && anyBits(flux[d], x0, x1, y0, y1)) return false;
+    if (!fluxDiag[d].empty() && anyBits(fluxDiag[d], x0, x1, y0, y1)) return false;
+  }
+  return true;
+}
+
+// Adding 0 to a compensated sum with a nonzero error term may change it (W20), so the sources
+// pass keeps running where a cell's evaporation sum has one.
+bool Impl::blockEvapResidual(int bx, int by) const {
+  const int x0 = bx * kBlock, y0 = by * kBlock;
+  return anyBits(accum[3], x0, std::min(w, x0 + kBlock), y0, std::min(h, y0 + kBlock));
+}
+
+void Impl::dilate(std::vector<uint8_t>& on) {
+  std::fill(work.begin(), work.end(), 0);
+  for (int by = 0; by < bh; ++by) {
+    for (int bx = 0; bx < bw; ++bx) {
+      if (!on[size_t(by * bw + bx)]) continue;
+      for (int j = std::max(by - 1, 0); j <= std::min(by + 1, bh - 1); ++j) {
+        for (int i = std::max(bx - 1, 0); i <= std::min(bx + 1, bw - 1); ++i) work[size_t(j * bw + i)] = 1;
+      }
+    }
+  }
+  on.swap(work);
+}
+
+void Impl::fillRuns(BlockSet& set) const {
+  set.runs.clear();
+  set.cells = 0;
+  for (int by = 0; by < bh; ++by) {
+    const int y0 = by * kBlock, y1 = std::min(h, y0 + kBlock);
+    for (int bx = 0; bx < bw;) {
+      if (!set.on[size_t(by * bw + bx)]) {
+        ++bx;
+        continue;
+      }
+      const int first = bx;
+      while (bx < bw && set.on[size_t(by * bw + bx)]) ++bx;
+      const Run r{y0, y1, first * kBlock, std::min(w, bx * kBlock)};
+      set.runs.push_back(r);
+      set.cells += size_t(r.y1 - r.y0) * size_t(r.x1 - r.x0);
+    }
+  }
+}
+
+// The blocks this step's passes run on. A block is busy when a cell of it is not quiet or it
+// gets rain, a source or a level this step; the water passes run on the busy blocks and their
+// neighbours (a step reaches less than a block), and on last step's such blocks too, so a block
+// that falls idle runs once more with quiet surroundings, which leaves both state buffers and
+// its faces, limits and predictor at the values every later step would give them. The sources
+// pass runs on the busy blocks and where an evaporation sum carries an error term.
+void Impl::planStep(const std::vector<SourceEntry>& entries, const std::vector<LevelEntry>& levels) {
+  const size_t blocks = quiet.size();
+  auto all = [&](BlockSet& set) {
+    std::fill(set.on.begin(), set.on.end(), 1);
+    fillRuns(set);
+  };
+  if (!skip) {
+    all(water);
+    all(sources);
+    if (p.thermalEnabled) all(thermalEval);
+    return;
+  }
+  std::vector<uint8_t>& busy = sources.on;
+  const bool rainEverywhere = p.rainMmPerHour != 0.0f;
+  for (size_t b = 0; b < blocks; ++b) busy[b] = !quiet[b] || rainBlock[b] || rainEverywhere;
+  auto blockOf = [&](uint32_t cell) {
+    return size_t(int(cell / uint32_t(w)) / kBlock * bw + int(cell % uint32_t(w)) / kBlock);
+  };
+  for (const auto& e : entries) busy[blockOf(e.cell)] = 1;
+  for (const auto& e : levels) busy[blockOf(e.cell)] = 1;
+  water.on = busy;
+  dilate(water.on);
+  for (size_t b = 0; b < blocks; ++b) water.on[b] = water.on[b] || forced[b] || dirty;
+  for (size_t b = 0; b < blocks; ++b) {
+    const uint8_t need = water.on[b];
+    water.on[b] = need || needPrev[b];
+    needPrev[b] = need;
+    busy[b] = busy[b] || evapResidual[b] || forced[b] || dirty;
+  }
+  fillRuns(water);
+  fillRuns(sources);
+  if (p.thermalEnabled) {
+    // The thermal flux of a block changes only when the bed, layers or water of it or its
+    // neighbours changed: where the water passes or last step's thermal transfers ran.
+    thermalEval.on = water.on;
+    for (size_t b = 0; b < blocks; ++b) {
+      thermalEval.on[b] = thermalEval.on[b] || lastThermalApply.on[b] || thermalForced[b];
+    }
+    dilate(thermalEval.on);
+    if (thermalDirty) std::fill(thermalEval.on.begin(), thermalEval.on.end(), 1);
+    fillRuns(thermalEval);
+  }
+}
+
+// After a step: the quiet and evaporation flags of the blocks that ran (the others did not change).
+void Impl::finishStep() {
+  cellUpdates += (long long)water.cells;
+  dirty = false;
+  thermalDirty = false;
+  if (!skip) return;
+  const int blocks = bw * bh;
+  const bool parallel = threads > 1 && water.cells >= kMinParallelCells;
+  // While rain falls everywhere every block is busy anyway: the blocks that ran count as not
+  // quiet (which is always safe) without a look at their cells.
+  const bool rainEverywhere = p.rainMmPerHour != 0.0f;
+#pragma omp parallel for schedule(dynamic, 8) num_threads(threads) if (parallel)
+  for (int b = 0; b < blocks; ++b) {
+    if (water.on[size_t(b)]) quiet[size_t(b)] = !rainEverywhere && blockQuiet(b % bw, b / bw);
+    if (sources.on[size_t(b)]) evapResidual[size_t(b)] = blockEvapResidual(b % bw, b / bw);
+  }
+  std::fill(forced.begin(), forced.end(), 0);
+  std::fill(thermalForced.begin(), thermalForced.end(), 0);
+  lastThermalApply.on.swap(thermalApply.on);
+}
+
+// One step: docs/sim-water.md, "Step".
+void Impl::step(const std::vector<SourceEntry>& entries, const std::vector<LevelEntry>& levels, float dtS,
+                double endS) {
+  dt = dtS;
+  planStep(entries, levels);
+  sourcesPass(entries);
+  if (p.waterModel == WaterModel::kVirtualPipes) {
+    pipeFluxPass();
+    pipeUpdatePass();
+  } else {
+    fvFacePass(now(), false);
+    fvUpdatePass(false);
+    fvFacePass(stage, true);
+    fvLimitPass();
+    if (anySuspended) fvDenPass();
+    fvUpdatePass(true);
+  }
+  cur = 1 - cur;
+  if (!levels.empty()) levelPass(levels);
+  if (p.erosionEnabled) erosionPass();
+  if (p.thermalEnabled) {
+    thermalFluxPass();
+    // What is shed lands on the neighbours: the blocks with a cell that sheds and theirs.
+    if (skip) {
+      thermalApply.on = thermalMoving;
+      dilate(thermalApply.on);
+    } else {
+      std::fill(thermalApply.on.begin(), thermalApply.on.end(), 1);
+    }
+    fillRuns(thermalApply);
+    thermalApplyPass();
+  } else {
+    std::fill(thermalApply.on.begin(), thermalApply.on.end(), 0);
+  }
+  if (floodStats) floodStatsPass(float(endS));
+  finishStep();
+}
+
+}  // namespace cpu
+
+struct CpuSolver::Impl : cpu::Impl {
+  using cpu::Impl::Impl;
+};
+
+using cpu::kMmPerHourToMS;
+using cpu::velocityOf;
+
+CpuSolver::CpuSolver(const SimInput& input, const SimParams& params, const CpuOptions& options)
+    : Solver(input, params), impl_(std::make_unique<Impl>(input, params, options.threads, options.skipQuietBlocks)) {}
+CpuSolver::CpuSolver(CpuSolver&&) noexcept = default;
+CpuSolver& CpuSolver::operator=(CpuSolver&&) noexcept = default;
+CpuSolver::~CpuSolver() = default;
+
+Result<CpuSolver> CpuSolver::create(const SimInput& input, const SimParams& params, const CpuOptions& options) {
+  STRATA_TRY_STATUS(validate(input, params));
+  CpuSolver s(input, params, options);
+  s.recordInitialTotals();
+  return s;
+}
+
+std::string CpuSolver::backendName() const {
+  const int n = impl_->threads;
+  return "CPU, " + std::to_string(n) + (n == 1 ? " OpenMP thread" : " OpenMP threads");
+}
+
+int CpuSolver::threads() const { return impl_->threads; }
+long long CpuSolver::cellUpdates() const { return impl_->cellUpdates; }
+
+SolverFactory cpuSolverFactory(const CpuOptions& options) {
+  return [options](const SimInput& input, const SimParams& params) -> Result<std::unique_ptr<Solver>> {
+    STRATA_TRY(auto s, CpuSolver::create(input, params, options));
+    return std::unique_ptr<Solver>(std::make_unique<CpuSolver>(std::move(s)));
+  };
+}
+
+void CpuSolver::runStep(const StepInputs& step) {
+  Impl& m = *impl_;
+  m.floodStats = floodThresholdM() >= 0;
+  m.wetThresholdM = floodThresholdM();
+  m.step(step.sources, step.levels, step.dtS, step.startS + double(step.dtS));
+}
+
+void CpuSolver::onParamsChanged() {
+  Impl& m = *impl_;
+  const SimParams& next = params();
+  // The thermal flux depends on these besides the cells: evaluate it everywhere once.
+  if (next.thermalEnabled != m.p.thermalEnabled || next.thermalRate != m.p.thermalRate ||
+      next.wetTalusScale != m.p.wetTalusScale || next.bankDepthM != m.p.bankDepthM ||
+      next.bankSlipRatePerS != m.p.bankSlipRatePerS || next.slowWaterMS != m.p.slowWaterMS) {
+    m.thermalDirty = true;
+  }
+  m.p = next;
+  m.allocateFor(next);
+}
+
+double CpuSolver::maxWaveSpeedMS() const { return double(impl_->maxWaveSpeed()); }
+
+namespace {
+template <class F>
+gis::Grid<float> gridOf(int w, int h, F&& value) {
+  gis::Grid<float> g(w, h);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) g.at(x, y) = value(x, y);
+  }
+  return g;
+}
+}  // namespace
+
+gis::Grid<float> CpuSolver::readWaterDepth() const {
+  const auto& u = impl_->now();
+  return gridOf(impl_->w, impl_->h, [&](int x, int y) { return u.h.at(x, y); });
+}
+
+VelocityField CpuSolver::readVelocity() const {
+  const auto& u = impl_->now();
+  const float dry = params().dryDepthM;
+  return {gridOf(impl_->w, impl_->h, [&](int x, int y) { return velocityOf(u.h.at(x, y), u.hu.at(x, y), dry); }),
+          gridOf(impl_->w, impl_->h, [&](int x, int y) { return velocityOf(u.h.at(x, y), u.hv.at(x, y), dry); })};
+}
+
+std::vector<gis::Grid<float>> CpuSolver::readLayers() const {
+  const Impl& m = *impl_;
+  std::vector<gis::Grid<float>> out;
+  for (int l = 0; l < m.L; ++l)
+    out.push_back(gridOf(m.w, m.h, [&](int x, int y) { return m.layers.at(x, l * m.h + y); }));
+  return out;
+}
+
+gis::Grid<float> CpuSolver::readSuspended() const {
+  const auto& u = impl_->now();
+  return gridOf(impl_->w, impl_->h, [&](int x, int y) { return u.s.at(x, y); });
+}
+
+gis::Grid<float> CpuSolver::readBed() const {
+  return gridOf(impl_->w, impl_->h, [&](int x, int y) { return impl_->bed.at(x, y); });
+}
+
+Solver::Totals CpuSolver::totals() const {
+  const Impl& m = *impl_;
+  const auto& u = m.now();
+  Totals t;
+  t.depth.resize(m.cells());
+  t.suspended.resize(m.cells());
+  t.layers.resize(m.cells() * size_t(m.L));
+  for (int y = 0; y < m.h; ++y) {
+    for (int x = 0; x < m.w; ++x) {
+      const size_t i = size_t(y) * size_t(m.w) + size_t(x);
+      t.depth[i] = u.h.at(x, y);
+      t.suspended[i] = u.s.at(x, y);
+      for (int l = 0; l < m.L; ++l) t.layers[size_t(l) * m.cells() + i] = m.layers.at(x, l * m.h + y);
+      t.outflowM3 += double(m.accum[0].at(x, y));
+      t.evaporatedM3 += double(m.accum[2].at(x, y));
+      t.sedimentOutflowM3 += double(m.accum[4].at(x, y));
+      const float level = m.accum[6].at(x, y);
+      (level > 0 ? t.levelInM3 : t.levelOutM3) += double(level);
+    }
+  }
+  return t;
+}
+
+void CpuSolver::resetFloodStats() {
+  Impl& m = *impl_;
+  for (auto& f : m.flood) f = cpu::Plane(m.w, m.h);
+  for (int y = 0; y < m.h; ++y) {
+    float* arrival = m.flood[2].row(y);
+    std::fill(arrival, arrival + m.w, -1.0f);
+  }
+}
+
+std::vector<float> CpuSolver::floodStatsCells() const {
+  const Impl& m = *impl_;
+  std::vector<float> out(4 * m.cells());
+  for (int y = 0; y < m.h; ++y) {
+    for (int x = 0; x < m.w; ++x) {
+      const size_t i = size_t(y) * size_t(m.w) + size_t(x);
+      for (int k = 0; k < 4; ++k) out[4 * i + size_t(k)] = m.flood[k].at(x, y);
+    }
+  }
+  return out;
+}
+
+void CpuSolver::setFloodStatsCells(const std::vector<float>& cells) {
+  Impl& m = *impl_;
+  STRATA_CHECK(cells.size() == 4 * m.cells()) << "flood statistics of " << cells.size() / 4 << " cells";
+  if (m.flood[0].empty()) resetFloodStats();
+  for (int y = 0; y < m.h; ++y) {
+    for (int x = 0; x < m.w; ++x) {
+      const size_t i = size_t(y) * size_t(m.w) + size_t(x);
+      for (int k = 0; k < 4; ++k) m.flood[k].at(x, y) = cells[4 * i + size_t(k)];
+    }
+  }
+}
+
+namespace {
+// Copies 4 (or 8) planes at cells [x0, x0 + width) x [y0, y0 + height) to / from per-cell groups.
+template <size_t N>
+void planesToCells(const cpu::Plane* const (&planes)[N], int x0, int y0, int width, int height, float* out) {
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      for (size_t k = 0; k < N; ++k) *out++ = planes[k]->empty() ? 0.0f : planes[k]->at(x0 + x, y0 + y);
+    }
+  }
+}
+template <size_t N>
+void cellsToPlanes(const float* in, int x0, int y0, int width, int height, cpu::Plane* const (&planes)[N]) {
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      for (size_t k = 0; k < N; ++k, ++in) {
+        if (!planes[k]->empty()) planes[k]->at(x0 + x, y0 + y) = *in;
+      }
+    }
+  }
+}
+}  // namespace
+
+void CpuSolver::saveCells(SolverState& out) const {
+  const Impl& m = *impl_;
+  const auto& u = m.now();
+  const size_t n = m.cells();
+  const cpu::Plane* const statePlanes[4] = {&u.h, &u.s, &u.hu, &u.hv};
+  const cpu::Plane* const fluxPlanes[4] = {&m.flux[0], &m.flux[1], &m.flux[2], &m.flux[3]};
+  const cpu::Plane* const diagPlanes[4] = {&m.fluxDiag[0], &m.fluxDiag[1], &m.fluxDiag[2], &m.fluxDiag[3]};
+  const cpu::Plane* const accumPlanes[8] = {&m.accum[0], &m.accum[1], &m.accum[2], &m.accum[3],
+                                            &m.accum[4], &m.accum[5], &m.accum[6], &m.accum[7]};
+  out.state.resize(4 * n);
+  out.flux.resize(4 * n);
+  out.fluxDiag.resize(4 * n);
+  out.accum.resize(8 * n);
+  planesToCells(statePlanes, 0, 0, m.w, m.h, out.state.data());
+  planesToCells(fluxPlanes, 0, 0, m.w, m.h, out.flux.data());
+  planesToCells(diagPlanes, 0, 0, m.w, m.h, out.fluxDiag.data());
+  planesToCells(accumPlanes, 0, 0, m.w, m.h, out.accum.data());
+  out.layers = totals().layers;
+}
+
+Status CpuSolver::restoreCells(const SolverState& in) {
+  Impl& m = *impl_;
+  const size_t n = m.cells();
+  if (in.state.size() != 4 * n || in.flux.size() != 4 * n || in.fluxDiag.size() != 4 * n ||
+      in.layers.size() != size_t(m.L) * n || in.accum.size() != 8 * n) {
+    return fail("sim: the saved state is of a different grid (" + std::to_string(in.state.size() / 4) +
+                " cells, this simulation has " + std::to_string(n) + ")");
+  }
+  CellBlock b{0, 0, m.w, m.h, in.state, in.flux, in.fluxDiag, in.layers, in.accum};
+  writeBlock(b);
+  m.markAll();
+  return {};
+}
+
+CellBlock CpuSolver::readBlock(int x0, int y0, int width, int height, unsigned parts) const {
+  const Impl& m = *impl_;
+  CellBlock b{x0, y0, width, height, {}, {}, {}, {}, {}};
+  STRATA_CHECK(blockFits(b, m.w, m.h, m.L)) << "readBlock (" << x0 << ", " << y0 << ") " << width << "x" << height
+                                            << " outside the " << m.w << "x" << m.h << " grid";
+  const auto& u = m.now();
+  const size_t cells = b.cells();
+  const cpu::Plane* const statePlanes[4] = {&u.h, &u.s, &u.hu, &u.hv};
+  const cpu::Plane* const fluxPlanes[4] = {&m.flux[0], &m.flux[1], &m.flux[2], &m.flux[3]};
+  const cpu::Plane* const diagPlanes[4] = {&m.fluxDiag[0], &m.fluxDiag[1], &m.fluxDiag[2], &m.fluxDiag[3]};
+  const cpu::Plane* const accumPlanes[8] = {&m.accum[0], &m.accum[1], &m.accum[2], &m.accum[3],
+                                            &m.accum[4], &m.accum[5], &m.accum[6], &m.accum[7]};
+  if (parts & kBlockState) {
+    b.state.resize(4 * cells);
+    planesToCells(statePlanes, x0, y0, width, height, b.state.data());
+  }
+  if (parts & kBlockFlux) {
+    b.flux.resize(4 * cells);
+    planesToCells(fluxPlanes, x0, y0, width, height, b.flux.data());
+    if (params().diagonalPipes) {
+      b.fluxDiag.resize(4 * cells);
+      planesToCells(diagPlanes, x0, y0, width, height, b.fluxDiag.data());
+    }
+  }
+  if (parts & kBlockLayers) {
+    b.layers.resize(size_t(m.L) * cells);
+    for (int l = 0; l < m.L; ++l) {
+      for (int y = 0; y < height; ++y) {
+        for (int x = 0; x < width; ++x) {
+          b.layers[size_t(l) * cells + size_t(y) * size_t(width) + size_t(x)] = m.layers.at(x0 + x, l * m.h + y0 + y);
+        }
+      }
+    }
+  }
+  if (parts & kBlockAccum) {
+    b.accum.resize(8 * cells);
+    planesToCells(accumPlanes, x0, y0, width, height, b.accum.data());
+  }
+  return b;
+}
+
+void CpuSolver::writeBlock(const CellBlock& b) {
+  Impl& m = *impl_;
+  STRATA_CHECK(blockFits(b, m.w, m.h, m.L)) << "writeBlock: sizes do not match the block or the grid";
+  auto& u = m.now();
+  const size_t cells = b.cells();
+  cpu::Plane* const statePlanes[4] = {&u.h, &u.s, &u.hu, &u.hv};
+  cpu::Plane* const fluxPlanes[4] = {&m.flux[0], &m.flux[1], &m.flux[2], &m.flux[3]};
+  cpu::Plane* const diagPlanes[4] = {&m.fluxDiag[0], &m.fluxDiag[1], &m.fluxDiag[2], &m.fluxDiag[3]};
+  cpu::Plane* const accumPlanes[8] = {&m.accum[0], &m.accum[1], &m.accum[2], &m.accum[3],
+                                      &m.accum[4], &m.accum[5], &m.accum[6], &m.accum[7]};
+  if (!b.state.empty()) cellsToPlanes(b.state.data(), b.x0, b.y0, b.width, b.height, statePlanes);
+  if (!b.flux.empty()) cellsToPlanes(b.flux.data(), b.x0, b.y0, b.width, b.height, fluxPlanes);
+  if (!b.fluxDiag.empty()) cellsToPlanes(b.fluxDiag.data(), b.x0, b.y0, b.width, b.height, diagPlanes);
+  if (!b.accum.empty()) cellsToPlanes(b.accum.data(), b.x0, b.y0, b.width, b.height, accumPlanes);
+  if (!b.layers.empty()) {
+    for (int l = 0; l < m.L; ++l) {
+      for (int y = 0; y < b.height; ++y) {
+        for (int x = 0; x < b.width; ++x) {
+          m.layers.at(b.x0 + x, l * m.h + b.y0 + y) =
+              b.layers[size_t(l) * cells + size_t(y) * size_t(b.width) + size_t(x)];
+        }
+      }
+    }
+    for (int y = 0; y < b.height; ++y) {
+      for (int x = 0; x < b.width; ++x) m.recomputeBed(b.x0 + x, b.y0 + y);
+    }
+  }
+  // The blocks written run in the next two steps (their other state buffer and intermediates
+  // are stale), and their flags follow the new cells.
+  if (b.width == 0 || b.height == 0) return;
+  for (int by = b.y0 / cpu::kBlock; by <= (b.y0 + b.height - 1) / cpu::kBlock; ++by) {
+    for (int bx = b.x0 / cpu::kBlock; bx <= (b.x0 + b.width - 1) / cpu::kBlock; ++bx) {
+      const size_t k = size_t(by * m.bw + bx);
+      m.forced[k] = 1;
+      m.thermalForced[k] = 1;
+      m.quiet[k] = m.blockQuiet(bx, by);
+      m.evapResidual[k] = m.blockEvapResidual(bx, by);
+    }
+  }
+  for (int y = b.y0; y < b.y0 + b.height && !m.anySuspended && !b.state.empty(); ++y) {
+    for (int x = b.x0; x < b.x0 + b.width; ++x)
+      m.anySuspended = m.anySuspended || u.s.at(x, y) != 0.0f || std::signbit(u.s.at(x, y));
+  }
+  m.allocateFor(m.p);
+}
+
+std::vector<float> CpuSolver::readFaceMassFlux() const {
+  const Impl& m = *impl_;
+  STRATA_CHECK(params().waterModel == WaterModel::kFiniteVolume) << "face fluxes exist in flood mode only";
+  // The flux the last corrector applied: scaled by its upwind cell's W25 limit (fvUpdatePass).
+  auto limited = [&](float f, int xl, int yl, int xr, int yr) {
+    const int x = f > 0.0f ? xl : xr, y = f > 0.0f ? yl : yr;
+    return x < 0 || y < 0 || x >= m.w || y >= m.h ? f : f * m.limit.at(x, y);
+  };
+  std::vector<float> out;
+  out.reserve(size_t(m.w + 1) * size_t(m.h) + size_t(m.w) * size_t(m.h + 1));
+  for (int y = 0; y < m.h; ++y) {
+    for (int x = 0; x <= m.w; ++x) out.push_back(limited(m.faceX.mass.at(x, y), x - 1, y, x, y));
+  }
+  for (int y = 0; y <= m.h; ++y) {
+    for (int x = 0; x < m.w; ++x) out.push_back(limited(m.faceY.mass.at(x, y), x, y - 1, x, y));
+  }
+  return out;
+}
+
+}  // namespace strata::sim

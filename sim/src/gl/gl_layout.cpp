@@ -1,0 +1,44 @@
+#include <strata/sim/gl_layout.hpp>
+
+namespace strata::sim {
+
+GpuSimParams gpuParams(const SimParams& p, const CellGrid& grid, float dtS) {
+  GpuSimParams g;
+  g.width = grid.width;
+  g.height = grid.height;
+  g.layerCount = grid.layers;
+  g.waterModel = int32_t(p.waterModel);
+  g.openEdges = p.openEdges;
+  g.erosionEnabled = p.erosionEnabled ? 1u : 0u;
+  g.thermalEnabled = p.thermalEnabled ? 1u : 0u;
+  g.diagonalPipes = p.diagonalPipes ? 1u : 0u;
+  g.dyM = float(grid.dyM);
+  g.gravityMS2 = p.gravityMS2;
+  g.dtS = dtS;
+  g.maxDtS = p.maxDtS;
+  g.cflAlpha = p.cflAlpha;
+  g.dryDepthM = p.dryDepthM;
+  g.pipeAreaM2 = p.pipeAreaM2;
+  g.manningN = p.manningN;
+  g.rainMmPerHour = p.rainMmPerHour;
+  g.evaporationMmPerHour = p.evaporationMmPerHour;
+  g.capacityK = p.capacityK;
+  g.erosionRate = p.erosionRate;
+  g.depositionRate = p.depositionRate;
+  g.deepWaterM = p.deepWaterM;
+  g.minSinTilt = p.minSinTilt;
+  g.slowWaterMS = p.slowWaterMS;
+  g.thermalRate = p.thermalRate;
+  g.wetTalusScale = p.wetTalusScale;
+  g.maxErosionPerStepM = p.maxErosionPerStepM;
+  g.slopeLimiter = int32_t(p.slopeLimiter);
+  g.bankDepthM = p.bankDepthM;
+  g.bankSlipRatePerS = p.bankSlipRatePerS;
+  return g;
+}
+
+GpuMaterial gpuMaterial(const MaterialConstants& m) {
+  return {m.erodibility, m.dissolutionRate, m.tanTalus, m.weatheringRatePerS};
+}
+
+}  // namespace strata::sim

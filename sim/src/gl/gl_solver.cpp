@@ -1,0 +1,437 @@
+// Host side of the GL backend: owns the buffers, binds them at the slots declared in
+// sim/shaders/sim.glsl, and dispatches the passes in the order CpuSolver::runStep runs them, with
+// a shader-storage barrier between passes.
+#include <strata/sim/gl_solver.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstring>
+#include <string>
+
+#include <strata/gl/context.hpp>
+#include <strata/gl/objects.hpp>
+#include <strata/gl/state.hpp>
+#include <strata/sim/gl_layout.hpp>
+#include <strata/sim/shader_slots.hpp>
+
+namespace strata::sim {
+
+namespace {
+constexpr size_t kParamsDtOffset = offsetof(GpuSimParams, dtS);
+
+void barrier() { gl::memoryBarrier(gl::Barrier::kStorage); }
+void readBarrier() { gl::memoryBarrier(gl::Barrier::kBufferUpdate); }
+}  // namespace
+
+struct GlSolver::Impl {
+  GpuSimParams p{};  // the block the kernels read (gpuParams)
+  size_t n = 0;
+  int layers = 0;
+
+  gl::Buffer params, materials, rowDx, base, bed, layerBuf, stateA, stateB, stage, flux, fluxDiag, faceX, faceY, tilt,
+      accum, rain, thermal, sourceEntries, maxSpeed, floodStats, fvLimit, levelEntries;
+  bool aIsCurrent = true;
+  gl::Program pSources, pPointSources, pWaveSpeed, pPipeFlux, pPipeUpdate, pFvFace, pFvLimit, pFvUpdate, pErode,
+      pThermalFlux, pThermalApply, pFloodStats, pLevel, pCopyRect, pBedRect;
+  gl::Buffer packed;  // copy_rect.comp's side of a rectangle moved to or from the host
+
+  const gl::Buffer& cur() const { return aIsCurrent ? stateA : stateB; }
+  const gl::Buffer& next() const { return aIsCurrent ? stateB : stateA; }
+  gl::Buffer& curMut() { return aIsCurrent ? stateA : stateB; }
+
+  void bindAll() const {
+    params.bind(slots::kParams);
+    materials.bind(slots::kMaterials);
+    rowDx.bind(slots::kRowDx);
+    base.bind(slots::kBase);
+    bed.bind(slots::kBed);
+    layerBuf.bind(slots::kLayers);
+    cur().bind(slots::kStateIn);
+    next().bind(slots::kStateOut);
+    stage.bind(slots::kStage);
+    flux.bind(slots::kFlux);
+    fluxDiag.bind(slots::kFluxDiag);
+    faceX.bind(slots::kFaceX);
+    faceY.bind(slots::kFaceY);
+    tilt.bind(slots::kTilt);
+    accum.bind(slots::kAccum);
+    rain.bind(slots::kRain);
+    thermal.bind(slots::kThermal);
+    sourceEntries.bind(slots::kSources);
+    maxSpeed.bind(slots::kMaxSpeed);
+    fvLimit.bind(slots::kFvLimit);
+  }
+
+  double maxWaveSpeed() {
+    maxSpeed.fill(0u);
+    bindAll();
+    pWaveSpeed.dispatchCovering(int(n));
+    readBarrier();
+    uint32_t bits = 0;
+    maxSpeed.download(0, 4, &bits);
+    float v;
+    std::memcpy(&v, &bits, 4);
+    return double(v);
+  }
+
+  void takeStep(const StepInputs& step, bool hasLevels, float wetThresholdM) {
+    const int w = p.width, h = p.height;
+    if (step.dtS != p.dtS) {
+      p.dtS = step.dtS;
+      params.upload(kParamsDtOffset, sizeof(float), &p.dtS);
+    }
+    bindAll();
+    pSources.dispatchCovering(w, h);
+    barrier();
+    if (!step.sources.empty()) {
+      const size_t bytes = step.sources.size() * sizeof(SourceEntry);
+      if (sourceEntries.size() < bytes) {
+        sourceEntries = gl::Buffer(bytes);
+        sourceEntries.bind(slots::kSources);
+      }
+      sourceEntries.upload(0, bytes, step.sources.data());
+      pPointSources.set("entryCount", unsigned(step.sources.size()));
+      pPointSources.dispatchCovering(int(step.sources.size()));
+      barrier();
+    }
+    if (p.waterModel == int32_t(WaterModel::kVirtualPipes)) {
+      pPipeFlux.dispatchCovering(w, h);
+      barrier();
+      pPipeUpdate.dispatchCovering(w, h);
+      barrier();
+    } else {
+      pFvFace.set("average", 0);
+      pFvFace.dispatchCovering(w, h);
+      barrier();
+      pFvUpdate.set("final_", 0);
+      pFvUpdate.dispatchCovering(w, h);
+      barrier();
+      stage.bind(slots::kStateIn);  // the corrector's faces come from U1
+      pFvFace.set("average", 1);
+      pFvFace.dispatchCovering(w, h);
+      barrier();
+      cur().bind(slots::kStateIn);
+      pFvLimit.dispatchCovering(w, h);
+      barrier();
+      pFvUpdate.set("final_", 1);
+      pFvUpdate.dispatchCovering(w, h);
+      barrier();
+    }
+    aIsCurrent = !aIsCurrent;
+    cur().bind(slots::kStateIn);
+    next().bind(slots::kStateOut);
+    if (hasLevels) levelPass(step.levels);
+    if (p.erosionEnabled) {
+      pErode.dispatchCovering(w, h);
+      barrier();
+    }
+    if (p.thermalEnabled) {
+      pThermalFlux.dispatchCovering(w, h);
+      barrier();
+      pThermalApply.dispatchCovering(w, h);
+      barrier();
+    }
+    if (wetThresholdM >= 0) {
+      cur().bind(slots::kStateIn);
+      floodStats.bind(slots::kFloodStats);
+      pFloodStats.set("timeS", float(step.startS + double(step.dtS)));
+      pFloodStats.set("wetThresholdM", wetThresholdM);
+      pFloodStats.dispatchCovering(int(n));
+      barrier();
+    }
+  }
+
+  // W26: the fixed levels at the end of the step (sim/shaders/level_boundary.comp).
+  void levelPass(const std::vector<LevelEntry>& entries) {
+    if (entries.empty()) return;
+    const size_t bytes = entries.size() * sizeof(LevelEntry);
+    if (levelEntries.size() < bytes) levelEntries = gl::Buffer(bytes);
+    levelEntries.upload(0, bytes, entries.data());
+    levelEntries.bind(slots::kLevels);
+    pLevel.set("entryCount", unsigned(entries.size()));
+    pLevel.dispatchCovering(int(entries.size()));
+    barrier();
+  }
+
+  std::vector<float> readState() const {
+    readBarrier();
+    return cur().read<float>();
+  }
+
+  // The cells [x0, x0 + width) x [y0, y0 + height) of `buf` (`planes` planes of n cells, `perCell`
+  // floats each) to or from the host, packed as CellBlock holds them, in one transfer: whole rows
+  // of one plane directly, anything else through `packed` with copy_rect.comp (a halo strip is
+  // thousands of rows; a transfer per row costs a driver round trip each).
+  struct Rect {
+    size_t perCell, planes;
+    int x0, y0, width, height;
+    size_t floats() const { return perCell * planes * size_t(width) * size_t(height); }
+    bool wholeRows(int gridWidth) const { return planes == 1 && x0 == 0 && width == gridWidth; }
+    size_t offset() const { return 4 * perCell * size_t(y0) * size_t(width); }  // bytes, whole rows
+  };
+  void copyRect(const gl::Buffer& buf, const Rect& r, bool scatter) {
+    if (packed.size() < 4 * r.floats()) packed = gl::Buffer(4 * r.floats());
+    buf.bind(slots::kCopyGrid);
+    packed.bind(slots::kCopyPacked);
+    pCopyRect.set("gridWidth", unsigned(p.width));
+    pCopyRect.set("gridCells", unsigned(n));
+    pCopyRect.set("x0", unsigned(r.x0));
+    pCopyRect.set("y0", unsigned(r.y0));
+    pCopyRect.set("width", unsigned(r.width));
+    pCopyRect.set("height", unsigned(r.height));
+    pCopyRect.set("perCell", unsigned(r.perCell));
+    pCopyRect.set("planes", unsigned(r.planes));
+    pCopyRect.set("scatter", scatter ? 1u : 0u);
+    pCopyRect.dispatchCovering(int(r.perCell) * r.width, int(r.planes) * r.height);
+  }
+  void downloadRect(const gl::Buffer& buf, const Rect& r, float* out) {
+    if (r.floats() == 0) return;
+    if (r.wholeRows(p.width)) return buf.download(r.offset(), 4 * r.floats(), out);
+    copyRect(buf, r, false);
+    readBarrier();
+    packed.download(0, 4 * r.floats(), out);
+  }
+  void uploadRect(gl::Buffer& buf, const Rect& r, const float* in) {
+    if (r.floats() == 0) return;
+    if (r.wholeRows(p.width)) return buf.upload(r.offset(), 4 * r.floats(), in);
+    if (packed.size() < 4 * r.floats()) packed = gl::Buffer(4 * r.floats());
+    packed.upload(0, 4 * r.floats(), in);
+    copyRect(buf, r, true);
+    barrier();
+  }
+
+  // The bed of a rectangle from base + layers (after its layers were written): bed_rect.comp.
+  void recomputeBed(int x0, int y0, int width, int height) {
+    bindAll();
+    pBedRect.set("gridWidth", unsigned(p.width));
+    pBedRect.set("gridCells", unsigned(n));
+    pBedRect.set("layerCount", unsigned(layers));
+    pBedRect.set("x0", unsigned(x0));
+    pBedRect.set("y0", unsigned(y0));
+    pBedRect.set("width", unsigned(width));
+    pBedRect.set("height", unsigned(height));
+    pBedRect.dispatchCovering(width, height);
+    barrier();
+  }
+};
+
+GlSolver::GlSolver(const SimInput& input, const SimParams& params, std::unique_ptr<Impl> impl)
+    : Solver(input, params), impl_(std::move(impl)) {}
+GlSolver::GlSolver(GlSolver&&) noexcept = default;
+GlSolver& GlSolver::operator=(GlSolver&&) noexcept = default;
+GlSolver::~GlSolver() = default;
+
+Result<GlSolver> GlSolver::create(const SimInput& input, const SimParams& params) {
+  STRATA_TRY_STATUS(validate(input, params));
+  auto impl = std::make_unique<Impl>();
+  Impl& s = *impl;
+  const CellGrid grid = CellGrid::of(input);
+  s.p = gpuParams(params, grid, 0.0f);
+  const int w = grid.width, h = grid.height, L = grid.layers;
+  s.n = grid.cells();
+  s.layers = L;
+  const size_t n = s.n;
+
+  struct Kernel {
+    gl::Program* program;
+    const char* name;
+  };
+  for (auto [program, name] :
+       {Kernel{&s.pSources, "sim/shaders/sources.comp"}, Kernel{&s.pPointSources, "sim/shaders/point_sources.comp"},
+        Kernel{&s.pWaveSpeed, "sim/shaders/wave_speed.comp"}, Kernel{&s.pPipeFlux, "sim/shaders/pipe_flux.comp"},
+        Kernel{&s.pPipeUpdate, "sim/shaders/pipe_update.comp"}, Kernel{&s.pFvFace, "sim/shaders/fv_face.comp"},
+        Kernel{&s.pFvLimit, "sim/shaders/fv_limit.comp"}, Kernel{&s.pFvUpdate, "sim/shaders/fv_update.comp"},
+        Kernel{&s.pErode, "sim/shaders/erode.comp"}, Kernel{&s.pThermalFlux, "sim/shaders/thermal_flux.comp"},
+        Kernel{&s.pThermalApply, "sim/shaders/thermal_apply.comp"},
+        Kernel{&s.pFloodStats, "sim/shaders/flood_stats.comp"}, Kernel{&s.pLevel, "sim/shaders/level_boundary.comp"},
+        Kernel{&s.pCopyRect, "sim/shaders/copy_rect.comp"}, Kernel{&s.pBedRect, "sim/shaders/bed_rect.comp"}}) {
+    auto prog = gl::Program::compute(name, gl::definesFor(slots::kAll));
+    if (!prog) return fail("sim: " + prog.message());
+    *program = std::move(prog).value();
+  }
+
+  std::vector<GpuMaterial> mats;
+  for (const auto& m : input.materials) mats.push_back(gpuMaterial(materialConstants(m)));
+  std::vector<float> rowDxF;
+  for (int y = 0; y < h; ++y) rowDxF.push_back(float(grid.rowDxM[size_t(y)]));
+  std::vector<float> base(n), layers(n * size_t(L)), bed(n), state(4 * n, 0.0f);
+  for (size_t i = 0; i < n; ++i) base[i] = float(double(input.baseM.data[i]) - input.datumM);
+  for (int l = 0; l < L; ++l) {
+    std::copy(input.layersM[size_t(l)].data.begin(), input.layersM[size_t(l)].data.end(),
+              layers.begin() + ptrdiff_t(size_t(l) * n));
+  }
+  for (size_t i = 0; i < n; ++i) {
+    float b = base[i];
+    for (int l = 0; l < L; ++l) b += layers[size_t(l) * n + i];
+    bed[i] = b;
+    if (input.waterDepthM.size() > 0) state[4 * i] = input.waterDepthM.data[i];
+  }
+  const std::vector<float> rain =
+      input.rainMmPerHour.size() > 0 ? input.rainMmPerHour.data : std::vector<float>(n, 0.0f);
+
+  s.params = gl::Buffer(sizeof(GpuSimParams), &s.p);
+  s.materials = gl::Buffer::from(std::span<const GpuMaterial>(mats));
+  s.rowDx = gl::Buffer::from(std::span<const float>(rowDxF));
+  s.base = gl::Buffer::from(std::span<const float>(base));
+  s.bed = gl::Buffer::from(std::span<const float>(bed));
+  s.layerBuf = gl::Buffer::from(std::span<const float>(layers));
+  s.stateA = gl::Buffer::from(std::span<const float>(state));
+  s.stateB = gl::Buffer::from(std::span<const float>(state));
+  s.stage = gl::Buffer::from(std::span<const float>(state));
+  s.flux = gl::Buffer(16 * n);
+  s.flux.fill(0u);
+  s.fluxDiag = gl::Buffer(params.diagonalPipes ? 16 * n : 16);
+  s.fluxDiag.fill(0u);
+  const bool flood = params.waterModel == WaterModel::kFiniteVolume;
+  s.faceX = gl::Buffer(flood ? 16 * size_t(w + 1) * size_t(h) : 16);
+  s.faceX.fill(0u);
+  s.faceY = gl::Buffer(flood ? 16 * size_t(w) * size_t(h + 1) : 16);
+  s.faceY.fill(0u);
+  s.fvLimit = gl::Buffer(flood ? 4 * n : 16);
+  s.fvLimit.fill(0u);
+  s.tilt = gl::Buffer(4 * n);
+  s.tilt.fill(0u);
+  s.accum = gl::Buffer(32 * n);
+  s.accum.fill(0u);
+  s.rain = gl::Buffer::from(std::span<const float>(rain));
+  s.thermal = gl::Buffer(16 * n);
+  s.thermal.fill(0u);
+  s.sourceEntries = gl::Buffer(sizeof(SourceEntry) * 16);
+  s.maxSpeed = gl::Buffer(4);
+  s.floodStats = gl::Buffer(16 * n);
+
+  GlSolver solver(input, params, std::move(impl));
+  solver.recordInitialTotals();
+  return solver;
+}
+
+std::string GlSolver::backendName() const {
+  const std::string renderer = gl::queryContextInfo().renderer;
+  return "GL on " + (renderer.empty() ? std::string("an unknown device") : renderer);
+}
+
+void GlSolver::runStep(const StepInputs& step) { impl_->takeStep(step, !levels().empty(), floodThresholdM()); }
+
+void GlSolver::onParamsChanged() {
+  Impl& s = *impl_;
+  s.p = gpuParams(params(), grid(), s.p.dtS);
+  s.params.upload(0, sizeof(GpuSimParams), &s.p);
+}
+
+double GlSolver::maxWaveSpeedMS() const { return impl_->maxWaveSpeed(); }
+
+const gl::Buffer& GlSolver::stateBuffer() const { return impl_->cur(); }
+
+gis::Grid<float> GlSolver::readBed() const {
+  readBarrier();
+  gis::Grid<float> g(grid().width, grid().height);
+  g.data = impl_->bed.read<float>();
+  return g;
+}
+
+size_t GlSolver::gpuBytes() const {
+  const Impl& s = *impl_;
+  size_t total = 0;
+  for (const gl::Buffer* b :
+       {&s.params, &s.materials, &s.rowDx,   &s.base,          &s.bed,      &s.layerBuf,   &s.stateA,
+        &s.stateB, &s.stage,     &s.flux,    &s.fluxDiag,      &s.faceX,    &s.faceY,      &s.tilt,
+        &s.accum,  &s.rain,      &s.thermal, &s.sourceEntries, &s.maxSpeed, &s.floodStats, &s.fvLimit}) {
+    total += b->size();
+  }
+  return total;
+}
+
+CellBlock GlSolver::readBlock(int x0, int y0, int width, int height, unsigned parts) const {
+  const int w = grid().width, L = grid().layers;
+  CellBlock b{x0, y0, width, height, {}, {}, {}, {}, {}};
+  STRATA_CHECK(blockFits(b, w, grid().height, L))
+      << "readBlock (" << x0 << ", " << y0 << ") " << width << "x" << height << " outside the grid";
+  Impl& s = *impl_;
+  readBarrier();
+  const size_t cells = b.cells();
+  if (parts & kBlockState) b.state.resize(4 * cells);
+  if (parts & kBlockFlux) b.flux.resize(4 * cells);
+  if ((parts & kBlockFlux) && params().diagonalPipes) b.fluxDiag.resize(4 * cells);
+  if (parts & kBlockLayers) b.layers.resize(size_t(L) * cells);
+  if (parts & kBlockAccum) b.accum.resize(8 * cells);
+  // One transfer per part (whole rows, or packed on the GPU first).
+  auto read = [&](const gl::Buffer& buf, size_t per, size_t planes, std::vector<float>& out) {
+    if (!out.empty()) s.downloadRect(buf, Impl::Rect{per, planes, x0, y0, width, height}, out.data());
+  };
+  read(s.cur(), 4, 1, b.state);
+  read(s.flux, 4, 1, b.flux);
+  read(s.fluxDiag, 4, 1, b.fluxDiag);
+  read(s.accum, 8, 1, b.accum);
+  read(s.layerBuf, 1, size_t(L), b.layers);
+  return b;
+}
+
+void GlSolver::writeBlock(const CellBlock& b) {
+  const int w = grid().width, L = grid().layers;
+  STRATA_CHECK(blockFits(b, w, grid().height, L)) << "writeBlock: sizes do not match the block or the grid";
+  Impl& s = *impl_;
+  readBarrier();
+  auto write = [&](gl::Buffer& buf, size_t per, size_t planes, const std::vector<float>& in) {
+    if (!in.empty()) s.uploadRect(buf, Impl::Rect{per, planes, b.x0, b.y0, b.width, b.height}, in.data());
+  };
+  write(s.curMut(), 4, 1, b.state);
+  write(s.flux, 4, 1, b.flux);
+  write(s.fluxDiag, 4, 1, b.fluxDiag);
+  write(s.accum, 8, 1, b.accum);
+  write(s.layerBuf, 1, size_t(L), b.layers);
+  if (!b.layers.empty()) s.recomputeBed(b.x0, b.y0, b.width, b.height);
+}
+
+SolverFactory glSolverFactory() {
+  return [](const SimInput& input, const SimParams& params) -> Result<std::unique_ptr<Solver>> {
+    STRATA_TRY(auto s, GlSolver::create(input, params));
+    return std::unique_ptr<Solver>(std::make_unique<GlSolver>(std::move(s)));
+  };
+}
+
+void GlSolver::resetFloodStats() {
+  const auto init = initialFloodStatsCells(impl_->n);
+  impl_->floodStats.upload(0, init.size() * 4, init.data());
+}
+
+std::vector<float> GlSolver::floodStatsCells() const {
+  readBarrier();
+  return impl_->floodStats.read<float>();
+}
+
+void GlSolver::setFloodStatsCells(const std::vector<float>& cells) {
+  STRATA_CHECK(cells.size() == 4 * impl_->n) << "flood statistics of " << cells.size() / 4 << " cells";
+  impl_->floodStats.upload(0, cells.size() * 4, cells.data());
+}
+
+std::vector<float> GlSolver::readFaceMassFlux() const {
+  const Impl& s = *impl_;
+  STRATA_CHECK(params().waterModel == WaterModel::kFiniteVolume) << "face fluxes exist in flood mode only";
+  readBarrier();
+  const auto fx = s.faceX.read<float>(), fy = s.faceY.read<float>();
+  const auto limit = s.fvLimit.read<float>();
+  const int w = grid().width, h = grid().height;
+  // The flux the last corrector applied: scaled by its upwind cell's W25 limit (fv_update.comp).
+  auto limited = [&](float f, int upX, int upY) {
+    const bool inside = upX >= 0 && upY >= 0 && upX < w && upY < h;
+    return inside ? f * limit[size_t(upY) * size_t(w) + size_t(upX)] : f;
+  };
+  std::vector<float> out;
+  out.reserve(fx.size() / 4 + fy.size() / 4);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x <= w; ++x) {
+      const float f = fx[4 * (size_t(y) * size_t(w + 1) + size_t(x))];
+      out.push_back(f > 0 ? limited(f, x - 1, y) : limited(f, x, y));
+    }
+  }
+  for (int y = 0; y <= h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const float f = fy[4 * (size_t(y) * size_t(w) + size_t(x))];
+      out.push_back(f > 0 ? limited(f, x, y - 1) : limited(f, x, y));
+    }
+  }
+  return out;
+}
+
+}  // namespace strata::sim

@@ -1,0 +1,81 @@
+#include <strata/sim/params.hpp>
+
+#include <cmath>
+#include <string>
+
+namespace strata::sim {
+namespace {
+
+// "sim params: <name> = <value>: must be <what>" unless `ok`.
+Status require(bool ok, const char* name, float value, const char* what) {
+  if (ok) return {};
+  return fail(std::string("sim params: ") + name + " = " + std::to_string(value) + ": must be " + what);
+}
+
+}  // namespace
+
+Status validateParams(const SimParams& p) {
+  if (p.waterModel != WaterModel::kVirtualPipes && p.waterModel != WaterModel::kFiniteVolume) {
+    return fail("sim params: waterModel " + std::to_string(int(p.waterModel)) + " is not 0 (pipes) or 1 (flood)");
+  }
+  if (p.slopeLimiter != SlopeLimiter::kMinmod && p.slopeLimiter != SlopeLimiter::kMonotonizedCentral) {
+    return fail("sim params: slopeLimiter " + std::to_string(int(p.slopeLimiter)) + " is not 0 (minmod) or 1 (MC)");
+  }
+  if (p.openEdges > 15u) return fail("sim params: openEdges " + std::to_string(p.openEdges) + " is not a set of edges");
+  // Every constant must be a finite number (NaN fails every comparison below as well).
+  const std::pair<const char*, float> all[] = {{"gravityMS2", p.gravityMS2},
+                                               {"maxDtS", p.maxDtS},
+                                               {"cflAlpha", p.cflAlpha},
+                                               {"dryDepthM", p.dryDepthM},
+                                               {"pipeAreaM2", p.pipeAreaM2},
+                                               {"manningN", p.manningN},
+                                               {"rainMmPerHour", p.rainMmPerHour},
+                                               {"evaporationMmPerHour", p.evaporationMmPerHour},
+                                               {"capacityK", p.capacityK},
+                                               {"erosionRate", p.erosionRate},
+                                               {"depositionRate", p.depositionRate},
+                                               {"deepWaterM", p.deepWaterM},
+                                               {"minSinTilt", p.minSinTilt},
+                                               {"slowWaterMS", p.slowWaterMS},
+                                               {"thermalRate", p.thermalRate},
+                                               {"wetTalusScale", p.wetTalusScale},
+                                               {"bankDepthM", p.bankDepthM},
+                                               {"bankSlipRatePerS", p.bankSlipRatePerS},
+                                               {"maxErosionPerStepM", p.maxErosionPerStepM}};
+  for (const auto& [name, v] : all) STRATA_TRY_STATUS(require(std::isfinite(v), name, v, "a finite number"));
+  STRATA_TRY_STATUS(require(p.maxDtS > 0, "maxDtS", p.maxDtS, "positive"));
+  STRATA_TRY_STATUS(require(p.gravityMS2 > 0, "gravityMS2", p.gravityMS2, "positive"));
+  STRATA_TRY_STATUS(require(p.cflAlpha >= 0, "cflAlpha", p.cflAlpha, ">= 0"));
+  if (p.waterModel == WaterModel::kFiniteVolume) {
+    STRATA_TRY_STATUS(require(p.cflAlpha > 0 && p.cflAlpha <= 0.5f, "cflAlpha", p.cflAlpha,
+                              "in (0, 0.5] in flood mode (positivity of the finite-volume scheme)"));
+  }
+  STRATA_TRY_STATUS(require(p.thermalRate > 0 && p.thermalRate <= 1, "thermalRate", p.thermalRate, "in (0, 1]"));
+  STRATA_TRY_STATUS(require(p.manningN >= 0, "manningN", p.manningN, ">= 0"));
+  STRATA_TRY_STATUS(require(p.bankDepthM >= 0, "bankDepthM", p.bankDepthM, ">= 0"));
+  STRATA_TRY_STATUS(require(p.bankSlipRatePerS >= 0, "bankSlipRatePerS", p.bankSlipRatePerS, ">= 0"));
+  STRATA_TRY_STATUS(require(p.dryDepthM > 0, "dryDepthM", p.dryDepthM, "positive"));
+  STRATA_TRY_STATUS(require(p.deepWaterM > 0, "deepWaterM", p.deepWaterM, "positive"));
+  STRATA_TRY_STATUS(require(p.pipeAreaM2 > 0, "pipeAreaM2", p.pipeAreaM2, "positive"));
+  for (const auto& [name, v] : {std::pair{"rainMmPerHour", p.rainMmPerHour},
+                                {"evaporationMmPerHour", p.evaporationMmPerHour},
+                                {"capacityK", p.capacityK},
+                                {"erosionRate", p.erosionRate},
+                                {"depositionRate", p.depositionRate},
+                                {"minSinTilt", p.minSinTilt},
+                                {"slowWaterMS", p.slowWaterMS},
+                                {"wetTalusScale", p.wetTalusScale},
+                                {"maxErosionPerStepM", p.maxErosionPerStepM}}) {
+    STRATA_TRY_STATUS(require(v >= 0, name, v, ">= 0"));
+  }
+  return {};
+}
+
+SimParams runtimeParams(const SimParams& current, const SimParams& next) {
+  SimParams p = next;
+  p.waterModel = current.waterModel;
+  p.diagonalPipes = current.diagonalPipes;
+  return p;
+}
+
+}  // namespace strata::sim

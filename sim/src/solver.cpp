@@ -1,0 +1,299 @@
+#include <strata/sim/solver.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+namespace strata::sim {
+
+Solver::Solver(const SimInput& input, const SimParams& params) : params_(params), grid_(CellGrid::of(input)) {
+  rainRaster_ = input.rainMmPerHour.data;
+  maxRainRasterMmH_ = rainRaster_.empty() ? 0.0 : double(*std::max_element(rainRaster_.begin(), rainRaster_.end()));
+  rainRateM3S_ = rainVolumeRate(params_, rainRaster_, grid_);
+}
+
+Solver::Solver(const CellGrid& grid, const SimParams& params) : params_(params), grid_(grid) {}
+
+Solver::~Solver() = default;
+
+Solver::RainTotals Solver::rainTotals() const {
+  RainTotals r;
+  for (float v : rainRaster_) r.maxRasterMmH = std::max(r.maxRasterMmH, double(v));
+  r.volumeM3S = rainVolumeRate(params_, rainRaster_, grid_);
+  return r;
+}
+
+void Solver::updateRainTotals() {
+  const RainTotals r = rainTotals();
+  maxRainRasterMmH_ = r.maxRasterMmH;
+  rainRateM3S_ = r.volumeM3S;
+}
+
+void Solver::recordInitialTotals() {
+  const SimStats s = stats();
+  c_.initialWaterM3 = s.storedWaterM3;
+  c_.initialMaterialM3 = s.materialM3;
+}
+
+Status Solver::addSource(const Source& source) {
+  STRATA_TRY_STATUS(checkSource(source, grid_.width, grid_.height));
+  STRATA_TRY_STATUS(onSourceAdded(source));
+  sources_.push_back(source);
+  return {};
+}
+
+Status Solver::addLevel(const LevelBoundary& level) {
+  STRATA_TRY_STATUS(checkLevel(level, grid_.width, grid_.height));
+  STRATA_TRY_STATUS(onLevelAdded(level));
+  levels_.push_back(level);
+  return {};
+}
+
+Status Solver::setParams(const SimParams& params) {
+  const SimParams next = runtimeParams(params_, params);
+  STRATA_TRY_STATUS(validateParams(next));
+  params_ = next;
+  updateRainTotals();
+  onParamsChanged();
+  return {};
+}
+
+double Solver::nextDt() {
+  if (params_.cflAlpha <= 0) return params_.maxDtS;  // no wave speed needed (a GPU read-back saved)
+  return stepDtWithSources(params_, maxWaveSpeedMS(), maxRainRasterMmH_, sources_, grid_, c_.timeS);
+}
+
+double Solver::sourceDepthRateMS(double t1S) const {
+  return sourceDepthRate(params_, maxRainRasterMmH_, sources_, grid_, c_.timeS, t1S);
+}
+
+void Solver::step(int n) {
+  for (int k = 0; k < n; ++k) stepWithDt(nextDt());
+}
+
+void Solver::advance(double seconds) {
+  const double end = c_.timeS + seconds;
+  while (c_.timeS < end - 1e-9 * std::max(1.0, end)) stepWithDt(std::min(nextDt(), end - c_.timeS));
+}
+
+void Solver::stepWithDt(double dtS) { takeStep(dtS, true); }
+
+void Solver::skipStep(double dtS) { takeStep(dtS, false); }
+
+void Solver::takeStep(double dtS, bool run) {
+  const float dt = float(dtS);
+  const auto entries = mergeSources(sources_, grid_.width, c_.timeS, c_.timeS + double(dt));
+  const auto levelCells = levels_.empty() ? std::vector<LevelEntry>{}
+                                          : levelEntries(levels_, grid_.width, c_.timeS + double(dt), grid_.datumM);
+  for (const auto& e : entries) c_.inflowM3 += double(e.rateM3S) * double(dt);
+  c_.rainM3 += rainRateM3S_ * double(dt);
+  if (run) runStep(StepInputs{dt, c_.timeS, entries, levelCells});
+  c_.timeS += double(dt);
+  c_.lastDtS = double(dt);
+  ++c_.steps;
+  if (run && wetThresholdM_ >= 0 && !keepsFloodStats()) updateHostFloodStats();
+}
+
+gis::Grid<float> Solver::readWaterDepth() const {
+  const CellBlock b = readBlock(0, 0, grid_.width, grid_.height, kBlockState);
+  gis::Grid<float> g(grid_.width, grid_.height);
+  for (size_t i = 0; i < g.size(); ++i) g.data[i] = b.state[4 * i];
+  return g;
+}
+
+gis::Grid<float> Solver::readSuspended() const {
+  const CellBlock b = readBlock(0, 0, grid_.width, grid_.height, kBlockState);
+  gis::Grid<float> g(grid_.width, grid_.height);
+  for (size_t i = 0; i < g.size(); ++i) g.data[i] = b.state[4 * i + 1];
+  return g;
+}
+
+VelocityField Solver::readVelocity() const {
+  const CellBlock b = readBlock(0, 0, grid_.width, grid_.height, kBlockState);
+  const float dry = params_.dryDepthM;
+  VelocityField v{gis::Grid<float>(grid_.width, grid_.height), gis::Grid<float>(grid_.width, grid_.height)};
+  for (size_t i = 0; i < v.uMS.size(); ++i) {
+    const float h = b.state[4 * i];
+    v.uMS.data[i] = h > dry ? b.state[4 * i + 2] / h : 0.0f;
+    v.vMS.data[i] = h > dry ? b.state[4 * i + 3] / h : 0.0f;
+  }
+  return v;
+}
+
+std::vector<gis::Grid<float>> Solver::readLayers() const {
+  const CellBlock b = readBlock(0, 0, grid_.width, grid_.height, kBlockLayers);
+  const size_t n = grid_.cells();
+  std::vector<gis::Grid<float>> out;
+  for (int l = 0; l < grid_.layers; ++l) {
+    gis::Grid<float> g(grid_.width, grid_.height);
+    std::copy_n(b.layers.begin() + ptrdiff_t(size_t(l) * n), n, g.data.begin());
+    out.push_back(std::move(g));
+  }
+  return out;
+}
+
+Solver::Totals Solver::totals() const {
+  CellBlock b = readBlock(0, 0, grid_.width, grid_.height, kBlockState | kBlockLayers | kBlockAccum);
+  const size_t n = grid_.cells();
+  Totals t;
+  t.depth.resize(n);
+  t.suspended.resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    t.depth[i] = b.state[4 * i];
+    t.suspended[i] = b.state[4 * i + 1];
+    t.outflowM3 += double(b.accum[8 * i]);
+    t.evaporatedM3 += double(b.accum[8 * i + 2]);
+    t.sedimentOutflowM3 += double(b.accum[8 * i + 4]);
+    (b.accum[8 * i + 6] > 0 ? t.levelInM3 : t.levelOutM3) += double(b.accum[8 * i + 6]);
+  }
+  t.layers = std::move(b.layers);
+  return t;
+}
+
+void Solver::saveCells(SolverState& out) const {
+  CellBlock b = readBlock(0, 0, grid_.width, grid_.height, kBlockAll);
+  out.state = std::move(b.state);
+  out.flux = std::move(b.flux);
+  out.fluxDiag = std::move(b.fluxDiag);
+  out.layers = std::move(b.layers);
+  out.accum = std::move(b.accum);
+}
+
+Status Solver::restoreCells(const SolverState& in) {
+  const size_t n = grid_.cells();
+  const size_t diag = params_.diagonalPipes ? 4 * n : 0;
+  if (in.state.size() != 4 * n || in.flux.size() != 4 * n || in.fluxDiag.size() != diag ||
+      in.layers.size() != size_t(grid_.layers) * n || in.accum.size() != 8 * n) {
+    return fail("sim: the saved state is of a different grid or model (" + std::to_string(in.state.size() / 4) +
+                " cells, this simulation has " + std::to_string(n) + ")");
+  }
+  writeBlock(CellBlock{0, 0, grid_.width, grid_.height, in.state, in.flux, in.fluxDiag, in.layers, in.accum});
+  return {};
+}
+
+SimStats Solver::counterStats() const {
+  SimStats s;
+  s.timeS = c_.timeS;
+  s.steps = c_.steps;
+  s.lastDtS = c_.lastDtS;
+  s.initialWaterM3 = c_.initialWaterM3;
+  s.rainM3 = c_.rainM3;
+  s.inflowM3 = c_.inflowM3;
+  s.initialMaterialM3 = c_.initialMaterialM3;
+  return s;
+}
+
+SimStats Solver::stats() const {
+  const Totals t = totals();
+  SimStats s = counterStats();
+  s.storedWaterM3 = integrate(t.depth, grid_);
+  s.inflowM3 = c_.inflowM3 + t.levelInM3;    // W26: level cells that gained water on balance
+  s.outflowM3 = t.outflowM3 - t.levelOutM3;  // and those that lost (levelOut <= 0)
+  s.evaporatedM3 = t.evaporatedM3;
+  s.sedimentOutflowM3 = t.sedimentOutflowM3;
+  s.suspendedM3 = integrate(t.suspended, grid_);
+  s.materialM3 = s.suspendedM3 + integrate(t.layers, grid_);
+  float hmax = 0.0f;
+  for (float h : t.depth) hmax = std::max(hmax, h);
+  s.maxDepthM = hmax;
+  return s;
+}
+
+bool blockFits(const CellBlock& b, int width, int height, int layers) {
+  const size_t n = b.cells();
+  auto sized = [&](const std::vector<float>& v, size_t per) { return v.empty() || v.size() == per * n; };
+  return b.x0 >= 0 && b.y0 >= 0 && b.width >= 0 && b.height >= 0 && b.x0 + b.width <= width &&
+         b.y0 + b.height <= height && sized(b.state, 4) && sized(b.flux, 4) && sized(b.fluxDiag, 4) &&
+         sized(b.layers, size_t(layers)) && sized(b.accum, 8);
+}
+
+std::vector<float> initialFloodStatsCells(size_t cells) {
+  std::vector<float> v(4 * cells, 0.0f);
+  for (size_t i = 0; i < cells; ++i) v[4 * i + 2] = -1.0f;
+  return v;
+}
+
+FloodStats floodStatsFromCells(const std::vector<float>& v, int width, int height) {
+  FloodStats f;
+  gis::Grid<float>* grids[4] = {&f.maxDepthM, &f.maxSpeedMS, &f.arrivalS, &f.wetDurationS};
+  const size_t n = size_t(width) * size_t(height);
+  for (int k = 0; k < 4; ++k) {
+    *grids[k] = gis::Grid<float>(width, height);
+    for (size_t i = 0; i < n; ++i) grids[k]->data[i] = v[4 * i + size_t(k)];
+  }
+  return f;
+}
+
+void Solver::startClockAt(double timeS) {
+  STRATA_CHECK(c_.steps == 0 && std::isfinite(timeS)) << "the clock is set before the first step";
+  c_.timeS = timeS;
+}
+
+void Solver::restartBudgets() {
+  CellBlock b = readBlock(0, 0, grid_.width, grid_.height, kBlockAccum);
+  std::fill(b.accum.begin(), b.accum.end(), 0.0f);
+  writeBlock(b);
+  c_.inflowM3 = 0;
+  c_.rainM3 = 0;
+  recordInitialTotals();
+}
+
+void Solver::enableFloodStats(float wetThresholdM) {
+  STRATA_CHECK(wetThresholdM >= 0 && std::isfinite(wetThresholdM)) << "wet threshold " << wetThresholdM;
+  wetThresholdM_ = wetThresholdM;
+  if (keepsFloodStats()) {
+    resetFloodStats();
+  } else {
+    hostFlood_ = initialFloodStatsCells(grid_.cells());
+  }
+}
+
+FloodStats Solver::readFloodStats() const {
+  if (wetThresholdM_ < 0) return floodStatsFromCells(initialFloodStatsCells(grid_.cells()), grid_.width, grid_.height);
+  return floodStatsFromCells(keepsFloodStats() ? floodStatsCells() : hostFlood_, grid_.width, grid_.height);
+}
+
+// The same per-cell update as the backends' own (e.g. sim/shaders/flood_stats.comp), on the host.
+void Solver::updateHostFloodStats() {
+  const auto h = readWaterDepth();
+  const auto v = readVelocity();
+  const float t = float(c_.timeS), dt = float(c_.lastDtS);
+  for (size_t i = 0; i < h.size(); ++i) {
+    float* f = &hostFlood_[4 * i];
+    f[0] = std::max(f[0], h.data[i]);
+    f[1] = std::max(f[1], std::sqrt(v.uMS.data[i] * v.uMS.data[i] + v.vMS.data[i] * v.vMS.data[i]));
+    if (h.data[i] > wetThresholdM_) {
+      if (f[2] < 0.0f) f[2] = t;
+      f[3] += dt;
+    }
+  }
+}
+
+SolverState Solver::saveState() const {
+  SolverState s;
+  s.counters = c_;
+  s.wetThresholdM = wetThresholdM_;
+  saveCells(s);
+  if (wetThresholdM_ >= 0 && !floodStatsInParts()) s.flood = keepsFloodStats() ? floodStatsCells() : hostFlood_;
+  return s;
+}
+
+Status Solver::restoreState(const SolverState& s) {
+  if (s.wetThresholdM >= 0 && !floodStatsInParts() && s.flood.size() != 4 * grid_.cells()) {
+    return fail("sim: the saved flood statistics are of " + std::to_string(s.flood.size() / 4) +
+                " cells, this simulation has " + std::to_string(grid_.cells()));
+  }
+  STRATA_TRY_STATUS(restoreCells(s));
+  c_ = s.counters;
+  wetThresholdM_ = s.wetThresholdM;
+  if (wetThresholdM_ >= 0 && !floodStatsInParts()) {
+    if (keepsFloodStats()) {
+      setFloodStatsCells(s.flood);
+    } else {
+      hostFlood_ = s.flood;
+    }
+  }
+  return {};
+}
+
+}  // namespace strata::sim

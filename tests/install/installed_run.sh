@@ -1,0 +1,37 @@
+#!/usr/bin/env bash
+# Installs Strata to a fresh prefix and runs a short flood scenario with the installed `strata`
+# from a folder outside the source and build trees: the plots must be written (their scripts are
+# compiled in), and the installed main-job scenario must name a DEM that exists.
+#   installed_run.sh BUILD_DIR DEM
+set -euo pipefail
+build=$1
+dem=$2
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+cmake --install "$build" --prefix "$work/prefix" >/dev/null
+cd "$work"
+cat > short.toml <<TOML
+name = "installed run"
+[terrain]
+dem = "$dem"
+[region]
+bbox_lonlat = [-112.25, 36.02, -112.001, 36.18]
+cell_size = "600 m"
+[[water.inflow]]
+line_lonlat = [[-112.0225, 36.063], [-112.0225, 36.08]]
+hydrograph = [[0, 0], [5, 20000], [20, 20000]]
+hydrograph_units = ["min", "m3/s"]
+[time]
+duration = "10 min"
+output_interval = "5 min"
+TOML
+"$work/prefix/bin/strata" flood short.toml -o run --backend cpu --no-pictures
+for f in run/report.md run/plots/water.png run/plots/max_depth.png run/maps/max_depth.tif; do
+  [ -s "$f" ] || { echo "installed run: $f missing" >&2; exit 1; }
+done
+installed="$work/prefix/share/strata/scenarios/grand_canyon_flood.toml"
+dem_line=$(grep '^dem' "$installed")
+rel=${dem_line#*\"}
+rel=${rel%\"*}
+[ -s "$(dirname "$installed")/$rel" ] || { echo "installed scenario names a missing DEM: $rel" >&2; exit 1; }
+echo "installed run: report, plots and maps written from $work"

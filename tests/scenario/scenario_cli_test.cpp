@@ -1,0 +1,234 @@
+// Issue 19 through the `strata` program, as a user (or a terminal) meets it: two floods into
+// one run folder, a re-run into a folder with outputs, Ctrl-C while the plots are drawn, the file
+// size limit (SIGXFSZ), and render onto an existing file. CPU only: no GL context is needed.
+#include <dlfcn.h>
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <link.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <csignal>
+#include <fstream>
+#include <functional>
+#include <sstream>
+#include <thread>
+#include <tuple>
+
+#include "scenario_fixture.hpp"
+#include "strata_test.hpp"
+
+namespace strata::scenario {
+namespace {
+
+using namespace test_support;
+namespace fs = std::filesystem;
+
+std::string slurp(const fs::path& p) {
+  std::ifstream f(p, std::ios::binary);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+// `strata ARGS...` in `cwd`, in its own process group (as a terminal's foreground job), its
+// output in `log`; with a file size limit when `fsizeBytes` > 0, and `env` ("NAME=value") set;
+// `wrapper` (a program and its arguments) runs strata when given.
+pid_t spawn(const std::vector<std::string>& args, const fs::path& cwd, const fs::path& log, rlim_t fsizeBytes = 0,
+            const std::vector<std::string>& env = {}, const std::vector<std::string>& wrapper = {}) {
+  const pid_t pid = ::fork();
+  if (pid != 0) return pid;
+  for (const auto& e : env) ::putenv(const_cast<char*>(e.c_str()));
+  ::setpgid(0, 0);
+  if (::chdir(cwd.c_str()) != 0) ::_exit(126);
+  const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  ::dup2(fd, 1);
+  ::dup2(fd, 2);
+  if (fsizeBytes > 0) {
+    const rlimit limit{fsizeBytes, fsizeBytes};
+    ::setrlimit(RLIMIT_FSIZE, &limit);
+  }
+  std::vector<char*> argv;
+  for (const auto& w : wrapper) argv.push_back(const_cast<char*>(w.c_str()));
+  argv.push_back(const_cast<char*>(STRATA_CLI));
+  for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  ::execv(argv[0], argv.data());
+  ::_exit(127);
+}
+
+// The exit code, or 128 + the signal that killed it.
+int waitFor(pid_t pid) {
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+int strata(const std::vector<std::string>& args, const fs::path& cwd, std::string& output, rlim_t fsize = 0,
+           const std::vector<std::string>& env = {}, const std::vector<std::string>& wrapper = {}) {
+  const auto log = cwd / "strata.log";
+  const int code = waitFor(spawn(args, cwd, log, fsize, env, wrapper));
+  output = slurp(log);
+  return code;
+}
+
+bool waitUntil(const std::function<bool()>& ready, double seconds) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  while (std::chrono::steady_clock::now() < end) {
+    if (ready()) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  return false;
+}
+
+// The fixture scenario with the CPU backend (the CLI's default picks GL when there is one).
+void writeCpuScenario(const fs::path& dir) {
+  std::string text = scenarioText();
+  text.replace(text.find("kind = \"flood\""), 14, "kind = \"flood\"\nbackend = \"cpu\"");
+  std::ofstream(dir / "flood.toml") << text;
+}
+
+TEST(StrataCli, TwoFloodsIntoOneFolderOneIsRefused) {
+  const auto dir = strata::test::tempDir("cli-two");
+  writeCpuScenario(dir);
+  const pid_t first = spawn({"flood", "flood.toml", "-o", "run", "--no-pictures"}, dir, dir / "first.log");
+  // The first holds the lock once its file names its process.
+  ASSERT_TRUE(waitUntil([&] { return slurp(dir / "run" / "run.lock") == std::to_string(first) + "\n"; }, 60))
+      << slurp(dir / "first.log");
+  std::string out;
+  const int second = strata({"flood", "flood.toml", "-o", "run", "--no-pictures"}, dir, out);
+  EXPECT_EQ(second, 1) << out;
+  EXPECT_NE(out.find("strata flood: run: another run is writing into this run folder (run/run.lock: is locked by "
+                     "process " +
+                     std::to_string(first) + ")"),
+            std::string::npos)
+      << out;
+  EXPECT_EQ(waitFor(first), 0) << slurp(dir / "first.log");
+  EXPECT_TRUE(fs::exists(dir / "run" / "report.md"));
+}
+
+TEST(StrataCli, ARerunIntoAFolderWithOutputsNeedsOverwrite) {
+  const auto dir = strata::test::tempDir("cli-rerun");
+  writeCpuScenario(dir);
+  std::string out;
+  ASSERT_EQ(strata({"flood", "flood.toml", "-o", "run", "--no-pictures", "--no-plots"}, dir, out), 0) << out;
+  const std::string series = slurp(dir / "run" / "series.csv");
+  EXPECT_EQ(strata({"flood", "flood.toml", "-o", "run", "--no-pictures", "--no-plots"}, dir, out), 1);
+  EXPECT_NE(out.find("strata flood: run: holds the outputs of an earlier run (scenario.toml, series.csv, "
+                     "checkpoint.bin, report.md, ...); continue it with --resume or replace them with --overwrite"),
+            std::string::npos)
+      << out;
+  EXPECT_EQ(slurp(dir / "run" / "series.csv"), series);
+  EXPECT_NE(strata({"flood", "flood.toml", "-o", "run", "--resume", "--overwrite"}, dir, out), 0);
+  EXPECT_NE(out.find("--resume excludes --overwrite"), std::string::npos) << out;
+  EXPECT_EQ(strata({"erode", "flood.toml", "-o", "run", "--resume", "--no-pictures", "--no-plots"}, dir, out), 1);
+  EXPECT_NE(out.find("erosion needs loose material"), std::string::npos) << out;
+  EXPECT_EQ(strata({"flood", "flood.toml", "-o", "run", "--overwrite", "--no-pictures", "--no-plots"}, dir, out), 0)
+      << out;
+}
+
+// The plotting child runs in its own process group: a Ctrl-C at the terminal reaches strata
+// (which finishes the plots and writes the report), not python in the middle of a plot.
+TEST(StrataCli, CtrlCWhilePlotsAreDrawnKeepsTheReport) {
+  const auto dir = strata::test::tempDir("cli-ctrl-c");
+  writeCpuScenario(dir);
+  const pid_t pid = spawn({"flood", "flood.toml", "-o", "run", "--no-pictures"}, dir, dir / "run.log");
+  // The plots folder is made just before the first plotting script starts.
+  ASSERT_TRUE(waitUntil([&] { return fs::exists(dir / "run" / "plots"); }, 120)) << slurp(dir / "run.log");
+  ASSERT_EQ(::kill(-pid, SIGINT), 0);  // what the terminal does: the whole foreground group
+  const int code = waitFor(pid);
+  const std::string log = slurp(dir / "run.log");
+  EXPECT_EQ(code, 0) << log;
+  EXPECT_NE(log.find("stopping after this interval"), std::string::npos) << "strata did not get the signal: " << log;
+  EXPECT_NE(log.find("finished: run/report.md"), std::string::npos) << log;
+  EXPECT_TRUE(fs::exists(dir / "run" / "report.md"));
+  EXPECT_TRUE(fs::exists(dir / "run" / "plots" / "water.png"));
+  EXPECT_TRUE(fs::exists(dir / "run" / "plots" / "max_depth.png"));
+}
+
+// SIGXFSZ killed strata silently at the file size limit; now the write fails and says where.
+TEST(StrataCli, OverTheFileSizeLimitTheFileIsNamed) {
+  const auto dir = strata::test::tempDir("cli-fsize");
+  writeCpuScenario(dir);
+  std::string out;
+  // 64 KiB: the maps and the series fit, the checkpoint (~100 B a cell) does not.
+  const int code = strata({"flood", "flood.toml", "-o", "run", "--no-pictures", "--no-plots"}, dir, out, 65536);
+  EXPECT_EQ(code, 1) << "killed by signal " << code - 128 << ": " << out;
+  EXPECT_NE(out.find("strata flood: run/checkpoint.bin: cannot write: File too large"), std::string::npos) << out;
+  EXPECT_FALSE(fs::exists(dir / "run" / "checkpoint.bin"));
+}
+
+// render -o onto an existing file replaced it silently.
+TEST(StrataCli, RenderOntoAnExistingFileNeedsOverwrite) {
+  const auto dir = strata::test::tempDir("cli-render");
+  std::ofstream(dir / "mine.png") << "mine";
+  std::string out;
+  EXPECT_EQ(strata({"render", "synthetic:16", "-o", "mine.png"}, dir, out), 1);
+  EXPECT_NE(out.find("strata render: mine.png: exists (use --overwrite to replace it)"), std::string::npos) << out;
+  std::ofstream(dir / "depth.exr") << "mine";
+  EXPECT_EQ(strata({"render", "synthetic:16", "-o", "new.png", "--depth", "depth.exr"}, dir, out), 1);
+  EXPECT_NE(out.find("strata render: depth.exr: exists"), std::string::npos) << out;
+  std::ofstream(dir / "frame_01.png") << "mine";
+  std::ofstream(dir / "keys.txt") << "0 0 100 0 -20\n1 1 100 0 -20\n";
+  EXPECT_EQ(strata({"render", "synthetic:16", "--path", "keys.txt", "--frames", "3", "-o", "frame_%02d.png"}, dir, out),
+            1);
+  EXPECT_NE(out.find("strata render: frame_01.png: exists"), std::string::npos) << out;
+  EXPECT_EQ(slurp(dir / "mine.png"), "mine");
+  EXPECT_EQ(slurp(dir / "depth.exr"), "mine");
+  // Numbers: NaN passed CLI11's range checks (--fov nan crashed with a segmentation fault).
+  for (const auto& [option, value, message] : std::vector<std::tuple<std::string, std::string, std::string>>{
+           {"--fov", "nan", "--fov nan: not a finite number"},
+           {"--height", "inf", "--height inf: not a finite number"},
+           {"--exaggeration", "0", "--exaggeration 0: expected 0.001 to 1000"}}) {
+    EXPECT_EQ(strata({"render", "synthetic:16", "-o", "x.png", option, value}, dir, out), 1) << option;
+    EXPECT_NE(out.find("strata render: " + message), std::string::npos) << out;
+  }
+  EXPECT_FALSE(fs::exists(dir / "x.png"));
+}
+
+// A GL failure is a Strata message naming what was tried: STRATA_EGL_DEVICE=bogus was taken as
+// device 0, and a missing libEGL aborted inside libepoxy ("Couldn't open libEGL.so.1", SIGABRT).
+TEST(StrataCli, GlFailuresAreStrataMessages) {
+  const auto dir = strata::test::tempDir("cli-gl");
+  std::string out;
+  EXPECT_EQ(strata({"gpu-info"}, dir, out, 0, {"STRATA_EGL_DEVICE=bogus"}), 1) << out;
+  EXPECT_NE(out.find("strata gpu-info: egl: STRATA_EGL_DEVICE=bogus: expected auto, surfaceless, an EGL device "
+                     "number or gpu:<k>"),
+            std::string::npos)
+      << out;
+  EXPECT_EQ(strata({"gpu-info"}, dir, out, 0, {"STRATA_EGL_DEVICE=99"}), 1) << out;
+  EXPECT_NE(out.find("strata gpu-info: egl: STRATA_EGL_DEVICE=99: EGL device 99 asked for, but there"),
+            std::string::npos)
+      << out;
+
+  // No libEGL: in a user and mount namespace of its own, the library is replaced by an empty file.
+  void* egl = ::dlopen("libEGL.so.1", RTLD_LAZY | RTLD_NOLOAD);
+  if (!egl) egl = ::dlopen("libEGL.so.1", RTLD_LAZY);
+  ASSERT_NE(egl, nullptr) << "this test needs libEGL to hide it";
+  link_map* map = nullptr;
+  ASSERT_EQ(::dlinfo(egl, RTLD_DI_LINKMAP, &map), 0);
+  const std::string lib = fs::canonical(map->l_name).string();
+  if (strata({}, dir, out, 0, {}, {"/usr/bin/unshare", "-rm", "true"}) != 0) {
+    GTEST_SKIP() << "no unprivileged user namespaces here (unshare -rm): " << out;
+  }
+  const std::vector<std::string> hidden{"/usr/bin/unshare", "-rm", "/bin/sh", "-c",
+                                        "mount --bind /dev/null '" + lib + "' && exec \"$0\" \"$@\""};
+  EXPECT_EQ(strata({"gpu-info"}, dir, out, 0, {}, hidden), 1) << out;
+  EXPECT_NE(out.find("strata gpu-info: egl: cannot load libEGL.so.1 ("), std::string::npos) << out;
+  EXPECT_NE(out.find("install libegl1"), std::string::npos) << out;
+  // A flood on the CPU without pictures needs no GL at all; with pictures the message says why.
+  writeCpuScenario(dir);
+  EXPECT_EQ(strata({"flood", "flood.toml", "-o", "run", "--no-plots"}, dir, out, 0, {}, hidden), 1) << out;
+  EXPECT_NE(out.find("pictures need a GL 4.5 context (run with --no-pictures without one): egl: cannot load "
+                     "libEGL.so.1"),
+            std::string::npos)
+      << out;
+  EXPECT_EQ(strata({"flood", "flood.toml", "-o", "run", "--no-plots", "--no-pictures"}, dir, out, 0, {}, hidden), 0)
+      << out;
+}
+
+}  // namespace
+}  // namespace strata::scenario

@@ -1,0 +1,75 @@
+#pragma once
+// The small flood scenario the scenario tests share (a ~24 x 18 km piece of the real Grand
+// Canyon DEM with a river inflow) and helpers to read what a run writes.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <strata/gis/dem_io.hpp>
+#include <strata/scenario/scenario.hpp>
+
+#include "strata_test.hpp"
+
+namespace strata::scenario::test_support {
+
+// 20 minutes of a 20,000 m3/s river entering a ~24 x 18 km piece of the canyon at ~600 m cells.
+inline std::string scenarioText() {
+  return "name = \"test flood\"\n"
+         "[terrain]\ndem = \"" +
+         strata::test::dataPath("grand_canyon/grand_canyon_512.tif") +
+         "\"\n"
+         "[region]\nbbox_lonlat = [-112.25, 36.02, -112.001, 36.18]\ncell_size = \"600 m\"\n"
+         "[model]\nkind = \"flood\"\nmanning_n = 0.04\n"
+         "boundary = { west = \"open\", east = \"closed\", south = \"open\", north = \"open\" }\n"
+         "[[water.inflow]]\nname = \"Colorado\"\nline_lonlat = [[-112.0225, 36.063], [-112.0225, 36.08]]\n"
+         "hydrograph = [[0, 0], [5, 20000], [20, 20000]]\nhydrograph_units = [\"min\", \"m3/s\"]\n"
+         "[time]\nduration = \"20 min\"\noutput_interval = \"5 min\"\n"
+         "[outputs]\nwet_threshold = \"0.1 m\"\n";
+}
+
+inline scenario::Scenario writeScenario(const std::filesystem::path& dir) {
+  const auto file = dir / "flood.toml";
+  std::ofstream(file) << scenarioText();
+  auto s = strata::scenario::loadScenario(file);
+  EXPECT_TRUE(s) << s.message();
+  return *s;
+}
+
+inline std::string run(const std::string& cmd) {
+  std::string out;
+  FILE* p = popen((cmd + " 2>&1").c_str(), "r");
+  std::array<char, 4096> buf{};
+  size_t n = 0;
+  while ((n = fread(buf.data(), 1, buf.size(), p)) > 0) out.append(buf.data(), n);
+  pclose(p);
+  return out;
+}
+
+inline gis::ReadOptions allowEmpty() {
+  gis::ReadOptions o;
+  o.allowAllNoData = true;
+  return o;
+}
+
+inline std::vector<std::vector<double>> readCsv(const std::filesystem::path& path) {
+  std::ifstream f(path);
+  std::string line;
+  std::getline(f, line);  // header
+  std::vector<std::vector<double>> rows;
+  while (std::getline(f, line)) {
+    std::vector<double> row;
+    std::stringstream ss(line);
+    std::string cell;
+    while (std::getline(ss, cell, ',')) row.push_back(std::stod(cell));
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+}  // namespace strata::scenario::test_support
