@@ -64,13 +64,17 @@ werror=${STRATA_WERROR:-OFF}
 
 # Configure only when the build folder is new or its settings changed (cmake re-runs itself
 # when a CMakeLists.txt changes).
-want="type=$build_type werror=$werror sanitize=$sanitize"
+# The sanitizer build leaves the benchmarks out (no test runs them; the normal build compiles them).
+bench=ON
+[ -z "$sanitize" ] || bench=OFF
+want="type=$build_type werror=$werror sanitize=$sanitize bench=$bench"
 stamp="$build_dir/.strata-setup"
 if [ ! -f "$build_dir/build.ninja" ] || [ "$(cat "$stamp" 2>/dev/null)" != "$want" ]; then
   cmake -S "$root" -B "$build_dir" -G Ninja \
     -DCMAKE_BUILD_TYPE="$build_type" \
     -DSTRATA_WERROR="$werror" \
-    -DSTRATA_SANITIZE="$sanitize" >/dev/null
+    -DSTRATA_SANITIZE="$sanitize" \
+    -DSTRATA_BUILD_BENCH="$bench" >/dev/null
   echo "$want" > "$stamp"
 fi
 cmake --build "$build_dir" -j "$(nproc)"
