@@ -231,13 +231,17 @@ class Run {
   // chose is kept apart (chosenDtS), since a shortened one says nothing about the flow.
   Result<bool> advanceTo(double endS) {
     auto& sv = solver();
-    while (sv.timeS() < endS - 1e-9 * std::max(1.0, endS)) {
+    // One rule for "t has reached a time": within 1e-9 of it, relative. (The edges were once
+    // compared with another tolerance: a step ending within 6e-8 s before a rain edge at 60 s left
+    // the outer loop choosing that edge and the inner loop refusing to step, forever.)
+    auto before = [](double t, double target) { return t < target - 1e-9 * std::max(1.0, std::abs(target)); };
+    while (before(sv.timeS(), endS)) {
       double next = endS;
       for (double edge : {d_.rainStartS, d_.rainEndS}) {
-        if (edge > sv.timeS() + 1e-9 && edge < next) next = edge;
+        if (before(sv.timeS(), edge) && edge < next) next = edge;
       }
       STRATA_TRY_STATUS(setRain(sv.timeS()));
-      while (sv.timeS() < next - 1e-9 * std::max(1.0, next)) {
+      while (before(sv.timeS(), next)) {
         chosenDtS_ = sv.nextDt();
         minChosenDtS_ = std::min(minChosenDtS_, chosenDtS_);
         sv.stepWithDt(std::min(chosenDtS_, next - sv.timeS()));
