@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <map>
 #include <memory>
 #include <queue>
 #include <set>
@@ -11,6 +12,7 @@
 #include <strata/core/memory.hpp>
 #include <strata/core/progress.hpp>
 #include <strata/gis/dem_io.hpp>
+#include <strata/gis/fill_nodata.hpp>
 #include <strata/gis/geodesy.hpp>
 #include <strata/gis/mosaic.hpp>
 #include <strata/terrain/material.hpp>
@@ -101,7 +103,8 @@ class TerrainSource {
     TerrainSource t;
     if (s.terrain.store.empty()) {
       t.path_ = s.terrain.dems.front();
-      STRATA_TRY(auto info, gis::probeDem(t.path_));
+      STRATA_TRY(t.assigned_, assignments(s));
+      STRATA_TRY(auto info, gis::probeDem(t.path_, t.readOptions(t.path_)));
       t.georef_ = info.georef;
       return t;
     }
@@ -139,18 +142,22 @@ class TerrainSource {
   /// The bed elevation of `w` (base-grid cells), at the source's own resolution.
   Result<gis::Raster> readBed(const gis::CellRect& w) const {
     if (!store_) {
-      gis::ReadOptions ro;
+      gis::ReadOptions ro = readOptions(path_);
       ro.window = w;
       return gis::readDem(path_, ro);
     }
     return readField(bedField_, w);
   }
 
-  /// What gis::warpToGrid resamples the bed from: the DEM file itself (GDAL reads what it needs),
-  /// or, for a store, the window already read (`nativeBed`), held in memory.
-  gis::MosaicInput resampleInput(const gis::Raster& nativeBed) const {
-    if (!store_) return {path_, std::nullopt};
-    return {"", nativeBed};
+  /// What gis::warpToGrid resamples from: the DEM file `path` itself (GDAL reads what it needs;
+  /// by default the first DEM), or, for a store, the window already read (`nativeBed`).
+  gis::MosaicInput resampleInput(const gis::Raster& nativeBed, const std::string& path = {}) const {
+    if (store_) return {"", nativeBed};
+    gis::MosaicInput in{path.empty() ? path_ : path, std::nullopt};
+    const gis::ReadOptions ro = readOptions(in.path);
+    in.assignCrs = ro.crs;
+    in.assignTransform = ro.transform;
+    return in;
   }
 
   /// The store's material layers over `w`, bottom first (none for DEMs).
@@ -173,7 +180,59 @@ class TerrainSource {
     return gis::Raster{store_->windowGeoref(sw, 0), std::move(values).value()};
   }
 
+  // What [terrain] assign_crs / assign_geotransform fill in for one DEM: only what it lacks.
+  struct Assigned {
+    std::optional<std::string> crs;
+    std::optional<gis::GeoTransform> transform;
+  };
+
+  // The assignments of every DEM of the scenario; a DEM without georeference and nothing to fill it
+  // in, or an assignment no DEM needs, is an error naming the key.
+  static Result<std::map<std::string, Assigned>> assignments(const Scenario& s) {
+    std::map<std::string, Assigned> out;
+    bool crsUsed = false, gtUsed = false;
+    for (const auto& path : s.terrain.dems) {
+      STRATA_TRY(auto has, gis::georefPresence(path));
+      Assigned a;
+      if (!has.crs && s.terrain.assignCrs) a.crs = *s.terrain.assignCrs, crsUsed = true;
+      if (!has.transform && s.terrain.assignGeotransform) {
+        gis::GeoTransform gt;
+        std::copy(s.terrain.assignGeotransform->begin(), s.terrain.assignGeotransform->end(), gt.c);
+        a.transform = gt;
+        gtUsed = true;
+      }
+      if (!has.crs && !a.crs) {
+        return fail(s.at("terrain.dem") + path +
+                    ": has no CRS; give it one with [terrain] assign_crs = \"EPSG:n\" (or WKT or PROJ text)");
+      }
+      if (!has.transform && !a.transform) {
+        return fail(s.at("terrain.dem") + path +
+                    ": has no geotransform; give it one with [terrain] assign_geotransform = "
+                    "[x0, dx, rx, y0, ry, dy]");
+      }
+      out[path] = std::move(a);
+    }
+    if (s.terrain.assignCrs && !crsUsed) {
+      return fail(s.at("terrain.assign_crs") + "every DEM has a CRS of its own (it fills in a missing one)");
+    }
+    if (s.terrain.assignGeotransform && !gtUsed) {
+      return fail(s.at("terrain.assign_geotransform") +
+                  "every DEM has a geotransform of its own (it fills in a missing one)");
+    }
+    return out;
+  }
+
+  gis::ReadOptions readOptions(const std::string& path) const {
+    gis::ReadOptions ro;
+    if (auto it = assigned_.find(path); it != assigned_.end()) {
+      ro.crs = it->second.crs;
+      ro.transform = it->second.transform;
+    }
+    return ro;
+  }
+
   std::string path_;
+  std::map<std::string, Assigned> assigned_;  // DEMs only, by path
   gis::Georef georef_;
   std::shared_ptr<TileStore> store_;  // shared: readWindow caches tiles (non-const)
   int bedField_ = -1;
@@ -301,20 +360,24 @@ Status planGrid(const Scenario& s, const TerrainSource& source, RegionFrame& fra
   const gis::Georef g0 = windowGeoref(source.georef(), frame.window);
   double width = g0.width, height = g0.height;
   if (s.region.cellSizeM > 0) {
-    STRATA_TRY(auto a, gis::pixelToLonLat(g0, g0.width * 0.5, g0.height * 0.5));
-    STRATA_TRY(auto b, gis::pixelToLonLat(g0, g0.width * 0.5, g0.height * 0.5 + 1));
-    const double nativeM = gis::geodesicDistanceM(a, b, g0.body);
-    const double scale = nativeM / s.region.cellSizeM;
-    width = std::floor(g0.width * scale);
-    height = std::floor(g0.height * scale);
+    // Square cells: each axis gets as many cells as its geodesic length at the window's centre
+    // holds (a geographic DEM's native cell is ~20% narrower than tall at 36 deg N). Away from the
+    // centre row a cell's width follows the cosine of its latitude; the report states the range.
+    STRATA_TRY(auto c, gis::pixelToLonLat(g0, g0.width * 0.5, g0.height * 0.5));
+    STRATA_TRY(auto east, gis::pixelToLonLat(g0, g0.width * 0.5 + 1, g0.height * 0.5));
+    STRATA_TRY(auto south, gis::pixelToLonLat(g0, g0.width * 0.5, g0.height * 0.5 + 1));
+    const double nativeXM = gis::geodesicDistanceM(c, east, g0.body);
+    const double nativeYM = gis::geodesicDistanceM(c, south, g0.body);
+    width = std::round(g0.width * nativeXM / s.region.cellSizeM);
+    height = std::round(g0.height * nativeYM / s.region.cellSizeM);
     if (!(width >= 4 && height >= 4)) {
-      STRATA_TRY(auto west, gis::pixelToLonLat(g0, 0, g0.height * 0.5));
-      STRATA_TRY(auto east, gis::pixelToLonLat(g0, g0.width, g0.height * 0.5));
+      STRATA_TRY(auto westEdge, gis::pixelToLonLat(g0, 0, g0.height * 0.5));
+      STRATA_TRY(auto eastEdge, gis::pixelToLonLat(g0, g0.width, g0.height * 0.5));
       char msg[200];
       std::snprintf(msg, sizeof msg,
                     "%.6g m cells give %.0f x %.0f cells over the region (%.4g x %.4g km); at least 4 x 4 are needed",
                     s.region.cellSizeM, std::max(0.0, width), std::max(0.0, height),
-                    gis::geodesicDistanceM(west, east, g0.body) / 1e3, g0.height * nativeM / 1e3);
+                    gis::geodesicDistanceM(westEdge, eastEdge, g0.body) / 1e3, g0.height * nativeYM / 1e3);
       return fail(s.at("region.cell_size") + msg);
     }
     frame.scaleX = width / g0.width;
@@ -339,6 +402,27 @@ Status planGrid(const Scenario& s, const TerrainSource& source, RegionFrame& fra
   }
   frame.width = int(width);
   frame.height = int(height);
+  return {};
+}
+
+// Step 3b: the bed's cells without data ([terrain] voids). Every mode but "refuse" fills their bed
+// from the cells around them (GDAL's fill-nodata): "walls" then masks them out (maskRegion) and
+// "holes" drains them (placeVoidHoles).
+Status handleVoids(const Scenario& s, const TerrainSource& source, ScenarioDomain& d) {
+  const int w = d.bed.georef.width, h = d.bed.georef.height;
+  d.voids = gis::Grid<uint8_t>(w, h, 0);
+  for (size_t i = 0; i < d.bed.values.size(); ++i) {
+    if (gis::isNoData(d.bed.values.data[i])) d.voids.data[i] = 1, d.voidCells += 1;
+  }
+  if (d.voidCells == 0) return {};
+  using V = decltype(s.terrain)::Voids;
+  if (s.terrain.voids == V::kRefuse) {
+    return fail(source.path() + ": the region has " + std::to_string(d.voidCells) +
+                " cells without data (nodata); choose a region the " + source.kind() +
+                " covers, or set [terrain] voids = \"fill\", \"walls\" or \"holes\"");
+  }
+  auto filled = gis::fillVoids(d.bed.values);
+  if (!filled) return fail(source.path() + ": " + filled.message());
   return {};
 }
 
@@ -368,30 +452,30 @@ Status readBed(const Scenario& s, const TerrainSource& source, const RegionFrame
   if (s.terrain.dems.size() > 1) {
     std::vector<gis::MosaicInput> inputs;
     for (const auto& p : s.terrain.dems) {
-      gis::MosaicInput in{p, std::nullopt, gis::BlendMode::Replace};
+      gis::MosaicInput in = source.resampleInput(d.bed, p);
+      in.mode = gis::BlendMode::Replace;
       in.resampling = gis::Resampling::MinimumIfCoarser;  // the lowest-elevation rule, as above
       inputs.push_back(std::move(in));
     }
     STRATA_TRY(auto layer, gis::buildMosaic("bedrock", d.bed.georef, inputs));
     d.bed = std::move(layer.raster);
   }
-  for (size_t i = 0; i < d.bed.values.size(); ++i) {
-    if (gis::isNoData(d.bed.values.data[i])) {
-      return fail(source.path() + ": the region has cells without data (nodata); choose a region the " + source.kind() +
-                  " covers");
-    }
-  }
-  return {};
+  return handleVoids(s, source, d);
 }
 
 // Step 4: the region mask: a polygon's outside becomes a wall.
-void maskRegion(const RegionFrame& frame, ScenarioDomain& d) {
+void maskRegion(const Scenario& s, const RegionFrame& frame, ScenarioDomain& d) {
   const int w = d.bed.georef.width, h = d.bed.georef.height;
   d.inside = gis::Grid<uint8_t>(w, h, 1);
+  if (s.terrain.voids == decltype(s.terrain)::Voids::kWalls) {
+    for (size_t i = 0; i < d.inside.size(); ++i) d.inside.data[i] = d.voids.data[i] ? 0 : 1;
+  }
   if (frame.polygonPx.empty()) return;
   const auto poly = frame.toRegion(frame.polygonPx);
   for (int y = 0; y < h; ++y) {
-    for (int x = 0; x < w; ++x) d.inside.at(x, y) = insidePolygon(poly, x + 0.5, y + 0.5) ? 1 : 0;
+    for (int x = 0; x < w; ++x) {
+      if (!insidePolygon(poly, x + 0.5, y + 0.5)) d.inside.at(x, y) = 0;
+    }
   }
 }
 
@@ -530,6 +614,23 @@ Status placeLevels(const Scenario& s, const PixelMapper& mapper, const RegionFra
     d.levelNames.push_back(lv.name);
   }
   return {};
+}
+
+// Step 9b: [terrain] voids = "holes": the region's void cells are held at depth 0 (a fixed level
+// below every bed), so whatever water reaches them leaves the region there and is counted as the
+// level's outflow in the balance.
+void placeVoidHoles(const Scenario& s, ScenarioDomain& d) {
+  if (s.terrain.voids != decltype(s.terrain)::Voids::kHoles || d.voidCells == 0) return;
+  sim::LevelBoundary holes;
+  for (int y = 0; y < d.voids.height; ++y) {
+    for (int x = 0; x < d.voids.width; ++x) {
+      if (d.voids.at(x, y) && d.inside.at(x, y)) holes.cells.push_back({x, y});
+    }
+  }
+  if (holes.cells.empty()) return;
+  holes.stageM = TimeSeries::constant(d.input.datumM - 1e4);
+  d.levels.push_back(std::move(holes));
+  d.levelNames.push_back("voids (holes)");
 }
 
 // Step 10: rain, uniform for a span of time or as a raster of multipliers for the whole run.
@@ -731,13 +832,17 @@ Status fillDepressions(const Scenario& s, ScenarioDomain& d) {
       const size_t c = size_t(y) * size_t(w) + size_t(x);
       const bool edge = (x == 0 && open[0] == Boundary::Open) || (x == w - 1 && open[1] == Boundary::Open) ||
                         (y == h - 1 && open[2] == Boundary::Open) || (y == 0 && open[3] == Boundary::Open);
-      if (edge && d.inside.data[c]) {
+      const bool hole = s.terrain.voids == decltype(s.terrain)::Voids::kHoles && d.voids.data[c];
+      if ((edge || hole) && d.inside.data[c]) {
         seen[c] = 1;
         queue.push({z.data[c], int(c)});
       }
     }
   }
-  if (queue.empty()) return fail(s.at("terrain.fill_depressions") + "no edge is open (model.boundary): nothing drains");
+  if (queue.empty()) {
+    return fail(s.at("terrain.fill_depressions") +
+                "no edge is open (model.boundary) and no void is a hole: nothing drains");
+  }
   while (!queue.empty()) {
     const auto [level, cell] = queue.top();
     queue.pop();
@@ -807,7 +912,7 @@ Result<ScenarioDomain> buildDomain(const Scenario& s, uint64_t memoryBudgetBytes
   ScenarioDomain d;
   std::vector<StoredLayer> storeLayers;
   STRATA_TRY_STATUS(readBed(s, source, frame, d, storeLayers));
-  maskRegion(frame, d);
+  maskRegion(s, frame, d);
   STRATA_TRY_STATUS(measureRegion(d));
   STRATA_TRY_STATUS(stackLayers(s, source, storeLayers, d));
   if (s.erosion.enabled) STRATA_TRY_STATUS(requireLooseMaterial(s, d));
@@ -817,6 +922,7 @@ Result<ScenarioDomain> buildDomain(const Scenario& s, uint64_t memoryBudgetBytes
   STRATA_TRY_STATUS(breachInflowPaths(s, d));
   STRATA_TRY_STATUS(fillDepressions(s, d));
   STRATA_TRY_STATUS(placeLevels(s, mapper, frame, d));
+  placeVoidHoles(s, d);
   STRATA_TRY_STATUS(placeRain(s, d));
   STRATA_TRY_STATUS(placeDamBreaks(s, mapper, frame, d));
   return d;

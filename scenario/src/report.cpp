@@ -144,11 +144,20 @@ Status writeReport(const fs::path& runDir, const ReportInput& in) {
   md += "| | |\n|---|---|\n";
   const std::string terrain =
       s.terrain.store.empty() ? "`" + s.terrain.dems.front() + "`" : "tile store `" + s.terrain.store + "`";
+  std::string assigned;
+  if (s.terrain.assignCrs) assigned += ", CRS assigned by the scenario";
+  if (s.terrain.assignGeotransform) assigned += ", geotransform assigned by the scenario";
   md += "| terrain | " + terrain + " (" + g.crsName + (g.epsg ? ", EPSG:" + std::to_string(*g.epsg) : "") + ", " +
-        g.body.name + ") |\n";
+        g.body.name + assigned + ") |\n";
+  // Cell widths follow the latitude on a geographic grid: the range over the rows is stated.
+  const auto [narrowest, widest] = std::minmax_element(d.input.rowDxM.begin(), d.input.rowDxM.end());
+  const std::string widths = *widest - *narrowest >= 0.5 ? " (widths " + fmt("%.0f", *narrowest) + " to " +
+                                                               fmt("%.0f", *widest) + " m over the rows)"
+                                                         : "";
   md += "| region | " + std::to_string(g.width) + " x " + std::to_string(g.height) + " cells of about " +
-        fmt("%.0f", d.input.rowDxM[d.input.rowDxM.size() / 2]) + " x " + fmt("%.0f", d.input.dyM) + " m, " +
-        fmt("%.0f", d.totalAreaM2 / 1e6) + " km², elevations " + fmt("%.0f", lo) + " to " + fmt("%.0f", hi) + " m |\n";
+        fmt("%.0f", d.input.rowDxM[d.input.rowDxM.size() / 2]) + " x " + fmt("%.0f", d.input.dyM) + " m" + widths +
+        ", " + fmt("%.0f", d.totalAreaM2 / 1e6) + " km², elevations " + fmt("%.0f", lo) + " to " + fmt("%.0f", hi) +
+        " m |\n";
   md += std::string("| model | ") +
         (s.model.kind == sim::WaterModel::kFiniteVolume ? "flood mode (finite-volume shallow water, Manning friction)"
                                                         : "virtual pipes") +
@@ -174,6 +183,14 @@ Status writeReport(const fs::path& runDir, const ReportInput& in) {
     md += "| depressions filled | " + std::to_string(d.filled.cells) +
           " cells that drained to no open edge raised to their spill level ([terrain] fill_depressions), by up to " +
           fmt("%.0f", d.filled.maxM) + " m, " + millions(d.filled.volumeM3) + " in all |\n";
+  }
+  if (d.voidCells > 0) {
+    using V = decltype(s.terrain)::Voids;
+    const char* what = s.terrain.voids == V::kFill    ? "filled from the cells around them (GDAL fill-nodata)"
+                       : s.terrain.voids == V::kWalls ? "walls no water enters"
+                                                      : "holes: water that reaches them leaves the region";
+    md += "| voids | " + std::to_string(d.voidCells) + " cells without data in the source, " + what +
+          " ([terrain] voids) |\n";
   }
   for (size_t i = 0; i < s.water.inflows.size(); ++i) {
     const auto& f = s.water.inflows[i];

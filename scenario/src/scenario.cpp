@@ -292,16 +292,33 @@ Result<TimeSeries> readHydrograph(const Reader& r, const toml::table& t, const s
 Status readTerrain(const Reader& r, const toml::table& root, Scenario& s) {
   const auto* t = root["terrain"].as_table();
   if (!t) return fail(r.file + ": missing [terrain] (dem = \"file.tif\" or store = \"folder\")");
-  STRATA_TRY_STATUS(r.onlyKeys(*t, "terrain", {"dem", "store", "layer", "breach_inflows", "fill_depressions"}));
+  STRATA_TRY_STATUS(r.onlyKeys(
+      *t, "terrain",
+      {"dem", "store", "layer", "breach_inflows", "fill_depressions", "voids", "assign_crs", "assign_geotransform"}));
   if (const auto* b = t->get("breach_inflows")) {
     STRATA_TRY(s.terrain.breachInflows, r.boolean(*b, "terrain.breach_inflows"));
   }
   if (const auto* f = t->get("fill_depressions")) {
     STRATA_TRY(s.terrain.fillDepressions, r.boolean(*f, "terrain.fill_depressions"));
   }
+  if (const auto* v = t->get("voids")) {
+    STRATA_TRY(auto mode, r.string(*v, "terrain.voids"));
+    using V = decltype(s.terrain)::Voids;
+    if (mode == "refuse")
+      s.terrain.voids = V::kRefuse;
+    else if (mode == "fill")
+      s.terrain.voids = V::kFill;
+    else if (mode == "walls")
+      s.terrain.voids = V::kWalls;
+    else if (mode == "holes")
+      s.terrain.voids = V::kHoles;
+    else
+      return r.error(*v, "terrain.voids", "\"" + mode + "\": expected \"refuse\", \"fill\", \"walls\" or \"holes\"");
+  }
   if (const auto* d = t->get("dem")) {
-    if (auto one = d->value<std::string>()) {
-      s.terrain.dems.push_back(r.path(*one));
+    if (d->is_string()) {
+      STRATA_TRY(auto one, r.string(*d, "terrain.dem"));
+      s.terrain.dems.push_back(r.path(one));
     } else if (const auto* a = d->as_array()) {
       for (const auto& n : *a) {
         STRATA_TRY(auto p, r.string(n, "terrain.dem"));
@@ -317,6 +334,26 @@ Status readTerrain(const Reader& r, const toml::table& root, Scenario& s) {
   }
   if (s.terrain.dems.empty() == s.terrain.store.empty()) {
     return r.errorAt(int(t->source().begin.line), "terrain", "give exactly one of dem or store");
+  }
+  if (const auto* c = t->get("assign_crs")) {
+    if (!s.terrain.store.empty()) return r.error(*c, "terrain.assign_crs", "a tile store has its own CRS");
+    STRATA_TRY(auto crs, r.string(*c, "terrain.assign_crs"));
+    if (crs.empty()) return r.error(*c, "terrain.assign_crs", "empty (expected EPSG:n, WKT or PROJ text)");
+    s.terrain.assignCrs = crs;
+  }
+  if (const auto* g = t->get("assign_geotransform")) {
+    const std::string key = "terrain.assign_geotransform";
+    if (!s.terrain.store.empty()) return r.error(*g, key, "a tile store has its own geotransform");
+    const auto* a = g->as_array();
+    if (!a || a->size() != 6) {
+      return r.error(*g, key, "expected GDAL's six coefficients [x0, dx, rx, y0, ry, dy]");
+    }
+    std::array<double, 6> c{};
+    for (size_t i = 0; i < 6; ++i) {
+      STRATA_TRY(c[i], r.number((*a)[i], key));
+    }
+    if (c[1] * c[5] - c[2] * c[4] == 0) return r.error(*g, key, "the cell size is zero (dx * dy - rx * ry = 0)");
+    s.terrain.assignGeotransform = c;
   }
   if (const auto* layers = t->get("layer")) {
     const auto* arr = layers->as_array();

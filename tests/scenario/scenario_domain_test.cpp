@@ -2,14 +2,20 @@
 // checks that need the terrain (region inside the DEM, sources inside the region).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 
 #include <limits>
 
 #include <queue>
+#include <vector>
 
+#include <gdal.h>
+
+#include <strata/gis/dem_io.hpp>
 #include <strata/gis/geodesy.hpp>
 #include <strata/scenario/domain.hpp>
+#include <strata/sim/cpu_solver.hpp>
 
 #include "scenario_fixture.hpp"
 #include "strata_test.hpp"
@@ -27,6 +33,9 @@ Result<ScenarioDomain> domainOf(const std::string& region, const std::string& wa
 
 const std::string kInflow =
     "[[water.inflow]]\nname = \"river\"\nat_lonlat = [-112.0225, 36.0713]\nhydrograph = [[0, 100], [3600, 100]]\n";
+// A spring inside the 3857 DEM's western part (it ends at 112.85 W).
+const std::string kInflowWest =
+    "[[water.inflow]]\nname = \"spring\"\nat_lonlat = [-113.0, 36.2]\nhydrograph = [[0, 100], [3600, 100]]\n";
 
 TEST(ScenarioDomain, CutsTheRegionWindowWithGeodesicCellSizes) {
   auto d = domainOf("bbox_lonlat = [-112.5, 36.01, -112.001, 36.3]", kInflow);
@@ -48,11 +57,41 @@ TEST(ScenarioDomain, CutsTheRegionWindowWithGeodesicCellSizes) {
   EXPECT_LE(d->input.datumM, 800.0);  // the datum is the region's lowest point, rounded down
 }
 
-TEST(ScenarioDomain, ResamplesToTheAskedCellSize) {
+// Issue 15: cell_size = "600 m" on an EPSG:4326 DEM gave 489 x 605 m cells (one scale for both
+// axes, from the north-south length of a native cell). Now each axis gets its own count: 434 m
+// asked gives 104 x 74 cells of 434 m (the native 1/512 degree cell is 176 x 217 m here).
+TEST(ScenarioDomain, ResamplesToSquareCellsOfTheAskedSize) {
   auto d = domainOf("bbox_lonlat = [-112.5, 36.01, -112.001, 36.3]\ncell_size = \"434 m\"", kInflow);
   ASSERT_TRUE(d) << d.message();
-  EXPECT_EQ(d->bed.georef.width, 127);  // half the native resolution
-  EXPECT_NEAR(d->input.dyM, 434.0, 5.0);
+  const auto& g = d->bed.georef;
+  EXPECT_EQ(g.width, 104);  // 256 columns x 176.3 m / 434 m
+  EXPECT_EQ(g.height, 74);  // 149 rows x 216.8 m / 434 m
+  EXPECT_NEAR(d->input.dyM, 434.0, 0.01 * 434.0);
+  EXPECT_NEAR(d->input.rowDxM[size_t(g.height / 2)], 434.0, 0.01 * 434.0);
+  // Away from the centre row the width follows the latitude: 0.29 degrees of latitude change a
+  // cell's width by about 0.4%.
+  const auto [lo, hi] = std::minmax_element(d->input.rowDxM.begin(), d->input.rowDxM.end());
+  EXPECT_GT(*hi - *lo, 0.5);
+  EXPECT_LT((*hi - *lo) / 434.0, 0.006);
+}
+
+// A polygon region's cells cover the polygon's geodesic area (GeographicLib) within 0.5% at the
+// native grid and at 434 m square cells (measured: +0.05% and +0.11%). Before, the 600 m cells of
+// the issue gave 702.3 km2 for a 705.5 km2 polygon.
+TEST(ScenarioDomain, PolygonMaskAreaMatchesTheGeodesicArea) {
+  const std::vector<gis::LonLat> ring{{-112.45, 36.03}, {-112.01, 36.04}, {-112.01, 36.27}, {-112.4, 36.2}};
+  std::string poly = "polygon_lonlat = [";
+  for (const auto& p : ring) poly += "[" + std::to_string(p.lonDeg) + ", " + std::to_string(p.latDeg) + "], ";
+  poly += "]";
+  const double exact = gis::geodesicPolygonAreaM2(ring, gis::Body::wgs84());
+  for (const std::string cellSize : {"", "\ncell_size = \"434 m\""}) {
+    SCOPED_TRACE(cellSize);
+    auto d = domainOf(poly + cellSize, kInflow);
+    ASSERT_TRUE(d) << d.message();
+    std::printf("polygon: mask %.2f km2, geodesic %.2f km2 (%+.3f%%)\n", d->totalAreaM2 / 1e6, exact / 1e6,
+                100 * (d->totalAreaM2 / exact - 1));
+    EXPECT_NEAR(d->totalAreaM2, exact, 0.005 * exact);
+  }
 }
 
 // Issue 15: a scenario's `dem = [a, b]` list was mosaicked with bilinear resampling, so coarser
@@ -258,6 +297,152 @@ TEST(ScenarioDomain, BreachingAndFillingLeaveNoDepression) {
       "%.3g m3\n",
       b->breach.cells, b->breach.maxCutM, b->breach.cutM3, b->breach.maxFillM, b->breach.fillM3, b->filled.cells,
       b->filled.maxM, b->filled.volumeM3);
+}
+
+// Issue 15: a DEM without a CRS (a lidar tile without its .prj) was refused with advice to pass
+// --assign-crs, which a scenario could not. [terrain] assign_crs / assign_geotransform fill in what
+// the file lacks: the real Grand Canyon DEM stripped of both and given them back in the scenario
+// gives the original's domain bit for bit.
+TEST(ScenarioDomain, AssignedCrsAndGeotransformStandInForMissingOnes) {
+  const auto dir = test::tempDir("scenario-assign");
+  const std::string original = test::dataPath("grand_canyon/grandcanyon_srtm_3857.tif");
+  const std::string bare = (dir / "bare.tif").string();
+  {
+    // The same cells and nodata value in a new TIFF given neither a CRS nor a geotransform.
+    GDALAllRegister();
+    GDALDatasetH src = GDALOpen(original.c_str(), GA_ReadOnly);
+    ASSERT_NE(src, nullptr);
+    const int w = GDALGetRasterXSize(src), h = GDALGetRasterYSize(src);
+    GDALRasterBandH in = GDALGetRasterBand(src, 1);
+    std::vector<float> cells(size_t(w) * size_t(h));
+    ASSERT_EQ(GDALRasterIO(in, GF_Read, 0, 0, w, h, cells.data(), w, h, GDT_Float32, 0, 0), CE_None);
+    GDALDatasetH dst = GDALCreate(GDALGetDriverByName("GTiff"), bare.c_str(), w, h, 1, GDT_Float32, nullptr);
+    ASSERT_NE(dst, nullptr);
+    GDALRasterBandH out = GDALGetRasterBand(dst, 1);
+    int hasNoData = 0;
+    const double noData = GDALGetRasterNoDataValue(in, &hasNoData);
+    if (hasNoData) GDALSetRasterNoDataValue(out, noData);
+    ASSERT_EQ(GDALRasterIO(out, GF_Write, 0, 0, w, h, cells.data(), w, h, GDT_Float32, 0, 0), CE_None);
+    GDALClose(dst);
+    GDALClose(src);
+  }
+  auto has = gis::georefPresence(bare);
+  ASSERT_TRUE(has) << has.message();
+  ASSERT_FALSE(has->crs);
+  ASSERT_FALSE(has->transform);
+
+  const std::string region = "[region]\nbbox_lonlat = [-113.1, 36.1, -112.9, 36.25]\n";
+  auto domain = [&](const std::string& dem, const std::string& extra) -> Result<ScenarioDomain> {
+    auto s = parseScenario(
+        "[terrain]\ndem = \"" + dem + "\"\n" + extra + region + kInflowWest + "\n[time]\nduration = \"1 h\"\n",
+        "/runs/t.toml");
+    if (!s) return s.error();
+    return buildDomain(*s);
+  };
+  const std::string assign =
+      "assign_crs = \"EPSG:3857\"\nassign_geotransform = [-12601714.231207296, 76.437028285174165, 0, "
+      "4344069.1915031355, 0, -76.437028285168708]\n";
+  auto a = domain(original, "");
+  auto b = domain(bare, assign);
+  ASSERT_TRUE(a) << a.message();
+  ASSERT_TRUE(b) << b.message();
+  EXPECT_EQ(a->bed.georef.width, b->bed.georef.width);
+  EXPECT_EQ(a->bed.georef.height, b->bed.georef.height);
+  EXPECT_EQ(a->bed.values.data, b->bed.values.data);
+  EXPECT_EQ(a->input.rowDxM, b->input.rowDxM);
+  ASSERT_EQ(a->sources.size(), 1u);
+  ASSERT_EQ(b->sources.size(), 1u);
+  EXPECT_EQ(a->sources[0].cells, b->sources[0].cells);
+
+  // Without them the key to add is named; with them on a DEM that has its own, they are refused.
+  auto none = domain(bare, "");
+  ASSERT_FALSE(none);
+  EXPECT_EQ(none.message(),
+            "/runs/t.toml:2: key 'terrain.dem': " + bare +
+                ": has no CRS; give it one with [terrain] assign_crs = \"EPSG:n\" (or WKT or PROJ text)");
+  auto noGt = domain(bare, "assign_crs = \"EPSG:3857\"\n");
+  ASSERT_FALSE(noGt);
+  EXPECT_NE(noGt.message().find("has no geotransform; give it one with [terrain] assign_geotransform"),
+            std::string::npos)
+      << noGt.message();
+  auto needless = domain(original, "assign_crs = \"EPSG:3857\"\n");
+  ASSERT_FALSE(needless);
+  EXPECT_EQ(needless.message(),
+            "/runs/t.toml:3: key 'terrain.assign_crs': every DEM has a CRS of its own (it fills in a missing one)");
+}
+
+// Issue 16 item 4: Rainier's SRTM has voids on its steep upper flanks (1,501 cells in this region),
+// and a scenario on it was refused with no way forward. [terrain] voids fills them (GDAL's
+// fill-nodata), makes them walls, or makes them holes that drain; the default still refuses,
+// naming the way out. Rain on the region with closed edges: only holes let water leave, and the
+// balance closes with what they took.
+TEST(ScenarioDomain, VoidsAreRefusedFilledWallsOrHoles) {
+  auto domain = [](const std::string& voids) -> Result<ScenarioDomain> {
+    auto s = parseScenario("[terrain]\ndem = \"" + test::dataPath("rainier/mt_rainier_90m.tif") + "\"\n" + voids +
+                               "[region]\nbbox_lonlat = [-121.82, 46.82, -121.70, 46.89]\n"
+                               "[model]\nboundary = \"closed\"\n[water.rain]\nrate = \"50 mm/h\"\n"
+                               "[time]\nduration = \"1 h\"\n",
+                           "/runs/t.toml");
+    if (!s) return s.error();
+    return buildDomain(*s);
+  };
+  auto refused = domain("");
+  ASSERT_FALSE(refused);
+  EXPECT_NE(refused.message().find(": the region has 1501 cells without data (nodata); choose a region the DEM "
+                                   "covers, or set [terrain] voids = \"fill\", \"walls\" or \"holes\""),
+            std::string::npos)
+      << refused.message();
+  auto bad = domain("voids = \"ignore\"\n");
+  ASSERT_FALSE(bad);
+  EXPECT_EQ(bad.message(),
+            "/runs/t.toml:3: key 'terrain.voids': \"ignore\": expected \"refuse\", \"fill\", \"walls\" "
+            "or \"holes\"");
+
+  auto fill = domain("voids = \"fill\"\n");
+  auto walls = domain("voids = \"walls\"\n");
+  auto holes = domain("voids = \"holes\"\n");
+  ASSERT_TRUE(fill) << fill.message();
+  ASSERT_TRUE(walls) << walls.message();
+  ASSERT_TRUE(holes) << holes.message();
+  EXPECT_EQ(fill->voidCells, 1501);
+  // Filled: every cell has data, each filled value between the lowest and highest valid cell.
+  float lo = 1e30f, hi = -1e30f;
+  for (size_t i = 0; i < fill->bed.values.size(); ++i) {
+    ASSERT_FALSE(std::isnan(fill->bed.values.data[i])) << i;
+    if (!fill->voids.data[i]) lo = std::min(lo, fill->bed.values.data[i]), hi = std::max(hi, fill->bed.values.data[i]);
+  }
+  for (size_t i = 0; i < fill->bed.values.size(); ++i) {
+    if (fill->voids.data[i]) {
+      ASSERT_GE(fill->bed.values.data[i], lo);
+      ASSERT_LE(fill->bed.values.data[i], hi);
+    }
+  }
+  // Walls: exactly the void cells are outside the region.
+  for (size_t i = 0; i < walls->inside.size(); ++i) {
+    ASSERT_EQ(walls->inside.data[i], walls->voids.data[i] ? 0 : 1) << i;
+  }
+  // Holes: one fixed level below every bed on exactly the void cells.
+  ASSERT_EQ(holes->levels.size(), 1u);
+  EXPECT_EQ(holes->levelNames.back(), "voids (holes)");
+  EXPECT_EQ(holes->levels.back().cells.size(), 1501u);
+
+  // Half an hour of rain on the CPU backend.
+  auto rain = [](const ScenarioDomain& d) {
+    auto params = d.params;
+    params.rainMmPerHour = float(d.rainMmPerHour);
+    auto sim = sim::CpuSolver::create(d.input, params);
+    EXPECT_TRUE(sim) << sim.message();
+    for (const auto& level : d.levels) EXPECT_TRUE(sim->addLevel(level));
+    sim->advance(1800);
+    return sim->stats();
+  };
+  const auto w = rain(*walls), h = rain(*holes), f = rain(*fill);
+  std::printf("30 min of 50 mm/h: rain %.4g / %.4g / %.4g m3, out %.4g / %.4g / %.4g m3 (walls / holes / fill)\n",
+              w.rainM3, h.rainM3, f.rainM3, w.outflowM3, h.outflowM3, f.outflowM3);
+  EXPECT_EQ(w.outflowM3, 0.0);
+  EXPECT_EQ(f.outflowM3, 0.0);
+  EXPECT_GT(h.outflowM3, 0.01 * h.rainM3);  // the holes drain what falls around them
+  for (const auto* st : {&w, &h, &f}) EXPECT_LT(std::abs(st->waterBalanceM3()), 1e-4 * st->rainM3);
 }
 
 }  // namespace

@@ -36,6 +36,10 @@ struct ScenarioDomain {
     double maxCutM = 0, maxFillM = 0;  ///< the largest lowering and raising (m)
     double cutM3 = 0, fillM3 = 0;      ///< terrain removed and added
   } breach;
+  /// The region's cells without data and what became of them ([terrain] voids): 1 where the
+  /// source had no data (their bed is filled from the cells around them in every mode).
+  gis::Grid<uint8_t> voids;
+  int voidCells = 0;
   /// What [terrain] fill_depressions raised (nothing when off).
   struct {
     int cells = 0;

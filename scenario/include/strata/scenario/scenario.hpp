@@ -84,12 +84,20 @@ struct Scenario {
 
   struct {
     std::vector<std::string> dems;  ///< resolved paths (mosaicked in order)
+    /// A CRS (EPSG:n, WKT or PROJ text) and a geotransform (GDAL's six coefficients) for DEMs that
+    /// lack their own (a lidar tile without a .prj); each fills in only what a DEM is missing.
+    std::optional<std::string> assignCrs;
+    std::optional<std::array<double, 6>> assignGeotransform;
     std::string store;
     std::vector<LayerSpec> layers;  ///< loose material on top of the bedrock DEM, bottom first
     /// Carve each inflow's least-barrier path to an open edge (docs/scenario.md, "Breaching").
     bool breachInflows = false;
     /// Raise every cell that does not drain to an open edge to its spill level (docs/scenario.md).
     bool fillDepressions = false;
+    /// What becomes of the region's cells without data (voids, e.g. SRTM's on steep slopes):
+    /// refused (the default), filled from the cells around them (GDAL's fill-nodata), walls, or
+    /// holes that take out all water that reaches them.
+    enum class Voids { kRefuse, kFill, kWalls, kHoles } voids = Voids::kRefuse;
   } terrain;
 
   struct {
