@@ -27,7 +27,7 @@ find_package(OpenEXR CONFIG REQUIRED)
 
 # GL: libepoxy resolves GL and EGL entry points (no X server needed for EGL).
 pkg_check_modules(EPOXY REQUIRED IMPORTED_TARGET epoxy)
-pkg_check_modules(EGL REQUIRED IMPORTED_TARGET egl)
+pkg_check_modules(EGL REQUIRED IMPORTED_TARGET egl)  # headers; libepoxy loads libEGL (gl/CMakeLists.txt)
 find_package(glfw3 CONFIG REQUIRED)
 find_package(glm CONFIG REQUIRED)
 
