@@ -29,6 +29,7 @@ uniform int uHasLayers;
 uniform float uSeaLevelM;        // water below this elevation when uHasSea
 uniform int uHasSea;
 uniform float uWaterDepthScaleM; // depth at which water looks 1/e of the way to deep
+uniform float uWaterFadeM;       // water shallower than this fades out (0: none)
 uniform float uLayerOpaqueM;     // thickness at which a layer hides 1/e of what is below
 uniform vec3 uLayerColour[4];
 uniform vec2 uElevRange;         // elevations (m) at the two ends of the tint
@@ -126,7 +127,10 @@ void main() {
       water = mix(water, uSiltColour, 1.0 - exp(-conc / uSiltConcentration));
     }
     float sunOnWater = 0.6 + 0.4 * max(dot(up, uSunDir), 0.0);
-    colour = mix(colour, water * sunOnWater, 0.55 + 0.45 * k);
+    // Thin water fades in (uWaterFadeM > 0): bilinear depth between a wet cell and a dry one is
+    // not drawn at full strength, so a wet cell's footprint is not a hard-edged square.
+    float fade = uWaterFadeM > 0.0 ? smoothstep(0.0, uWaterFadeM, depth) : 1.0;
+    colour = mix(colour, water * sunOnWater, (0.55 + 0.45 * k) * fade);
   }
   if (uFogM > 0.0) colour = mix(colour, uSky.rgb, 1.0 - exp(-length(fs.rel) / uFogM));
 

@@ -81,6 +81,7 @@ Status setCommonUniforms(const gl::Program& p, const TerrainScene& scene, const 
   p.set("uHasSea", shading.seaLevelM ? 1 : 0);
   p.set("uSeaLevelM", shading.seaLevelM.value_or(0.0f));
   p.set("uWaterDepthScaleM", shading.waterDepthScaleM);
+  p.set("uWaterFadeM", shading.waterFadeM);
   p.set("uLayerOpaqueM", shading.layerOpaqueM);
   for (int k = 0; k < 4; ++k) {
     const std::string name = "uLayerColour[" + std::to_string(k) + "]";

@@ -157,8 +157,18 @@ Result<Engine> startEngine(Backend backend, const ScenarioDomain& d, bool pictur
 // centre, about a quarter of the region's north-south extent above its highest point.
 class Pictures {
  public:
-  static Result<Pictures> create(const ScenarioDomain& d) {
+  /// `erosion`: draw the solver's current surface and its layers (in their materials' colours),
+  /// not the initial bed. Water is drawn only where it is deeper than `wetThresholdM`.
+  static Result<Pictures> create(const ScenarioDomain& d, bool erosion, double wetThresholdM) {
     Pictures p;
+    p.erosion_ = erosion;
+    p.wetThresholdM_ = float(wetThresholdM);
+    p.datumM_ = d.input.datumM;
+    const size_t layers = d.input.materials.size();
+    for (size_t k = layers > 4 ? layers - 4 : 0, slot = 0; k < layers; ++k, ++slot) {
+      const auto& c = d.input.materials[k].colour;
+      p.shading_.layerColours[slot] = glm::vec3(c[0], c[1], c[2]);
+    }
     const auto& g = d.bed.georef;
     STRATA_TRY(p.scene_, render::TerrainScene::create(d.bed));
     STRATA_TRY(p.ring_, render::RingRenderer::create({.circles = 160}));
@@ -182,11 +192,22 @@ class Pictures {
     p.camera_.pitchDeg = -40;
     p.camera_.fovYDeg = 50;
     p.shading_.waterDepthScaleM = 15;
+    p.shading_.waterFadeM = std::max(p.wetThresholdM_, 0.05f);
     return p;
   }
 
-  /// Draws the terrain with `depthM` of water and writes `file` (PNG).
-  Status draw(const gis::Grid<float>& depthM, const fs::path& file) {
+  /// Draws the terrain with the solver's water (`depthM`, read already) and writes `file` (PNG).
+  Status draw(const sim::Solver& sv, gis::Grid<float> depthM, const fs::path& file) {
+    for (float& h : depthM.data) h = h > wetThresholdM_ ? h : 0.0f;  // no rain film painted as water
+    if (erosion_) {
+      // The surface as it is now (bed above the datum, layers included) and the top four layers.
+      gis::Grid<float> surface = sv.readBed();
+      for (float& z : surface.data) z = float(double(z) + datumM_);
+      scene_.writeHeights(0, 0, surface);
+      auto layers = sv.readLayers();
+      if (layers.size() > 4) layers.erase(layers.begin(), layers.end() - 4);
+      STRATA_TRY_STATUS(scene_.setMaterialLayers(layers));
+    }
     STRATA_TRY_STATUS(scene_.setWaterDepth(depthM));
     STRATA_TRY_STATUS(ring_->draw(scene_, camera_, shading_, target_));
     const auto tmp = temporaryPathFor(file).string() + ".png";
@@ -196,6 +217,9 @@ class Pictures {
 
  private:
   static constexpr int kWidth = 960, kHeight = 540;
+  bool erosion_ = false;
+  float wetThresholdM_ = 0;
+  double datumM_ = 0;
   render::TerrainScene scene_;
   std::unique_ptr<render::RingRenderer> ring_;
   render::OffscreenTarget target_;
@@ -521,10 +545,11 @@ Result<RunSummary> runScenario(const Scenario& s, const RunOptions& opt) {
   std::optional<Pictures> pictures;
   if (opt.pictures) {
     fs::create_directories(opt.outDir / "pictures", ec);
-    STRATA_TRY(auto p, Pictures::create(run.domain()));
+    STRATA_TRY(auto p, Pictures::create(run.domain(), s.erosion.enabled, s.outputs.wetThresholdM));
     pictures.emplace(std::move(p));
     if (!opt.resume)
-      STRATA_TRY_STATUS(pictures->draw(run.solver().readWaterDepth(), opt.outDir / "pictures" / "before.png"));
+      STRATA_TRY_STATUS(
+          pictures->draw(run.solver(), run.solver().readWaterDepth(), opt.outDir / "pictures" / "before.png"));
   }
 
   RunSummary summary;
@@ -577,8 +602,10 @@ Result<RunSummary> runScenario(const Scenario& s, const RunOptions& opt) {
       // The peak picture is redrawn whenever the stored water reaches a new high at an interval.
       const bool peak = std::all_of(summary.series.begin(), summary.series.end(),
                                     [&](const SeriesRow& r) { return r.waterM3 <= row.waterM3; });
-      if (peak) STRATA_TRY_STATUS(pictures->draw(depth, opt.outDir / "pictures" / "peak.png"));
-      if (interval == intervals) STRATA_TRY_STATUS(pictures->draw(depth, opt.outDir / "pictures" / "after.png"));
+      if (peak) STRATA_TRY_STATUS(pictures->draw(run.solver(), depth, opt.outDir / "pictures" / "peak.png"));
+      if (interval == intervals) {
+        STRATA_TRY_STATUS(pictures->draw(run.solver(), depth, opt.outDir / "pictures" / "after.png"));
+      }
     }
     STRATA_TRY_STATUS(writeFileAtomic(opt.outDir / "series.csv", seriesCsv(summary.series)));
     STRATA_TRY_STATUS(run.writeMaps(depth));

@@ -46,6 +46,7 @@ struct Shading {
   float fogM = 0;                                                   ///< haze distance (m); 0: none
   std::optional<float> seaLevelM;                                   ///< water wherever the terrain is below (m)
   float waterDepthScaleM = 20;                ///< depth at which water is 1/e of the way to deep blue (m)
+  float waterFadeM = 0;                       ///< water shallower than this fades in (m); 0: drawn at once
   glm::vec3 siltColour{0.62f, 0.50f, 0.32f};  ///< water colour at high suspended-sediment concentration
   float siltConcentration = 0.01f;  ///< concentration s / h at which water is 1 - 1/e of the way to siltColour
   float layerOpaqueM = 0.5f;        ///< thickness at which a layer hides 1/e of what is below (m)
