@@ -7,6 +7,9 @@ int main(int argc, char** argv) {
   // Over the file size limit (ulimit -f) a write fails with EFBIG and the message names the file,
   // instead of the process dying silently of SIGXFSZ.
   std::signal(SIGXFSZ, SIG_IGN);
+  // A child (the plotting python) that dies early makes the write to its stdin fail with EPIPE,
+  // which runProcess reports, instead of killing strata silently with SIGPIPE.
+  std::signal(SIGPIPE, SIG_IGN);
   CLI::App app{"Strata: GIS terrain visualisation and what-if erosion and flood simulation on the GPU"};
   app.require_subcommand(1);
   strata::app::addGpuInfoCommand(app);

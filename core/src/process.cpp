@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <poll.h>
+#include <signal.h>
 #include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -37,8 +38,18 @@ Result<std::string> runProcess(const std::vector<std::string>& argv, std::string
   posix_spawn_file_actions_adddup2(&actions, out[1], 2);
   posix_spawnattr_t attr;
   posix_spawnattr_init(&attr);
-  posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETPGROUP);
-  posix_spawnattr_setpgroup(&attr, 0);  // its own process group: terminal signals do not reach it
+  // Its own process group: terminal signals (Ctrl-C to the foreground group) do not reach it. A
+  // group signal sent before the child has left the group would still kill it (glibc resets
+  // handled signals to their default in the child), so the terminal's signals are also blocked
+  // in it: one sent in that window stays pending, harmlessly. (StrataCli.CtrlCWhilePlotsAreDrawn
+  // KeepsTheReport lost the race under load: python died of the Ctrl-C before it started, and
+  // strata died of SIGPIPE writing it the script.)
+  posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETPGROUP | POSIX_SPAWN_SETSIGMASK);
+  posix_spawnattr_setpgroup(&attr, 0);
+  sigset_t terminal;
+  sigemptyset(&terminal);
+  for (int sig : {SIGINT, SIGQUIT, SIGTSTP}) sigaddset(&terminal, sig);
+  posix_spawnattr_setsigmask(&attr, &terminal);
   std::vector<char*> args;
   for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
   args.push_back(nullptr);
