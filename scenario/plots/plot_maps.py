@@ -76,13 +76,22 @@ def main():
         ax.imshow(shade, extent=extent, cmap="gray", vmin=0, vmax=1)
         if a.count() > 0:
             if name == "terrain_change":
-                lim = float(np.nanmax(np.abs(a))) or 1.0
+                # The colour range is the 99th percentile of the cells that changed, not the largest
+                # change: a few cells of tens of metres (a pit filled, a bank slumped) would
+                # otherwise wash out every channel. Beyond it the colour saturates (the colour bar
+                # says so with its arrows).
+                changed = np.abs(a.compressed())
+                changed = changed[changed > 0]
+                lim = float(np.percentile(changed, 99)) if changed.size else 1.0
                 im = ax.imshow(a, extent=extent, cmap=cmap, vmin=-lim, vmax=lim, alpha=0.85)
+                fig.colorbar(im, ax=ax, shrink=0.8, extend="both", label=f"{title.lower()} ({unit})")
+                im = None
             elif name == "exposed_material":
                 im = ax.imshow(a, extent=extent, cmap=cmap, vmin=-0.5, vmax=9.5, alpha=0.85, interpolation="nearest")
             else:
                 im = ax.imshow(a, extent=extent, cmap=cmap, alpha=0.85)
-            fig.colorbar(im, ax=ax, shrink=0.8, label=f"{title.lower()} ({unit})")
+            if im is not None:
+                fig.colorbar(im, ax=ax, shrink=0.8, label=f"{title.lower()} ({unit})")
         ax.set_title(title)
         ax.set_xlabel("longitude (°)" if geographic else "x (m)")
         ax.set_ylabel("latitude (°)" if geographic else "y (m)")

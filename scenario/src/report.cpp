@@ -108,7 +108,8 @@ std::string materialSection(const MaterialBudget& b) {
   md += "| deposited + suspended + carried out − eroded (0 up to float rounding) | " + fmt("%.3g", balance) + " (" +
         fmt("%.2e", b.initialM3Total > 0 ? balance / b.initialM3Total : 0.0) + " of all material) |\n\n";
   md +=
-      "`maps/exposed_material.tif` holds the layer number − 1 of the topmost material (0 = layer 1); "
+      "Exposed: the topmost layer at least 1 cm thick (a thinner film does not hide what is under it). "
+      "`maps/exposed_material.tif` holds the layer number − 1 of the exposed material (0 = layer 1); "
       "`maps/layer_K.tif` each layer's thickness at the end (m).\n\n";
   return md;
 }
@@ -183,6 +184,13 @@ Status writeReport(const fs::path& runDir, const ReportInput& in) {
     md += "| depressions filled | " + std::to_string(d.filled.cells) +
           " cells that drained to no open edge raised to their spill level ([terrain] fill_depressions), by up to " +
           fmt("%.0f", d.filled.maxM) + " m, " + millions(d.filled.volumeM3) + " in all |\n";
+  }
+  for (size_t l = 0; l < s.terrain.layers.size() && l < d.layerCellsTooSteep.size(); ++l) {
+    if (!s.terrain.layers[l].atRest) continue;
+    const size_t k = d.input.layersM.size() - s.terrain.layers.size() + l;  // the scenario's layers are on top
+    md += "| " + s.terrain.layers[l].material + " at rest | none on the " + std::to_string(d.layerCellsTooSteep[l]) +
+          " cells whose ground is steeper than its " + fmt("%.0f", d.input.materials[k].talusAngleDeg) +
+          "° angle of repose ([[terrain.layer]] at_rest) |\n";
   }
   if (d.voidCells > 0) {
     using V = decltype(s.terrain)::Voids;

@@ -227,6 +227,21 @@ class Pictures {
   render::Shading shading_;
 };
 
+// The layer a cell shows: the topmost at least kExposedM thick (a film of a few millimetres that
+// the drying rain leaves over everything does not hide what lies under it), else the topmost
+// with any material; -1 for none. `thickness(k)` gives layer k's, bottom first.
+constexpr float kExposedM = 0.01f;
+template <class Thickness>
+int exposedLayer(int layers, Thickness&& thickness) {
+  int any = -1;
+  for (int k = layers - 1; k >= 0; --k) {
+    const float t = thickness(k);
+    if (t >= kExposedM) return k;
+    if (t > 0 && any < 0) any = k;
+  }
+  return any;
+}
+
 // The run in progress: the scenario, its domain, the solver and what has been written so far.
 class Run {
  public:
@@ -372,8 +387,8 @@ class Run {
     return {};
   }
 
-  // terrain_change (net cut and fill, m), exposed_material (index of the topmost layer with
-  // material, bottom = 0; none: no data), suspended_sediment (m of material in the water) and
+  // terrain_change (net cut and fill, m), exposed_material (exposedLayer: bottom = 0; none: no
+  // data), suspended_sediment (m of material in the water) and
   // layer_thickness (maps/layer_K.tif, K = 1 the bottom layer, each naming its material).
   template <class WriteMap>
   Status writeErosionMaps(WriteMap&& writeMap) {
@@ -382,9 +397,8 @@ class Run {
     const int L = int(layers.size());
     gis::Grid<float> top(layers.front().width, layers.front().height, gis::kNoData);
     for (size_t i = 0; i < top.size(); ++i) {
-      for (int l = 0; l < L; ++l) {
-        if (layers[size_t(l)].data[i] > 0.0f) top.data[i] = float(l);
-      }
+      const int l = exposedLayer(L, [&](int k) { return layers[size_t(k)].data[i]; });
+      if (l >= 0) top.data[i] = float(l);
     }
     STRATA_TRY_STATUS(writeMap("exposed_material", top, false));
     STRATA_TRY_STATUS(writeMap("suspended_sediment", solver().readSuspended(), false));
@@ -421,17 +435,17 @@ class Run {
     for (int y = 0; y < h; ++y) {
       const double area = solver().grid().area(y);  // as the solver's totals (float32 dy)
       for (int x = 0; x < w; ++x) {
-        int topBefore = -1, topAfter = -1;
         double change = 0;
         for (size_t l = 0; l < layers.size(); ++l) {
           const double before = d_.input.layersM[l].at(x, y), after = layers[l].at(x, y);
           b.initialM3[l] += before * area;
           b.finalM3[l] += after * area;
           change += after - before;
-          if (before > 0) topBefore = int(l);
-          if (after > 0) topAfter = int(l);
         }
         (change < 0 ? b.erodedM3 : b.depositedM3) += std::abs(change) * area;
+        const int topBefore =
+            exposedLayer(int(layers.size()), [&](int k) { return d_.input.layersM[size_t(k)].at(x, y); });
+        const int topAfter = exposedLayer(int(layers.size()), [&](int k) { return layers[size_t(k)].at(x, y); });
         if (topBefore >= 0) b.exposedInitialM2[size_t(topBefore)] += area;
         if (topAfter >= 0) b.exposedFinalM2[size_t(topAfter)] += area;
       }
@@ -519,9 +533,9 @@ Result<RunSummary> runScenario(const Scenario& s, const RunOptions& opt) {
   STRATA_TRY(auto domain, buildDomain(s, opt.memoryBudgetBytes));
   const auto& g = domain.bed.georef;
   const std::string name = displayName(s.name);
-  log::info("flood") << name << ": " << g.width << " x " << g.height << " cells, " << domain.totalAreaM2 / 1e6
-                     << " km^2, " << domain.sources.size() << " inflow(s), " << domain.levels.size()
-                     << " fixed level(s), " << formatDuration(s.durationS) << " simulated";
+  log::info(opt.command) << name << ": " << g.width << " x " << g.height << " cells, " << domain.totalAreaM2 / 1e6
+                         << " km^2, " << domain.sources.size() << " inflow(s), " << domain.levels.size()
+                         << " fixed level(s), " << formatDuration(s.durationS) << " simulated";
 
   STRATA_TRY(const FileLock lock, takeRunFolder(opt));
   std::error_code ec;
@@ -534,7 +548,7 @@ Result<RunSummary> runScenario(const Scenario& s, const RunOptions& opt) {
   STRATA_TRY(auto engine, startEngine(opt.backend.value_or(s.model.backend), domain, opt.pictures));
   engine.solver->enableFloodStats(float(s.outputs.wetThresholdM));
   Run run(s, opt, std::move(domain), std::move(engine));
-  log::info("flood") << "running on " << run.backendName();
+  log::info(opt.command) << "running on " << run.backendName();
 
   installInterruptHandler();
   SpinUpSummary spinUp;
@@ -566,7 +580,8 @@ Result<RunSummary> runScenario(const Scenario& s, const RunOptions& opt) {
     earlierWallS = c.wallS;
     spinUp = c.spinUp;
     summary.series = std::move(c.series);
-    log::info("flood") << "resuming at " << formatDuration(run.solver().timeS()) << " (interval " << interval << ")";
+    log::info(opt.command) << "resuming at " << formatDuration(run.solver().timeS()) << " (interval " << interval
+                           << ")";
   } else {
     STRATA_TRY_STATUS(writeFileAtomic(opt.outDir / "scenario.toml", scenarioText));
   }
@@ -575,7 +590,7 @@ Result<RunSummary> runScenario(const Scenario& s, const RunOptions& opt) {
   auto wallSoFar = [&] {
     return earlierWallS + std::chrono::duration<double>(std::chrono::steady_clock::now() - wallStart).count();
   };
-  Progress progress("flood " + name, s.durationS);
+  Progress progress(opt.command + " " + name, s.durationS);
   while (interval < intervals) {
     const double t0 = interval * s.outputIntervalS, t1 = std::min(s.durationS, (interval + 1) * s.outputIntervalS);
     // Progress a few times an interval (a bar on a terminal, log lines otherwise).
@@ -621,8 +636,8 @@ Result<RunSummary> runScenario(const Scenario& s, const RunOptions& opt) {
   if (summary.completed) {
     progress.finish(std::to_string(st.steps) + " steps");
   } else {
-    log::warn("flood") << "stopped at " << formatDuration(summary.series.empty() ? 0 : summary.series.back().timeS)
-                       << "; outputs are those of that interval; continue with --resume";
+    log::warn(opt.command) << "stopped at " << formatDuration(summary.series.empty() ? 0 : summary.series.back().timeS)
+                           << "; outputs are those of that interval; continue with --resume";
   }
   summary.files = {"scenario.toml", "series.csv", "checkpoint.bin"};
   const auto maps = run.mapFiles();

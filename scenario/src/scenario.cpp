@@ -362,7 +362,7 @@ Status readTerrain(const Reader& r, const toml::table& root, Scenario& s) {
       const std::string key = "terrain.layer[" + std::to_string(i) + "]";
       const auto* lt = (*arr)[i].as_table();
       if (!lt) return r.error((*arr)[i], key, "expected a table");
-      STRATA_TRY_STATUS(r.onlyKeys(*lt, key, {"material", "thickness", "raster"}));
+      STRATA_TRY_STATUS(r.onlyKeys(*lt, key, {"material", "thickness", "raster", "at_rest"}));
       LayerSpec l;
       if (!lt->get("material")) return r.error(*lt, key + ".material", "missing");
       STRATA_TRY(l.material, r.string(*lt->get("material"), key + ".material"));
@@ -370,6 +370,9 @@ Status readTerrain(const Reader& r, const toml::table& root, Scenario& s) {
         STRATA_TRY(l.thicknessM, r.quantity(*th, key + ".thickness", "length"));
         if (l.thicknessM < 0) return r.error(*th, key + ".thickness", "negative thickness");
         STRATA_TRY_STATUS(r.check(*th, key + ".thickness", l.thicknessM, kThickness));
+      }
+      if (const auto* ar = lt->get("at_rest")) {
+        STRATA_TRY(l.atRest, r.boolean(*ar, key + ".at_rest"));
       }
       if (const auto* ra = lt->get("raster")) {
         STRATA_TRY(auto p, r.string(*ra, key + ".raster"));

@@ -40,6 +40,8 @@ struct ScenarioDomain {
   /// source had no data (their bed is filled from the cells around them in every mode).
   gis::Grid<uint8_t> voids;
   int voidCells = 0;
+  /// Per [[terrain.layer]]: the cells left without it by at_rest (too steep for its material).
+  std::vector<int> layerCellsTooSteep;
   /// What [terrain] fill_depressions raised (nothing when off).
   struct {
     int cells = 0;

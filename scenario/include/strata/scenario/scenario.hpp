@@ -69,6 +69,9 @@ struct LayerSpec {
   std::string material;   ///< a name from the material table
   double thicknessM = 0;  ///< uniform thickness, or
   std::string raster;     ///< a thickness raster
+  /// Only where it can rest: none on cells whose ground drops to a neighbour more steeply than
+  /// the material's angle of repose (thermal weathering would shed it at once).
+  bool atRest = false;
 };
 
 struct Scenario {
