@@ -13,6 +13,7 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
+import matplotlib.colors  # noqa: E402
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from osgeo import gdal  # noqa: E402
@@ -26,7 +27,7 @@ STYLE = {
     "arrival_time": ("Arrival time of the water", "h", "viridis_r", 1 / 3600.0),
     "inundation_duration": ("Time under water", "h", "magma_r", 1 / 3600.0),
     "terrain_change": ("Terrain change (erosion < 0 < deposition)", "m", "RdBu", None),
-    "exposed_material": ("Exposed material at the end (layer number - 1)", "layer", "tab10", None),
+    "exposed_material": ("Exposed material at the end", "layer", "tab10", None),
     "suspended_sediment": ("Suspended sediment at the end", "m", "YlOrBr", None),
 }
 
@@ -87,7 +88,23 @@ def main():
                 fig.colorbar(im, ax=ax, shrink=0.8, extend="both", label=f"{title.lower()} ({unit})")
                 im = None
             elif name == "exposed_material":
-                im = ax.imshow(a, extent=extent, cmap=cmap, vmin=-0.5, vmax=9.5, alpha=0.85, interpolation="nearest")
+                # One colour per layer, the material's own (STRATA_COLOUR_k), labelled with its name
+                # (STRATA_MATERIAL_k); maps without them get tab10 and layer numbers.
+                meta = gdal.Open(str(path)).GetMetadata()
+                n = 0
+                while f"STRATA_MATERIAL_{n}" in meta and f"STRATA_COLOUR_{n}" in meta:
+                    n += 1
+                if n > 0:
+                    colours = [tuple(float(c) for c in meta[f"STRATA_COLOUR_{k}"].split(",")) for k in range(n)]
+                    names = [f"{k + 1}: {meta[f'STRATA_MATERIAL_{k}']}" for k in range(n)]
+                    im = ax.imshow(a, extent=extent, cmap=matplotlib.colors.ListedColormap(colours), vmin=-0.5,
+                                   vmax=n - 0.5, alpha=0.9, interpolation="nearest")
+                    bar = fig.colorbar(im, ax=ax, shrink=0.8, ticks=range(n), label="layer: material")
+                    bar.ax.set_yticklabels(names)
+                    im = None
+                else:
+                    im = ax.imshow(a, extent=extent, cmap=cmap, vmin=-0.5, vmax=9.5, alpha=0.85,
+                                   interpolation="nearest")
             else:
                 im = ax.imshow(a, extent=extent, cmap=cmap, alpha=0.85)
             if im is not None:

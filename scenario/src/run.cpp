@@ -368,7 +368,8 @@ class Run {
   // The maps the scenario asks for, as GeoTIFFs in the region's CRS.
   Status writeMaps(const gis::Grid<float>& depth) {
     const auto flood = solver().readFloodStats();
-    auto writeMap = [&](const std::string& name, const gis::Grid<float>& values, bool wetOnly) -> Status {
+    auto writeMap = [&](const std::string& name, const gis::Grid<float>& values, bool wetOnly,
+                        const std::vector<std::pair<std::string, std::string>>& metadata = {}) -> Status {
       if (std::find(s_.outputs.maps.begin(), s_.outputs.maps.end(), name) == s_.outputs.maps.end()) return {};
       gis::Raster r{d_.bed.georef, values};
       for (size_t i = 0; i < r.values.size(); ++i) {
@@ -376,7 +377,9 @@ class Run {
           r.values.data[i] = gis::kNoData;
         }
       }
-      return gis::writeGeoTiff((opt_.outDir / ("maps/" + name + ".tif")).string(), r);
+      gis::WriteOptions o;
+      o.metadata = metadata;
+      return gis::writeGeoTiff((opt_.outDir / ("maps/" + name + ".tif")).string(), r, o);
     };
     STRATA_TRY_STATUS(writeMap("max_depth", flood.maxDepthM, false));
     STRATA_TRY_STATUS(writeMap("max_speed", flood.maxSpeedMS, false));
@@ -400,7 +403,17 @@ class Run {
       const int l = exposedLayer(L, [&](int k) { return layers[size_t(k)].data[i]; });
       if (l >= 0) top.data[i] = float(l);
     }
-    STRATA_TRY_STATUS(writeMap("exposed_material", top, false));
+    // Each value's material and colour (STRATA_MATERIAL_k, STRATA_COLOUR_k "r,g,b"): GIS tools
+    // list them, and the plot draws its legend from them.
+    std::vector<std::pair<std::string, std::string>> legend;
+    for (int l = 0; l < L; ++l) {
+      const auto& m = d_.input.materials[size_t(l)];
+      char rgb[64];
+      std::snprintf(rgb, sizeof rgb, "%.3f,%.3f,%.3f", m.colour[0], m.colour[1], m.colour[2]);
+      legend.push_back({"STRATA_MATERIAL_" + std::to_string(l), m.name});
+      legend.push_back({"STRATA_COLOUR_" + std::to_string(l), rgb});
+    }
+    STRATA_TRY_STATUS(writeMap("exposed_material", top, false, legend));
     STRATA_TRY_STATUS(writeMap("suspended_sediment", solver().readSuspended(), false));
     if (std::find(s_.outputs.maps.begin(), s_.outputs.maps.end(), "layer_thickness") == s_.outputs.maps.end()) {
       return {};

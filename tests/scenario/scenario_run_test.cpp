@@ -1,5 +1,6 @@
 // Scenario runs on the CPU backend with no GL context at all: the run folder (maps, series,
 // plots, report), and run folders and scenario names that a shell would have misread.
+#include <gdal.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -115,6 +116,17 @@ TEST(ScenarioRun, ErosionRunWritesMaterialMapsAndBalance) {
   int rockExposed = 0;
   for (float t : top->values.data) rockExposed += t == 0.0f;
   EXPECT_GT(rockExposed, 0);  // the sand has gone somewhere (steep walls it slid off, the channel)
+  {
+    // Each value's material and colour ride along as metadata (the plot's legend, gdalinfo).
+    GDALAllRegister();
+    GDALDatasetH ds = GDALOpen((opt.outDir / "maps/exposed_material.tif").string().c_str(), GA_ReadOnly);
+    ASSERT_NE(ds, nullptr);
+    const char* m0 = GDALGetMetadataItem(ds, "STRATA_MATERIAL_0", nullptr);
+    const char* c0 = GDALGetMetadataItem(ds, "STRATA_COLOUR_0", nullptr);
+    EXPECT_STREQ(m0, "rock");
+    EXPECT_STREQ(c0, "0.450,0.360,0.300");
+    GDALClose(ds);
+  }
   EXPECT_TRUE(std::filesystem::exists(opt.outDir / "maps/suspended_sediment.tif"));
   const std::string report = slurp(opt.outDir / "report.md");
   EXPECT_NE(report.find("## Material"), std::string::npos);
