@@ -726,12 +726,6 @@ Status checkTomlText(std::string_view text, const std::string& file) {
   auto outside = [&](size_t i) {
     return refuse(codePoint(text, i) + " outside a string or a comment (TOML allows ASCII only there)");
   };
-  auto digit = [&](size_t k) { return k < text.size() && std::isdigit(static_cast<unsigned char>(text[k])) != 0; };
-  // YYYY-MM-DD at `i`.
-  auto isDate = [&](size_t i) {
-    return digit(i) && digit(i + 1) && digit(i + 2) && digit(i + 3) && text[i + 4] == '-' && digit(i + 5) &&
-           digit(i + 6) && text[i + 7] == '-' && digit(i + 8) && digit(i + 9);
-  };
   auto quotes = [&](size_t i, char q) {
     size_t n = 0;
     while (i + n < text.size() && text[i + n] == q) ++n;
@@ -809,9 +803,14 @@ Status checkTomlText(std::string_view text, const std::string& file) {
         break;
       case State::Bare:
         if (u >= 0x80) return outside(i);
-        if ((c == 'T' || c == 't') && i == bareStart + 10 && isDate(bareStart) && !digit(i + 1)) {
-          // A date, its 'T' and no time: toml++ fails an assertion (is_decimal_digit in parse_time).
-          return refuse(std::string("a date-time with '") + c + "' and no time after it (expected HH:MM:SS)");
+        // A '-' inside a value (not its sign, not an exponent's) or a ':' makes toml++ read a
+        // date or a time, and its date and time scanning fails assertions on malformed ones
+        // ("1979-05-27T:", "1979-05-27 1]", "1908-05-\6 7": parse_time, parse_value). No
+        // scenario key takes a date or a time of day, so none reaches it.
+        if (c == ':' || (c == '-' && i > bareStart && text[i - 1] != 'e' && text[i - 1] != 'E')) {
+          return refuse(std::string("'") + c +
+                        "' inside a value: a date or a time of day, which no scenario key takes (durations are "
+                        "quantities such as \"3 h\")");
         }
         break;
       case State::Comment: break;
