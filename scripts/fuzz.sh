@@ -55,7 +55,8 @@ seed_dem() {
 
 run_dem() {
   "$out/read_dem_fuzz" -max_total_time="$seconds" -timeout=20 -rss_limit_mb=2048 -max_len=65536 \
-    -artifact_prefix="$out/crashes/dem/" -print_final_stats=1 "$out/corpus/dem" "$out/seeds/dem"
+    -artifact_prefix="$out/crashes/dem/" -print_final_stats=1 "$out/corpus/dem" "$out/seeds/dem" \
+    "$root/tests/gis/fuzz/regressions"
 }
 
 build_manifest() {

@@ -13,6 +13,7 @@
 #include <numbers>
 #include <optional>
 #include <sstream>
+#include <utility>
 
 #include "gdal_util.hpp"
 
@@ -85,6 +86,15 @@ Result<Probed> probe(const std::string& path, const ReadOptions& options) {
         std::isfinite(t.c[4]) && std::isfinite(t.c[5])) ||
       t.c[1] * t.c[5] - t.c[2] * t.c[4] == 0) {
     return fail(path + ": degenerate geotransform (zero or non-finite pixel size)");
+  }
+  for (const auto& [col, row] : {std::pair{0, 0}, {g.width, 0}, {0, g.height}, {g.width, g.height}}) {
+    const double x = t.x(col, row), y = t.y(col, row);
+    if (!(std::abs(x) <= 1e10 && std::abs(y) <= 1e10)) {  // as CrsTransform::transform's bound
+      std::ostringstream m;
+      m << path << ": geotransform puts corner (" << col << ", " << row << ") at (" << x << ", " << y
+        << "), beyond any body (more than 1e10 CRS units from the origin)";
+      return fail(m.str());
+    }
   }
   if (!(g.body.semiMajorM > 0) || !(g.body.flattening >= 0 && g.body.flattening < 1)) {
     return fail(path + ": unknown CRS '" + g.crsName + "' (no usable ellipsoid)");

@@ -196,12 +196,22 @@ Result<CrsTransform> CrsTransform::fromGeographic(const Georef& georef) {
 }
 
 bool CrsTransform::transform(std::size_t n, double* x, double* y, double* z) const {
+  // No coordinate of any CRS on any body is this far from its origin (1e10 units is 1,500 Earth
+  // radii in metres); such points fail without reaching GDAL, whose Web Mercator shortcut (GDAL
+  // 3.6) wraps a longitude by 360 degrees per iteration: a 1e20 m easting spins for hours.
+  constexpr double kFarthest = 1e10;
+  std::vector<char> tooFar(n, 0);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!(std::abs(x[i]) <= kFarthest && std::abs(y[i]) <= kFarthest)) {
+      tooFar[i] = 1;
+      x[i] = y[i] = 0;  // a harmless stand-in for GDAL; the point fails below
+    }
+  }
   std::vector<int> ok(n, 0);
   detail::GdalErrorCapture quiet;
-  const bool all = impl_->ct->Transform(n, x, y, z, nullptr, ok.data()) != 0;
-  bool allOk = all;
+  bool allOk = impl_->ct->Transform(n, x, y, z, nullptr, ok.data()) != 0;
   for (std::size_t i = 0; i < n; ++i) {
-    if (!ok[i] || !std::isfinite(x[i]) || !std::isfinite(y[i])) {
+    if (tooFar[i] || !ok[i] || !std::isfinite(x[i]) || !std::isfinite(y[i])) {
       x[i] = y[i] = std::nan("");
       allOk = false;
     }

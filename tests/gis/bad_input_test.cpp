@@ -212,6 +212,23 @@ TEST(BadInput, UnknownCrs) {
   EXPECT_CONTAINS(readError(local), "unknown CRS 'site grid' (neither geographic nor projected)");
 }
 
+TEST(BadInput, AGridBeyondAnyBodyIsRefused) {
+  // The fuzzer's input: a Web Mercator grid 1e20 m from the origin (GDAL 3.6 spins for hours
+  // taking such a corner to lon/lat). Refused at the probe, naming the corner.
+  const auto dir = strata::test::tempDir("far");
+  const std::string path = (dir / "far.tif").string();
+  auto s = geoRaster();
+  s.crs = "EPSG:3857";
+  s.gt = std::array<double, 6>{-1e20, 5e18, 0, 1e20, 0, -5e18};
+  ASSERT_TRUE(test::writeSynthetic(path, s));
+  EXPECT_CONTAINS(readError(path), "geotransform puts corner (0, 0) at (-1e+20, 1e+20), beyond any body");
+  // 1e4 km off the origin is unusual but possible (a false easting): read.
+  const std::string near = (dir / "near.tif").string();
+  s.gt = std::array<double, 6>{1e7, 30, 0, 1e7, 0, -30};
+  ASSERT_TRUE(test::writeSynthetic(near, s));
+  EXPECT_TRUE(readDem(near).ok());
+}
+
 TEST(BadInput, WindowAndBandOutOfRange) {
   const auto dir = strata::test::tempDir("range");
   const std::string path = (dir / "g.tif").string();

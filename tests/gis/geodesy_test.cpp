@@ -286,6 +286,26 @@ TEST(CellAreas, WholeMoonAndMarsSumToTheSphere) {
   }
 }
 
+TEST(CellAreas, AWebMercatorGridFarOffTheEarthFailsAtOnce) {
+  // A fuzzed GeoTIFF put a 3857 grid's corners at 1e20 m: GDAL 3.6's Web Mercator shortcut
+  // wraps such a longitude 360 degrees per iteration and did not return within 29 s (CI's fuzzer
+  // timed out). Such points now fail before reaching GDAL: NaN areas, at once.
+  auto info = probeDem(test::dataFile("grand_canyon/grandcanyon_srtm_3857.tif"));
+  ASSERT_TRUE(info.ok()) << info.message();
+  Georef g = info->georef;
+  g.width = g.height = 4;
+  g.transform = GeoTransform{{-1e20, 5e19, 0, 1e20, 0, -5e19}};
+  auto areas = cellAreasM2(g);
+  ASSERT_TRUE(areas.ok()) << areas.message();
+  for (double a : areas->data) EXPECT_TRUE(std::isnan(a)) << a;
+  auto ct = CrsTransform::toGeographic(g);
+  ASSERT_TRUE(ct.ok()) << ct.message();
+  double x[3] = {-1e20, 1e11, 1000}, y[3] = {0, 0, 1000};
+  EXPECT_FALSE(ct->transform(3, x, y));
+  EXPECT_TRUE(std::isnan(x[0]) && std::isnan(y[0]) && std::isnan(x[1]) && std::isnan(y[1]));
+  EXPECT_NEAR(x[2], 1000 / 6378137.0 * 180 / std::numbers::pi, 1e-9);  // the sane point still goes through
+}
+
 TEST(Geodesy, CrsTransformErrorsNameTheCrs) {
   auto t = CrsTransform::create("EPSG:4326", "EPSG:999999");
   ASSERT_FALSE(t.ok());
