@@ -10,6 +10,8 @@
 
 #include <toml++/toml.h>
 
+#include <strata/core/toml_screen.hpp>
+
 namespace strata::terrain::detail {
 namespace {
 
@@ -82,8 +84,8 @@ size_t utf8Length(std::string_view s, size_t i) {
 
 // A TOML basic string in ASCII: quotes, backslashes and control characters escaped, every
 // non-ASCII character written as a \uXXXX / \UXXXXXXXX escape (so the whole manifest is ASCII,
-// which screenToml relies on); bytes that are not UTF-8 become U+FFFD (a manifest's strings come
-// from GDAL, validated names and Strata's file names, which are UTF-8).
+// which strata::screenToml's ASCII-only mode relies on); bytes that are not UTF-8 become U+FFFD (a manifest's strings
+// come from GDAL, validated names and Strata's file names, which are UTF-8).
 std::string tomlString(std::string_view s) {
   std::string out = "\"";
   char buf[16];
@@ -378,7 +380,10 @@ std::string tileFileName(int tx, int ty, uint64_t generation) {
 }
 
 Result<Manifest> parseManifest(const std::string& text, const std::string& path) {
-  STRATA_TRY_STATUS(screenToml(text, path));
+  TomlScreenOptions screen;
+  screen.asciiOnly = true;  // the writer escapes every other character
+  screen.kind = "manifest";
+  STRATA_TRY_STATUS(screenToml(text, path, screen));
   toml::table root;
   try {
     root = toml::parse(text, path);
@@ -588,133 +593,6 @@ Result<Manifest> parseManifest(const std::string& text, const std::string& path)
     return r.error(b["pass"], "build.pass", "an incomplete store must be in pass 1 or 2");
   }
   return m;
-}
-
-Status screenToml(std::string_view text, const std::string& path) {
-  if (text.size() > (size_t(1) << 30)) return fail(path + ": larger than 1 GiB: not a manifest");
-  // A small lexer: strings and comments are skipped as TOML defines them, so that table
-  // headers (a '[' first on a line, outside any array or inline table) are recognised.
-  enum class State { Normal, Comment, Basic, Literal, MlBasic, MlLiteral };
-  State state = State::Normal;
-  size_t line = 1;
-  std::string open;       // the open arrays '[' and inline tables '{', innermost last
-  bool lineStart = true;  // only whitespace so far on this line
-  bool header = false;    // inside a table header (its brackets do not nest)
-  auto refuse = [&](const std::string& what) { return fail(path + ":" + std::to_string(line) + ": " + what); };
-  auto bareKey = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-'; };
-  const size_t n = text.size();
-  for (size_t i = 0; i < n;) {
-    const auto c = static_cast<unsigned char>(text[i]);
-    // TOML allows no control character but tab, newline and carriage return anywhere (strings
-    // escape them); toml++ 3.3.0 asserts on some of them (undefined behaviour in release builds).
-    if ((c < 0x20 && c != '\t' && c != '\n' && c != '\r') || c == 0x7F) {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "0x%02X", unsigned(c));
-      return refuse(std::string("control character ") + buf + ": not a manifest");
-    }
-    // A manifest is ASCII (its writer escapes everything else): toml++ 3.3.0 reaches
-    // TOML_UNREACHABLE (undefined behaviour) classifying some non-ASCII characters as whitespace
-    // (is_non_ascii_horizontal_whitespace, e.g. U+FEE2 U+FEEF), also where it is scanning a
-    // malformed value. Refusing them all keeps every such path out of reach.
-    if (c >= 0x80) return refuse("a non-ASCII byte (write it as a \\uXXXX escape in a string): not a manifest");
-    const size_t len = 1;
-    if (c == '\n') {
-      ++line;
-      if (state != State::MlBasic && state != State::MlLiteral) {
-        state = State::Normal;  // an unterminated string or a comment ends here (toml++ reports the former)
-        lineStart = true;
-        header = false;
-      }
-      ++i;
-      continue;
-    }
-    const char quote = state == State::Basic || state == State::MlBasic ? '"' : '\'';
-    switch (state) {
-      case State::Comment: break;
-      case State::Basic:
-      case State::MlBasic:
-      case State::Literal:
-      case State::MlLiteral: {
-        const bool multi = state == State::MlBasic || state == State::MlLiteral;
-        if (quote == '"' && c == '\\' && i + 1 < n && text[i + 1] > 0x20 && text[i + 1] < 0x7F) {
-          i += 2;  // an escaped printable character (not a quote that ends the string)
-          continue;
-        }
-        if (!multi && char(c) == quote) state = State::Normal;
-        if (multi && text.substr(i, 3) == std::string(3, quote)) {
-          i += 3;
-          for (int k = 0; k < 2 && i < n && text[i] == quote; ++k) ++i;  // up to two more end the content
-          state = State::Normal;
-          continue;
-        }
-        break;
-      }
-      case State::Normal:
-        if (c == ' ' || c == '\t' || c == '\r') break;
-        if (c == '#') {
-          state = State::Comment;
-          break;
-        }
-        if (c == '"' || c == '\'') {
-          const bool triple = text.substr(i, 3) == std::string(3, char(c));
-          state = c == '"' ? (triple ? State::MlBasic : State::Basic) : (triple ? State::MlLiteral : State::Literal);
-          lineStart = false;
-          i += triple ? 3 : 1;
-          continue;
-        }
-        if (lineStart && open.empty() && c == '[') {
-          // toml++ 3.3.0 asserts (parse_key: is_bare_key_character(*cp) || is_string_delimiter(*cp))
-          // when a table header's key starts with anything else, e.g. "[&": undefined behaviour in
-          // release builds. Such a header is invalid TOML: refused here.
-          size_t j = i + 1;
-          while (j < n && (text[j] == ' ' || text[j] == '\t')) ++j;
-          if (j < n && text[j] == '[') {
-            ++j;
-            while (j < n && (text[j] == ' ' || text[j] == '\t')) ++j;
-          }
-          if (j >= n || !(bareKey(text[j]) || text[j] == '"' || text[j] == '\'' || text[j] == ']')) {
-            return refuse("a table header whose key does not start with a letter, digit, '_', '-' or a quote");
-          }
-          header = true;
-          lineStart = false;
-          i = j;
-          continue;
-        }
-        lineStart = false;
-        if (std::isdigit(c) ||
-            ((c == '+' || c == '-') && i + 1 < n && std::isdigit(static_cast<unsigned char>(text[i + 1])))) {
-          // A number (or a key or date that starts like one). toml++ 3.3.0 asserts (scan:
-          // !is_value_terminator(*cp)) re-scanning a date-like value followed by a space and a
-          // digit, e.g. "x= 5301-04-0s 3,": undefined behaviour in release builds. A manifest
-          // holds no dates or times: a '-' not after an exponent's 'e', or a ':', is refused.
-          size_t j = i + 1;
-          for (; j < n && (std::isalnum(static_cast<unsigned char>(text[j])) || std::strchr("_.+-:", text[j])); ++j) {
-            const char d = text[j];
-            if (d == ':' || (d == '-' && text[j - 1] != 'e' && text[j - 1] != 'E')) {
-              return refuse("a date or time (or a number with a stray '" + std::string(1, d) + "'): not a manifest");
-            }
-          }
-          i = j;
-          continue;
-        }
-        if (!header && (c == '[' || c == '{')) {
-          // A manifest nests two deep at most (an array in an array of tables).
-          if (open.size() >= 64) return refuse("nesting deeper than 64: not a manifest");
-          open += char(c);
-        } else if (!header && (c == ']' || c == '}')) {
-          // toml++ 3.3.0 asserts (parse_value: !is_value_terminator(*cp)) on an array closed by
-          // '}', e.g. "u=[}": undefined behaviour in release builds. Brackets must pair.
-          if (open.empty() || open.back() != (c == ']' ? '[' : '{')) {
-            return refuse(std::string("'") + char(c) + "' closes no matching '" + (c == ']' ? '[' : '{') +
-                          "': not a manifest");
-          }
-          open.pop_back();
-        }
-        break;
-    }
-    i += len;
-  }
-  return {};
 }
 
 }  // namespace strata::terrain::detail

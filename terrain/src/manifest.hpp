@@ -39,13 +39,7 @@ Status validateDesc(const StoreDesc& desc);
 std::string manifestToToml(const Manifest& m);
 /// Parses and validates; errors name `path`, the line where known, and the key. Every number is
 /// checked finite and in range; text that the TOML parser cannot take safely is refused before
-/// it reaches it (see screenToml).
+/// it reaches it (strata/core/toml_screen.hpp; a manifest is ASCII).
 Result<Manifest> parseManifest(const std::string& text, const std::string& path);
-
-/// Refuses text before it reaches toml++ 3.3.0 where that parser has known defects (see the
-/// definition), and text a manifest never holds (non-ASCII bytes: the writer escapes them;
-/// control characters; over 1 GiB; unpaired or deeply nested brackets). Empty: the text may be
-/// parsed.
-Status screenToml(std::string_view text, const std::string& path);
 
 }  // namespace strata::terrain::detail

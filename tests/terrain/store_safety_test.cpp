@@ -517,14 +517,18 @@ TEST(StoreManifest, TextThatTripsTomlPlusPlusIsRefusedBeforeItReachesIt) {
     std::string text, want;
   };
   const std::vector<Case> cases = {
-      {"[\x19", ":1: a table header whose key does not start with a letter, digit"},
-      {"a = \"\x19\"", ":1: control character 0x19: not a manifest"},
-      {"format = 1\n[&", ":2: a table header whose key does not start with a letter, digit"},
-      {"u=[}", ":1: '}' closes no matching '{': not a manifest"},
-      {"x = 1\n\xEF\xBB\xA2", ":2: a non-ASCII byte (write it as a \\uXXXX escape in a string): not a manifest"},
-      {"nte= 0e-'xbo\xEF\xBB\xAF", ":1: a non-ASCII byte"},
-      {"solcoln= 5301-04-0s 3, 0o darat", ":1: a date or time (or a number with a stray '-'): not a manifest"},
-      {"a = [" + std::string(100, '['), ":1: nesting deeper than 64: not a manifest"},
+      {"[\x19", ":1: U+0019: a control character (TOML allows tab and line breaks only)"},
+      {"a = \"\x19\"", ":1: U+0019: a control character"},
+      {"format = 1\n[&", ":2: '&' starts a table name (TOML allows ASCII letters, digits, _ and -, or a quoted name)"},
+      {"u=[}", ":1: '}' inside an array (no inline table to close)"},
+      {"x = 1\n\xEF\xBB\xA2",
+       ":2: U+FEE2: not ASCII (a manifest is ASCII; its strings write other characters as "
+       "\\uXXXX escapes)"},
+      {"nte= 0e-'xbo\xEF\xBB\xAF", ":1: U+FEEF: not ASCII"},
+      {"solcoln= 5301-04-0s 3, 0o darat",
+       ":1: '-' inside a value: a date or a time of day, which no manifest key takes"},
+      {"a = [" + std::string(100, '['), ":1: arrays and inline tables nested deeper than 64"},
+      {"a = {b = ]", ":1: ']' inside an inline table (no array to close)"},
   };
   for (const auto& c : cases) {
     std::ofstream(dir / "manifest.toml", std::ios::binary) << c.text;
