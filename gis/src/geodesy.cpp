@@ -161,17 +161,25 @@ Result<CrsTransform> CrsTransform::create(const std::string& from, const std::st
   return t;
 }
 
-Result<CrsTransform> CrsTransform::toGeographic(const Georef& georef) {
+Result<CrsTransform> CrsTransform::lonLat(const Georef& georef, bool fromLonLat) {
   STRATA_TRY(OGRSpatialReference srs, detail::srsOf(georef));
   std::unique_ptr<OGRSpatialReference> geog(srs.CloneGeogCS());
   if (!geog) return fail("CRS '" + georef.crsName + "' has no geographic base");
   geog->SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
   detail::GdalErrorCapture errors;
   CrsTransform t;
-  t.impl_->ct.reset(OGRCreateCoordinateTransformation(&srs, geog.get()));
-  if (!t.impl_->ct) return fail("no transformation from '" + georef.crsName + "' to lon/lat: " + errors.last());
+  t.impl_->ct.reset(fromLonLat ? OGRCreateCoordinateTransformation(geog.get(), &srs)
+                               : OGRCreateCoordinateTransformation(&srs, geog.get()));
+  if (!t.impl_->ct) {
+    return fail(fromLonLat ? "no transformation from lon/lat to '" + georef.crsName + "': " + errors.last()
+                           : "no transformation from '" + georef.crsName + "' to lon/lat: " + errors.last());
+  }
   return t;
 }
+
+Result<CrsTransform> CrsTransform::toGeographic(const Georef& georef) { return lonLat(georef, false); }
+
+Result<CrsTransform> CrsTransform::fromGeographic(const Georef& georef) { return lonLat(georef, true); }
 
 Result<Georef> describeCrs(const std::string& crs) {
   STRATA_TRY(OGRSpatialReference srs, detail::parseCrs(crs));
@@ -181,18 +189,6 @@ Result<Georef> describeCrs(const std::string& crs) {
   Georef g;
   detail::fillCrs(srs, g);
   return g;
-}
-
-Result<CrsTransform> CrsTransform::fromGeographic(const Georef& georef) {
-  STRATA_TRY(OGRSpatialReference srs, detail::srsOf(georef));
-  std::unique_ptr<OGRSpatialReference> geog(srs.CloneGeogCS());
-  if (!geog) return fail("CRS '" + georef.crsName + "' has no geographic base");
-  geog->SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-  detail::GdalErrorCapture errors;
-  CrsTransform t;
-  t.impl_->ct.reset(OGRCreateCoordinateTransformation(geog.get(), &srs));
-  if (!t.impl_->ct) return fail("no transformation from lon/lat to '" + georef.crsName + "': " + errors.last());
-  return t;
 }
 
 bool CrsTransform::transform(std::size_t n, double* x, double* y, double* z) const {

@@ -95,6 +95,7 @@ class CrsTransform {
 
  private:
   CrsTransform();
+  static Result<CrsTransform> lonLat(const Georef& georef, bool fromLonLat);  ///< both of the above
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
