@@ -41,6 +41,9 @@ struct RenderArgs {
   std::optional<float> seaLevel;
   std::string palette = "hypsometric";
   float fogM = 0;
+  std::string drape, drapeRange;
+  float drapeOpacity = 1;
+  bool drapeHideBelow = false;
   std::string path;
   int frames = 0;
   int clipSize = 512, pageSize = 64, uploadPages = 64;
@@ -210,6 +213,23 @@ void run(const RenderArgs& a) {
                                         {.planetary = a.planetary});
   }();
   if (!scene) die(a.dem + ": " + scene.message());
+  if (!a.drape.empty()) {
+    DrapeOptions o;
+    o.transparentBelow = a.drapeHideBelow;
+    if (!a.drapeRange.empty()) {
+      double lo = 0, hi = 0;
+      char end = 0;
+      if (std::sscanf(a.drapeRange.c_str(), "%lf,%lf%c", &lo, &hi, &end) != 2 || !(lo < hi)) {
+        die("--drape-range '" + a.drapeRange + "': expected LOW,HIGH with LOW < HIGH, e.g. 0.1,10");
+      }
+      o.range = std::array<double, 2>{lo, hi};
+    }
+    auto image = loadDrape(a.drape, scene->georef(), o);
+    if (!image) die("--drape " + image.message());
+    if (auto st = scene->setDrape(*image); !st) die("--drape " + a.drape + ": " + st.message());
+    shading.drapeOpacity = a.drapeOpacity;
+    std::printf("drape: %s, %dx%d texels\n", image->description.c_str(), image->width, image->height);
+  }
   auto renderer = makeRenderer(a);
   if (!renderer) die(renderer.message());
   auto target = OffscreenTarget::create(w, h);
@@ -305,6 +325,15 @@ void addRenderCommand(CLI::App& app) {
   cmd->add_option("--sea-level", a->seaLevel, "Water wherever the terrain is below this elevation (m)");
   cmd->add_option("--palette", a->palette, "hypsometric, grey or rust");
   cmd->add_option("--fog", a->fogM, "Haze distance (m); 0: none");
+  cmd->add_option("--drape", a->drape,
+                  "A georeferenced raster drawn on the terrain (orthophoto: 3-4 Byte bands; hillshade: 1 Byte "
+                  "band; any other single band through a colour ramp), reprojected by GDAL");
+  cmd->add_option("--drape-opacity", a->drapeOpacity, "How much the drape hides the elevation tint")
+      ->check(CLI::Range(0.0, 1.0));
+  cmd->add_option("--drape-range", a->drapeRange,
+                  "LOW,HIGH: a single-band drape's values at the ramp's ends (default: its 2nd-98th percentile)");
+  cmd->add_flag("--drape-hide-below", a->drapeHideBelow,
+                "Do not draw a single-band drape's values below its range (e.g. dry cells of a depth map)");
   cmd->add_option("--path", a->path, "Keyframe file (lon lat height heading pitch [fov] per line)");
   cmd->add_option("--frames", a->frames, "Frames to render along --path");
   cmd->add_option("--clip-size", a->clipSize, "Store: texels a side of each streamed level's window")

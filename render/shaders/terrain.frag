@@ -1,6 +1,7 @@
 #version 450
 // Terrain shading shared by the renderers: sun lighting with normals from the height texture,
-// a hypsometric tint, material layers blended by thickness, water coloured by depth, haze.
+// a hypsometric tint, material layers blended by thickness, a draped raster, water coloured by
+// depth, haze.
 #include "terrain_common.glsl"
 
 in VertexData {
@@ -23,6 +24,9 @@ uniform int uHasSediment;
 uniform int uHasWaterState;
 layout(binding = SLOT_VOID_MASK) uniform sampler2D uVoidMask;  // 1 with data, 0 over voids drawn as holes, optional
 uniform int uHasVoidMask;
+layout(binding = SLOT_DRAPE) uniform sampler2D uDrape;  // a raster draped on the terrain (RGBA8), optional
+uniform int uHasDrape;
+uniform float uDrapeOpacity;
 uniform vec3 uSiltColour;        // water colour at high sediment concentration
 uniform float uSiltConcentration; // concentration s / h at which water is 1 - 1/e of the way to silt
 uniform int uHasLayers;
@@ -103,6 +107,12 @@ void main() {
   if (uHasLayers != 0) {
     vec4 thick = textureLod(uLayers, uv, lod);
     for (int k = 0; k < 4; ++k) albedo = mix(albedo, uLayerColour[k], 1.0 - exp(-max(thick[k], 0.0) / uLayerOpaqueM));
+  }
+  if (uHasDrape != 0) {
+    // The pixel's own footprint (the mesh's level of detail, `lod`, is far coarser than a pixel
+    // near the viewer), from the texel offsets q, which do not wrap where uv does.
+    vec4 d = textureGrad(uDrape, uv, dFdx(q) / uTexSize, dFdy(q) / uTexSize);
+    albedo = mix(albedo, d.rgb, d.a * uDrapeOpacity);
   }
   float light = 0.25 + 0.75 * max(dot(n, uSunDir), 0.0);
   vec3 colour = albedo * light;

@@ -75,6 +75,9 @@ Status setCommonUniforms(const gl::Program& p, const TerrainScene& scene, const 
   p.set("uHasSediment", scene.sedimentTexture() && scene.waterTexture() ? 1 : 0);
   p.set("uHasWaterState", scene.waterStateTexture() ? 1 : 0);
   p.set("uHasVoidMask", scene.voidMaskTexture() ? 1 : 0);
+  p.set("uHasDrape", scene.drapeTexture() ? 1 : 0);
+  p.set("uDrapeOpacity", shading.drapeOpacity);
+  if (scene.drapeTexture()) scene.drapeTexture()->bind(slots::kDrape);
   if (scene.voidMaskTexture()) scene.voidMaskTexture()->bind(slots::kVoidMask);
   p.set("uSiltColour", shading.siltColour);
   p.set("uSiltConcentration", shading.siltConcentration);
@@ -315,6 +318,21 @@ Status TerrainScene::setMaterialLayers(const std::vector<gis::Grid<float>>& thic
   layers_ = gl::Texture::create2D(gl::TextureFormat::kRGBA32F, width(), height(), 0);
   layers_.upload(packed.data());
   layers_.generateMipmap();
+  return {};
+}
+
+Status TerrainScene::setDrape(const DrapeImage& image) {
+  if (streamed_) return fail("render: a drape is drawn on whole-DEM scenes only (this one is streamed)");
+  if (image.width < width() || image.height < height() || image.width % width() != 0 || image.height % height() != 0 ||
+      image.width / width() != image.height / height() ||
+      image.rgba.size() != size_t(image.width) * size_t(image.height) * 4) {
+    return fail("render: drape of " + std::to_string(image.width) + "x" + std::to_string(image.height) +
+                " texels is not on the DEM's grid (" + std::to_string(width()) + "x" + std::to_string(height()) +
+                " cells; loadDrape makes it so)");
+  }
+  drape_ = gl::Texture::create2D(gl::TextureFormat::kRGBA8, image.width, image.height, 0);
+  drape_.upload(image.rgba.data());
+  drape_.generateMipmap();
   return {};
 }
 

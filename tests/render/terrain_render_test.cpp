@@ -9,6 +9,8 @@
 #include <numeric>
 
 #include <strata/gis/dem_io.hpp>
+#include <strata/gis/geodesy.hpp>
+#include <strata/render/drape.hpp>
 #include <strata/render/image_io.hpp>
 #include <strata/render/screen_error.hpp>
 #include <strata/render/shader_slots.hpp>
@@ -16,6 +18,7 @@
 #include <strata/render/synthetic_dem.hpp>
 #include <strata/render/terrain_renderer.hpp>
 
+#include "drape_raster.hpp"
 #include "gl_fixture.hpp"
 #include "strata_test.hpp"
 #include "terrain_fixture.hpp"
@@ -582,6 +585,67 @@ TEST_F(GlTest, WaterAndMaterialLayersShowWhereTheyAre) {
   EXPECT_EQ(blue + sandy, total) << blue << " blue and " << sandy << " sand pixels of " << total;
   auto img = colourImage(*target);
   ASSERT_TRUE(writeImage8((test::outputDir("render") / "water_layers.png").string(), w, h, 4, img.pixels));
+}
+
+TEST_F(GlTest, ADrapedRastersMarkerIsDrawnUnderTheCameraItIsOn) {
+  // The Grand Canyon DEM (lon/lat) with a UTM raster draped over it: blue, with a red 1.5 km
+  // square. Looking straight down at the square's georeferenced centre from 12 km above the
+  // ground, the image's centre is red and its corners blue; without the drape, neither.
+  auto dem = gis::readDem(test::dataPath("grand_canyon/grand_canyon_512.tif"));
+  ASSERT_TRUE(dem) << dem.message();
+  auto scene = TerrainScene::create(*dem);
+  ASSERT_TRUE(scene) << scene.message();
+  const std::string path = (test::tempDir("drape_gl") / "utm_marker.tif").string();
+  ASSERT_TRUE(test::writeUtmMarker(path));
+  DrapeOptions o;
+  o.texelsPerCell = 2;
+  auto image = loadDrape(path, scene->georef(), o);
+  ASSERT_TRUE(image) << image.message();
+  auto ct = gis::CrsTransform::create("EPSG:32612", "EPSG:4326");
+  ASSERT_TRUE(ct) << ct.message();
+  double lon = test::kMarkerUtm[0], lat = test::kMarkerUtm[1];
+  ASSERT_TRUE(ct->transform(1, &lon, &lat));
+  auto ring = RingRenderer::create({.circles = 64});
+  ASSERT_TRUE(ring) << ring.message();
+  const int w = 64, h = 64;
+  auto target = OffscreenTarget::create(w, h);
+  ASSERT_TRUE(target) << target.message();
+  // 12 km up with a 20 degree view: the image spans ~4.2 km, the marker ~36% of it.
+  const CameraPose cam{.lon = lon,
+                       .lat = lat,
+                       .heightM = scene->heightAt(lon, lat) + 12000,
+                       .headingDeg = 0,
+                       .pitchDeg = -90,
+                       .fovYDeg = 20};
+  Shading shading;
+  shading.sunDir = {0, 0, 1};
+  auto pixel = [&](int x, int y) {
+    const auto px = target->colour();
+    const uint8_t* p = &px[(size_t(y) * size_t(w) + size_t(x)) * 4];
+    return std::array<int, 3>{p[0], p[1], p[2]};
+  };
+  ASSERT_TRUE((*ring)->draw(*scene, cam, shading, *target));
+  const auto plainCentre = pixel(w / 2, h / 2);
+  EXPECT_LT(plainCentre[0], plainCentre[2] + 200) << "the tint alone is not the marker's red";
+  ASSERT_TRUE(scene->setDrape(*image));
+  ASSERT_TRUE((*ring)->draw(*scene, cam, shading, *target));
+  const auto centre = pixel(w / 2, h / 2);
+  EXPECT_GT(centre[0], centre[2] + 100) << centre[0] << " " << centre[1] << " " << centre[2];
+  for (auto [x, y] : {std::pair{2, 2}, {w - 3, 2}, {2, h - 3}, {w - 3, h - 3}}) {
+    const auto c = pixel(x, y);
+    EXPECT_GT(c[2], c[0] + 100) << x << ", " << y << ": " << c[0] << " " << c[1] << " " << c[2];
+  }
+  // Half opacity: half way between the tint and the drape.
+  shading.drapeOpacity = 0.5f;
+  ASSERT_TRUE((*ring)->draw(*scene, cam, shading, *target));
+  const auto half = pixel(w / 2, h / 2);
+  EXPECT_NEAR(half[0], (plainCentre[0] + centre[0]) / 2.0, 12);
+  auto img = colourImage(*target);
+  ASSERT_TRUE(writeImage8((test::outputDir("render") / "drape_marker.png").string(), w, h, 4, img.pixels));
+  // A drape made for another grid is refused.
+  DrapeImage wrong = *image;
+  wrong.width -= 1;
+  EXPECT_FALSE(scene->setDrape(wrong));
 }
 
 TEST_F(GlTest, RainierRidgeCloseViewMatchesGoldenImage) {

@@ -27,6 +27,10 @@ inline constexpr gl::Binding kWaterState{"SLOT_WATER_STATE", ResourceKind::kSamp
 /// 1 where the DEM has data, 0 over voids drawn as holes, optional.
 inline constexpr gl::Binding kVoidMask{"SLOT_VOID_MASK", ResourceKind::kSampler, 7, "uVoidMask"};
 
-inline constexpr gl::Binding kAll[] = {kHeight, kWater, kLayers, kClip, kClipPages, kSediment, kWaterState, kVoidMask};
+/// A raster draped over the terrain (RGBA8, full mip chain), optional.
+inline constexpr gl::Binding kDrape{"SLOT_DRAPE", ResourceKind::kSampler, 8, "uDrape"};
+
+inline constexpr gl::Binding kAll[] = {kHeight,   kWater,      kLayers,   kClip, kClipPages,
+                                       kSediment, kWaterState, kVoidMask, kDrape};
 
 }  // namespace strata::render::slots

@@ -17,6 +17,7 @@
 #include <strata/core/result.hpp>
 #include <strata/gis/raster.hpp>
 #include <strata/gl/objects.hpp>
+#include <strata/render/drape.hpp>
 #include <strata/render/ring_mesh.hpp>
 #include <strata/render/streamed_elevation.hpp>
 
@@ -50,6 +51,7 @@ struct Shading {
   glm::vec3 siltColour{0.62f, 0.50f, 0.32f};  ///< water colour at high suspended-sediment concentration
   float siltConcentration = 0.01f;  ///< concentration s / h at which water is 1 - 1/e of the way to siltColour
   float layerOpaqueM = 0.5f;        ///< thickness at which a layer hides 1/e of what is below (m)
+  float drapeOpacity = 1;  ///< how much a draped raster (TerrainScene::setDrape) hides the tint, times its alpha
   std::array<glm::vec3, 4> layerColours{glm::vec3(0.76f, 0.70f, 0.50f), glm::vec3(0.45f, 0.35f, 0.25f),
                                         glm::vec3(0.30f, 0.45f, 0.20f), glm::vec3(0.9f, 0.9f, 0.95f)};
 };
@@ -97,6 +99,10 @@ class TerrainScene {
   /// Thicknesses (m) of up to four material layers (bottom first), same grid as the DEM;
   /// drawn with Shading::layerColours.
   Status setMaterialLayers(const std::vector<gis::Grid<float>>& thicknessM);
+  /// A raster draped over the terrain (loadDrape, on this scene's grid): drawn over the elevation
+  /// tint and the material layers, times its alpha and Shading::drapeOpacity, lit by the sun;
+  /// water is drawn over it. Whole-DEM scenes only.
+  Status setDrape(const DrapeImage& image);
   /// Replaces the elevations of the `patch.width` x `patch.height` cells at (x, y) (m), on the
   /// GPU and in the CPU copy; the mip chain is rebuilt. The patch must lie inside the grid.
   void writeHeights(int x, int y, const gis::Grid<float>& patch);
@@ -136,6 +142,7 @@ class TerrainScene {
   const gl::Texture* layerTexture() const { return layers_ ? &layers_ : nullptr; }
   const gl::Texture* sedimentTexture() const { return sediment_ ? &sediment_ : nullptr; }
   const gl::Texture* waterStateTexture() const { return waterState_ ? &waterState_ : nullptr; }
+  const gl::Texture* drapeTexture() const { return drape_ ? &drape_ : nullptr; }
   /// r32f: 1 where the DEM has data, 0 over voids; null unless voids are drawn as holes.
   const gl::Texture* voidMaskTexture() const { return voidMask_ ? &voidMask_ : nullptr; }
 
@@ -145,7 +152,7 @@ class TerrainScene {
   bool planetary_ = false;
   float minM_ = 0, maxM_ = 0;
   size_t voids_ = 0;
-  gl::Texture height_, water_, layers_, sediment_, waterState_, voidMask_;
+  gl::Texture height_, water_, layers_, sediment_, waterState_, voidMask_, drape_;
   std::shared_ptr<StreamedElevation> streamed_;
 };
 

@@ -1,0 +1,107 @@
+#include <strata/render/drape.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include <strata/gis/dem_io.hpp>
+
+namespace strata::render {
+
+std::array<uint8_t, 3> drapeRamp(double t) {
+  // Five stops of viridis (matplotlib's, sampled at 0, 1/4, 1/2, 3/4, 1).
+  static constexpr double kStops[5][3] = {{68, 1, 84}, {59, 82, 139}, {33, 145, 140}, {94, 201, 98}, {253, 231, 37}};
+  t = std::clamp(std::isfinite(t) ? t : 0.0, 0.0, 1.0) * 4;
+  const int i = std::min(int(t), 3);
+  const double f = t - i;
+  std::array<uint8_t, 3> c{};
+  for (int k = 0; k < 3; ++k) c[size_t(k)] = uint8_t(std::lround(kStops[i][k] + (kStops[i + 1][k] - kStops[i][k]) * f));
+  return c;
+}
+
+Result<DrapeImage> loadDrape(const std::string& path, const gis::Georef& scene, const DrapeOptions& options) {
+  gis::ReadOptions probe;
+  probe.allowAllNoData = true;
+  STRATA_TRY(gis::DemInfo info, gis::probeDem(path, probe));
+  if (options.texelsPerCell < 1) return fail(path + ": drape texels per cell must be at least 1");
+  int f = options.texelsPerCell;
+  while (f > 1 && std::max(scene.width, scene.height) * f > 8192) --f;
+  gis::Georef target = scene;
+  target.width = scene.width * f;
+  target.height = scene.height * f;
+  for (int k : {1, 2, 4, 5}) target.transform.c[k] /= f;
+
+  const bool bytes = info.bandType == "Byte";
+  const int bands = bytes ? std::min(info.bandCount, 4) : 1;
+  std::vector<gis::Grid<float>> values;
+  for (int b = 1; b <= bands; ++b) {
+    gis::MosaicInput in;
+    in.path = path;
+    in.band = b;
+    in.resampling = options.resampling;
+    STRATA_TRY(gis::Raster r, gis::warpToGrid(in, target));
+    values.push_back(std::move(r.values));
+  }
+
+  DrapeImage img;
+  img.width = target.width;
+  img.height = target.height;
+  img.georef = target;
+  img.rgba.assign(size_t(img.width) * size_t(img.height) * 4, 0);
+  const size_t n = size_t(img.width) * size_t(img.height);
+  auto byte = [](float v) { return uint8_t(std::clamp(std::lround(v), 0L, 255L)); };
+  char text[160];
+  if (bytes && bands >= 3) {
+    for (size_t i = 0; i < n; ++i) {
+      const float r = values[0].data[i], g = values[1].data[i], b = values[2].data[i];
+      if (std::isnan(r) || std::isnan(g) || std::isnan(b)) continue;
+      const float a = bands == 4 ? values[3].data[i] : 255.0f;
+      img.rgba[i * 4 + 0] = byte(r), img.rgba[i * 4 + 1] = byte(g), img.rgba[i * 4 + 2] = byte(b);
+      img.rgba[i * 4 + 3] = std::isnan(a) ? 0 : byte(a);
+    }
+    std::snprintf(text, sizeof text, "%s (%d Byte bands)", bands == 4 ? "RGBA" : "RGB", bands);
+  } else if (bytes) {
+    for (size_t i = 0; i < n; ++i) {
+      const float v = values[0].data[i];
+      if (std::isnan(v)) continue;
+      const float a = bands >= 2 ? values[1].data[i] : 255.0f;
+      img.rgba[i * 4 + 0] = img.rgba[i * 4 + 1] = img.rgba[i * 4 + 2] = byte(v);
+      img.rgba[i * 4 + 3] = std::isnan(a) ? 0 : byte(a);
+    }
+    std::snprintf(text, sizeof text, "grey%s (Byte)", bands >= 2 ? " and alpha" : "");
+  } else {
+    std::array<double, 2> range{0, 0};
+    if (options.range) {
+      range = *options.range;
+      if (!(std::isfinite(range[0]) && std::isfinite(range[1]) && range[0] < range[1])) {
+        return fail(path + ": drape range " + std::to_string(range[0]) + " .. " + std::to_string(range[1]) +
+                    " is not an interval");
+      }
+    } else {
+      std::vector<float> valid;
+      for (float v : values[0].data) {
+        if (std::isfinite(v)) valid.push_back(v);
+      }
+      if (valid.empty()) return fail(path + ": no data over the terrain to drape");
+      auto at = [&](double q) {
+        auto it = valid.begin() + std::ptrdiff_t(q * double(valid.size() - 1));
+        std::nth_element(valid.begin(), it, valid.end());
+        return double(*it);
+      };
+      range = {at(0.02), at(0.98)};
+      if (!(range[1] > range[0])) range[1] = range[0] + 1;
+    }
+    for (size_t i = 0; i < n; ++i) {
+      const float v = values[0].data[i];
+      if (!std::isfinite(v) || (options.transparentBelow && v < range[0])) continue;
+      const auto c = drapeRamp((v - range[0]) / (range[1] - range[0]));
+      img.rgba[i * 4 + 0] = c[0], img.rgba[i * 4 + 1] = c[1], img.rgba[i * 4 + 2] = c[2], img.rgba[i * 4 + 3] = 255;
+    }
+    img.range = range;
+    std::snprintf(text, sizeof text, "ramp %.4g .. %.4g (%s)", range[0], range[1], info.bandType.c_str());
+  }
+  img.description = text;
+  return img;
+}
+
+}  // namespace strata::render

@@ -1,0 +1,126 @@
+// Rasters draped over a terrain (render/drape.hpp): warped by GDAL onto the scene's grid, a
+// pixel lands on its georeferenced ground point; bands become colours as documented. CPU only:
+// the picture test is in terrain_render_test.cpp.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include <strata/gis/dem_io.hpp>
+#include <strata/gis/geodesy.hpp>
+#include <strata/render/drape.hpp>
+
+#include "drape_raster.hpp"
+#include "strata_test.hpp"
+
+namespace strata::render {
+namespace {
+
+gis::Georef canyonGeoref() {
+  auto info = gis::probeDem(strata::test::dataPath("grand_canyon/grand_canyon_512.tif"));
+  EXPECT_TRUE(info.ok()) << info.message();
+  return info.ok() ? info->georef : gis::Georef{};
+}
+
+TEST(Drape, AUtmPixelLandsOnItsGroundPointOnALonLatDem) {
+  // The issue's check: a draped raster's pixel lands on its georeferenced ground point within
+  // one pixel. The DEM is in lon/lat (EPSG:4326), the raster in UTM 12N.
+  const auto dir = strata::test::tempDir("drape");
+  const std::string path = (dir / "utm_marker.tif").string();
+  ASSERT_TRUE(test::writeUtmMarker(path));
+  const gis::Georef scene = canyonGeoref();
+  DrapeOptions o;
+  o.texelsPerCell = 2;
+  auto img = loadDrape(path, scene, o);
+  ASSERT_TRUE(img) << img.message();
+  EXPECT_EQ(img->width, 1024);
+  EXPECT_EQ(img->description, "RGB (3 Byte bands)");
+  double sx = 0, sy = 0;
+  int red = 0, blue = 0;  // and a few texels on the marker's edge, blended half and half
+  for (int y = 0; y < img->height; ++y) {
+    for (int x = 0; x < img->width; ++x) {
+      const uint8_t* p = &img->rgba[(size_t(y) * size_t(img->width) + size_t(x)) * 4];
+      ASSERT_EQ(p[3], 255) << "the raster covers the whole DEM: every texel opaque, not at " << x << ", " << y;
+      if (p[0] > 128) {
+        sx += x + 0.5, sy += y + 0.5, ++red;
+      } else {
+        blue += p[2] > 128;
+      }
+    }
+  }
+  ASSERT_GT(red, 0);
+  EXPECT_GT(red + blue, img->width * img->height - 100);
+  const double lon = img->georef.transform.x(sx / red, sy / red), lat = img->georef.transform.y(sx / red, sy / red);
+  auto ct = gis::CrsTransform::create("EPSG:32612", "EPSG:4326");
+  ASSERT_TRUE(ct) << ct.message();
+  double mx = test::kMarkerUtm[0], my = test::kMarkerUtm[1];
+  ASSERT_TRUE(ct->transform(1, &mx, &my));
+  const double kDeg = std::numbers::pi / 180, r = 6371000;
+  const double eastM = (lon - mx) * kDeg * r * std::cos(my * kDeg), northM = (lat - my) * kDeg * r;
+  std::printf("marker at %.6f, %.6f; drawn at %.6f, %.6f: %.1f m east, %.1f m north; %d texels\n", mx, my, lon, lat,
+              eastM, northM, red);
+  // The issue asks for one raster pixel (500 m); 12 m measured. 50 m, under half a drape texel
+  // (87 x 111 m), catches a drape moved by a texel or a DEM cell (pixel-is-point, a flipped row).
+  EXPECT_LT(std::hypot(eastM, northM), 50.0);
+  // The marker is 1.5 km square: about that many texels of 1/1024 degree.
+  const double texelArea = (1.0 / 1024 * kDeg * r) * (1.0 / 1024 * kDeg * r * std::cos(my * kDeg));
+  EXPECT_NEAR(red * texelArea / (1500.0 * 1500.0), 1.0, 0.3);
+}
+
+TEST(Drape, OneBandRampsOverItsRangeAndHidesWhatIsBelowAndNoData) {
+  const auto dir = strata::test::tempDir("drape");
+  const std::string path = (dir / "ramp.tif").string();
+  const gis::Georef scene = canyonGeoref();
+  // On the DEM's own degree square, 64 columns: value = column; a nodata block in the corner.
+  const std::array<double, 6> gt{-113, 1.0 / 64, 0, 37, 0, -1.0 / 64};
+  ASSERT_TRUE(test::writeDrapeRaster(
+      path, 64, 64, 1, GDT_Float32, "EPSG:4326", gt, [](int x, int y, int) { return x < 8 && y < 8 ? -9999.0 : x; },
+      -9999.0));
+  DrapeOptions o;
+  o.texelsPerCell = 1;
+  o.resampling = gis::Resampling::Nearest;
+  o.range = std::array<double, 2>{10, 50};
+  o.transparentBelow = true;
+  auto img = loadDrape(path, scene, o);
+  ASSERT_TRUE(img) << img.message();
+  EXPECT_EQ(img->description, "ramp 10 .. 50 (Float32)");
+  auto texel = [&](int x, int y) { return &img->rgba[(size_t(y) * size_t(img->width) + size_t(x)) * 4]; };
+  // 8 texels a source column: texel x holds column x / 8.
+  const auto top = drapeRamp(1), bottom = drapeRamp(0);
+  const uint8_t* hi = texel(511, 511);  // value 63: above the range, the ramp's end
+  EXPECT_EQ(hi[0], top[0]);
+  EXPECT_EQ(hi[1], top[1]);
+  EXPECT_EQ(hi[2], top[2]);
+  EXPECT_EQ(hi[3], 255);
+  const uint8_t* lo = texel(80, 300);  // column 10: the ramp's start
+  EXPECT_EQ(lo[0], bottom[0]);
+  EXPECT_EQ(lo[3], 255);
+  EXPECT_EQ(texel(20, 20)[3], 0) << "no data is not drawn";
+  EXPECT_EQ(texel(79, 300)[3], 0) << "column 9 is below the range";
+  // Without a range: the 2nd to 98th percentile of what lies on the scene.
+  o.range.reset();
+  o.transparentBelow = false;
+  auto auto_ = loadDrape(path, scene, o);
+  ASSERT_TRUE(auto_) << auto_.message();
+  EXPECT_NEAR(auto_->range[0], 1, 1);
+  EXPECT_NEAR(auto_->range[1], 62, 1);
+}
+
+TEST(Drape, BadInputNamesTheFile) {
+  const gis::Georef scene = canyonGeoref();
+  auto missing = loadDrape("/nonexistent/drape.tif", scene);
+  ASSERT_FALSE(missing);
+  EXPECT_NE(missing.message().find("/nonexistent/drape.tif"), std::string::npos) << missing.message();
+  const auto dir = strata::test::tempDir("drape");
+  const std::string path = (dir / "flat.tif").string();
+  ASSERT_TRUE(test::writeDrapeRaster(path, 8, 8, 1, GDT_Float32, "EPSG:4326", {-113, 0.125, 0, 37, 0, -0.125},
+                                     [](int, int, int) { return 1.0; }));
+  DrapeOptions o;
+  o.range = std::array<double, 2>{5, 5};
+  auto bad = loadDrape(path, scene, o);
+  ASSERT_FALSE(bad);
+  EXPECT_EQ(bad.message(), path + ": drape range 5.000000 .. 5.000000 is not an interval");
+}
+
+}  // namespace
+}  // namespace strata::render
