@@ -19,6 +19,47 @@ std::array<uint8_t, 3> drapeRamp(double t) {
   return c;
 }
 
+Result<DrapeImage> drapeFromGrid(const gis::Grid<float>& values, const gis::Georef& georef, const DrapeOptions& options,
+                                 const std::string& name) {
+  std::array<double, 2> range{0, 0};
+  if (options.range) {
+    range = *options.range;
+    if (!(std::isfinite(range[0]) && std::isfinite(range[1]) && range[0] < range[1])) {
+      return fail(name + ": drape range " + std::to_string(range[0]) + " .. " + std::to_string(range[1]) +
+                  " is not an interval");
+    }
+  } else {
+    std::vector<float> valid;
+    for (float v : values.data) {
+      if (std::isfinite(v)) valid.push_back(v);
+    }
+    if (valid.empty()) return fail(name + ": no data over the terrain to drape");
+    auto at = [&](double q) {
+      auto it = valid.begin() + std::ptrdiff_t(q * double(valid.size() - 1));
+      std::nth_element(valid.begin(), it, valid.end());
+      return double(*it);
+    };
+    range = {at(0.02), at(0.98)};
+    if (!(range[1] > range[0])) range[1] = range[0] + 1;
+  }
+  DrapeImage img;
+  img.width = values.width;
+  img.height = values.height;
+  img.georef = georef;
+  img.rgba.assign(values.size() * 4, 0);
+  for (size_t i = 0; i < values.size(); ++i) {
+    const float v = values.data[i];
+    if (!std::isfinite(v) || (options.transparentBelow && v < range[0])) continue;
+    const auto c = drapeRamp((v - range[0]) / (range[1] - range[0]));
+    img.rgba[i * 4 + 0] = c[0], img.rgba[i * 4 + 1] = c[1], img.rgba[i * 4 + 2] = c[2], img.rgba[i * 4 + 3] = 255;
+  }
+  img.range = range;
+  char text[96];
+  std::snprintf(text, sizeof text, "ramp %.4g .. %.4g", range[0], range[1]);
+  img.description = text;
+  return img;
+}
+
 Result<DrapeImage> loadDrape(const std::string& path, const gis::Georef& scene, const DrapeOptions& options) {
   gis::ReadOptions probe;
   probe.allowAllNoData = true;
@@ -42,6 +83,11 @@ Result<DrapeImage> loadDrape(const std::string& path, const gis::Georef& scene, 
     STRATA_TRY(gis::Raster r, gis::warpToGrid(in, target));
     values.push_back(std::move(r.values));
   }
+  if (!bytes) {
+    STRATA_TRY(DrapeImage ramp, drapeFromGrid(values[0], target, options, path));
+    ramp.description += " (" + info.bandType + ")";
+    return ramp;
+  }
 
   DrapeImage img;
   img.width = target.width;
@@ -60,7 +106,7 @@ Result<DrapeImage> loadDrape(const std::string& path, const gis::Georef& scene, 
       img.rgba[i * 4 + 3] = std::isnan(a) ? 0 : byte(a);
     }
     std::snprintf(text, sizeof text, "%s (%d Byte bands)", bands == 4 ? "RGBA" : "RGB", bands);
-  } else if (bytes) {
+  } else {
     for (size_t i = 0; i < n; ++i) {
       const float v = values[0].data[i];
       if (std::isnan(v)) continue;
@@ -69,36 +115,6 @@ Result<DrapeImage> loadDrape(const std::string& path, const gis::Georef& scene, 
       img.rgba[i * 4 + 3] = std::isnan(a) ? 0 : byte(a);
     }
     std::snprintf(text, sizeof text, "grey%s (Byte)", bands >= 2 ? " and alpha" : "");
-  } else {
-    std::array<double, 2> range{0, 0};
-    if (options.range) {
-      range = *options.range;
-      if (!(std::isfinite(range[0]) && std::isfinite(range[1]) && range[0] < range[1])) {
-        return fail(path + ": drape range " + std::to_string(range[0]) + " .. " + std::to_string(range[1]) +
-                    " is not an interval");
-      }
-    } else {
-      std::vector<float> valid;
-      for (float v : values[0].data) {
-        if (std::isfinite(v)) valid.push_back(v);
-      }
-      if (valid.empty()) return fail(path + ": no data over the terrain to drape");
-      auto at = [&](double q) {
-        auto it = valid.begin() + std::ptrdiff_t(q * double(valid.size() - 1));
-        std::nth_element(valid.begin(), it, valid.end());
-        return double(*it);
-      };
-      range = {at(0.02), at(0.98)};
-      if (!(range[1] > range[0])) range[1] = range[0] + 1;
-    }
-    for (size_t i = 0; i < n; ++i) {
-      const float v = values[0].data[i];
-      if (!std::isfinite(v) || (options.transparentBelow && v < range[0])) continue;
-      const auto c = drapeRamp((v - range[0]) / (range[1] - range[0]));
-      img.rgba[i * 4 + 0] = c[0], img.rgba[i * 4 + 1] = c[1], img.rgba[i * 4 + 2] = c[2], img.rgba[i * 4 + 3] = 255;
-    }
-    img.range = range;
-    std::snprintf(text, sizeof text, "ramp %.4g .. %.4g (%s)", range[0], range[1], info.bandType.c_str());
   }
   img.description = text;
   return img;

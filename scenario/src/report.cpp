@@ -304,7 +304,11 @@ Status writeReport(const fs::path& runDir, const ReportInput& in) {
   }
   if (!in.pictures.empty()) {
     md += "\n## Pictures\n\n";
-    for (const auto& p : in.pictures) md += "![" + p + "](" + p + ")\n";
+    for (const auto& p : in.pictures) {
+      md += "![" + p + "](" + p + ")\n";
+      if (p.find("max_depth") != std::string::npos && !in.maxDepthLegend.empty())
+        md += "\n" + in.maxDepthLegend + "\n\n";
+    }
   }
   md += "\n## Files\n\n";
   for (const auto& f : sum.files) md += "- `" + f + "`\n";

@@ -60,7 +60,7 @@ std::vector<std::string> runFolderFiles() {
   }
   for (int k = 1; k <= kMaxLayerMaps; ++k) files.push_back(layerMapFile(k));
   for (const char* p : {"water", "area", "balance", "sediment"}) files.push_back("plots/" + std::string(p) + ".png");
-  for (const char* p : {"before", "peak", "after"}) files.push_back("pictures/" + std::string(p) + ".png");
+  for (const char* p : {"before", "peak", "after", "max_depth"}) files.push_back("pictures/" + std::string(p) + ".png");
   return files;
 }
 
@@ -209,15 +209,46 @@ class Pictures {
       STRATA_TRY_STATUS(scene_.setMaterialLayers(layers));
     }
     STRATA_TRY_STATUS(scene_.setWaterDepth(depthM));
+    return write(file);
+  }
+
+  /// The run's maximum depth draped over the terrain as drawn last (no water drawn), through the
+  /// drape's ramp from the wet threshold to the 98th percentile of the wet cells' maxima (shallower
+  /// cells not drawn); the last picture of a run (the drape stays on the scene).
+  Status drawMaxDepth(const gis::Grid<float>& maxDepthM, const gis::Georef& georef, const fs::path& file) {
+    std::vector<float> wet;
+    for (float v : maxDepthM.data) {
+      if (v > wetThresholdM_) wet.push_back(v);
+    }
+    render::DrapeOptions o;
+    o.transparentBelow = true;
+    float top = wetThresholdM_ + 1;
+    if (!wet.empty()) {
+      auto it = wet.begin() + std::ptrdiff_t(0.98 * double(wet.size() - 1));
+      std::nth_element(wet.begin(), it, wet.end());
+      top = std::max(*it, top);
+    }
+    o.range = std::array<double, 2>{std::max(double(wetThresholdM_), 1e-3), double(top)};
+    STRATA_TRY(auto image, render::drapeFromGrid(maxDepthM, georef, o, "max_depth"));
+    STRATA_TRY_STATUS(scene_.setWaterDepth(gis::Grid<float>(maxDepthM.width, maxDepthM.height, 0.0f)));
+    STRATA_TRY_STATUS(scene_.setDrape(image));
+    maxDepthRange_ = *o.range;
+    return write(file);
+  }
+  /// The ramp's ends of the max-depth picture (m).
+  std::array<double, 2> maxDepthRange() const { return maxDepthRange_; }
+
+ private:
+  Status write(const fs::path& file) {
     STRATA_TRY_STATUS(ring_->draw(scene_, camera_, shading_, target_));
     const auto tmp = temporaryPathFor(file).string() + ".png";
     STRATA_TRY_STATUS(render::writeImage8(tmp, kWidth, kHeight, 4, target_.colour()));
     return commitTemporary(tmp, file);
   }
 
- private:
   static constexpr int kWidth = 960, kHeight = 540;
   bool erosion_ = false;
+  std::array<double, 2> maxDepthRange_{0, 0};
   float wetThresholdM_ = 0;
   double datumM_ = 0;
   render::TerrainScene scene_;
@@ -633,6 +664,8 @@ Result<RunSummary> runScenario(const Scenario& s, const RunOptions& opt) {
       if (peak) STRATA_TRY_STATUS(pictures->draw(run.solver(), depth, opt.outDir / "pictures" / "peak.png"));
       if (interval == intervals) {
         STRATA_TRY_STATUS(pictures->draw(run.solver(), depth, opt.outDir / "pictures" / "after.png"));
+        STRATA_TRY_STATUS(pictures->drawMaxDepth(run.solver().readFloodStats().maxDepthM, run.domain().bed.georef,
+                                                 opt.outDir / "pictures" / "max_depth.png"));
       }
     }
     STRATA_TRY_STATUS(writeFileAtomic(opt.outDir / "series.csv", seriesCsv(summary.series)));
@@ -655,9 +688,21 @@ Result<RunSummary> runScenario(const Scenario& s, const RunOptions& opt) {
   summary.files = {"scenario.toml", "series.csv", "checkpoint.bin"};
   const auto maps = run.mapFiles();
   summary.files.insert(summary.files.end(), maps.begin(), maps.end());
-  for (const char* p : {"pictures/before.png", "pictures/peak.png", "pictures/after.png"}) {
-    if (fs::exists(opt.outDir / p)) summary.files.push_back(p);
+  std::string maxDepthLegend;
+  if (pictures && summary.completed) {
+    char text[200];
+    const auto r = pictures->maxDepthRange();
+    std::snprintf(text, sizeof text,
+                  "`max_depth.png`: the largest depth each cell had, from %.2f m (dark purple; shallower cells "
+                  "not drawn) to %.1f m and more (yellow).",
+                  r[0], r[1]);
+    maxDepthLegend = text;
   }
+  std::vector<std::string> pictureFiles;
+  for (const char* p : {"pictures/before.png", "pictures/peak.png", "pictures/after.png", "pictures/max_depth.png"}) {
+    if (fs::exists(opt.outDir / p)) pictureFiles.push_back(p);
+  }
+  summary.files.insert(summary.files.end(), pictureFiles.begin(), pictureFiles.end());
   if (s.erosion.enabled) {
     summary.material = run.materialBudget();
     for (int k = 1; k <= kMaxLayerMaps; ++k) {
@@ -668,8 +713,8 @@ Result<RunSummary> runScenario(const Scenario& s, const RunOptions& opt) {
     STRATA_TRY(auto plots, writePlots(opt.outDir, run.domain().bed, summary.completed));
     summary.files.insert(summary.files.end(), plots.begin(), plots.end());
   }
-  STRATA_TRY_STATUS(
-      writeReport(opt.outDir, ReportInput{s, run.domain(), summary, run.solver().readFloodStats(), run.backendName()}));
+  STRATA_TRY_STATUS(writeReport(opt.outDir, ReportInput{s, run.domain(), summary, run.solver().readFloodStats(),
+                                                        run.backendName(), pictureFiles, maxDepthLegend}));
   summary.files.push_back("report.md");
   return summary;
 }

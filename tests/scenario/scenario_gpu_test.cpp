@@ -10,6 +10,7 @@
 #include <strata/core/files.hpp>
 #include <strata/gis/dem_io.hpp>
 #include <strata/gis/geodesy.hpp>
+#include <strata/render/image_io.hpp>
 #include <strata/scenario/domain.hpp>
 #include <strata/scenario/run.hpp>
 
@@ -80,12 +81,28 @@ TEST_F(GlTest, FloodScenarioWritesMapsSeriesAndReport) {
 
   // Plots and the report.
   for (const char* f : {"plots/water.png", "plots/area.png", "plots/max_depth.png", "pictures/before.png",
-                        "pictures/peak.png", "pictures/after.png", "report.md"}) {
+                        "pictures/peak.png", "pictures/after.png", "pictures/max_depth.png", "report.md"}) {
     EXPECT_TRUE(std::filesystem::exists(opt.outDir / f)) << f;
   }
   std::ifstream report(opt.outDir / "report.md");
   std::stringstream text;
   text << report.rdbuf();
+  // The max-depth picture drapes the map in the ramp's colours, which the 'after' picture (the
+  // terrain's tint and water) does not have: the ramp's deep yellow, red well over blue.
+  auto yellow = [](const render::Image8& im) {
+    int n = 0;
+    for (size_t i = 0; i + 3 < im.pixels.size(); i += size_t(im.channels)) {
+      n += im.pixels[i] > 180 && im.pixels[i + 1] > 160 && im.pixels[i + 2] < 90;
+    }
+    return n;
+  };
+  auto maxPic = render::readImage8((opt.outDir / "pictures" / "max_depth.png").string());
+  auto afterPic = render::readImage8((opt.outDir / "pictures" / "after.png").string());
+  ASSERT_TRUE(maxPic && afterPic);
+  EXPECT_GT(yellow(*maxPic), 20);
+  EXPECT_EQ(yellow(*afterPic), 0);
+  EXPECT_NE(text.str().find("![pictures/max_depth.png](pictures/max_depth.png)"), std::string::npos);
+  EXPECT_NE(text.str().find("`max_depth.png`: the largest depth each cell had, from 0.10 m"), std::string::npos);
   EXPECT_NE(text.str().find("| largest flooded area |"), std::string::npos);
   EXPECT_NE(text.str().find("| volume balance error at the end |"), std::string::npos);
 }

@@ -41,6 +41,11 @@ struct DrapeImage {
 /// Warps `path` onto `sceneGeoref` (same CRS and extent, finer cells). Errors name the file.
 Result<DrapeImage> loadDrape(const std::string& path, const gis::Georef& sceneGeoref, const DrapeOptions& options = {});
 
+/// One band already on a grid (a flood run's maximum depth on the scene's own cells) through the
+/// ramp, as loadDrape does for a one-band raster; NaN cells transparent. `georef` is the grid's.
+Result<DrapeImage> drapeFromGrid(const gis::Grid<float>& values, const gis::Georef& georef, const DrapeOptions& options,
+                                 const std::string& name);
+
 /// The ramp used for one-band rasters at t in [0, 1] (dark blue through teal and green to yellow,
 /// perceptually ordered as viridis), as RGB bytes.
 std::array<uint8_t, 3> drapeRamp(double t);

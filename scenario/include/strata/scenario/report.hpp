@@ -20,6 +20,7 @@ struct ReportInput {
   sim::FloodStats flood;                   ///< per-cell maxima, arrival and duration at the end of the run
   std::string backend;                     ///< what ran the simulation (Solver::backendName)
   std::vector<std::string> pictures = {};  ///< rendered pictures (relative paths), if any
+  std::string maxDepthLegend = {};         ///< what the max-depth picture's colours mean
 };
 
 /// plots/*.png: the time series (scenario/plots/plot_series.py) and the maps over a hillshade
