@@ -12,6 +12,9 @@
 // DEM texture and streamed from a tile store (ingested once into $TMPDIR/strata_bench_stream_N),
 // with the viewer gliding east; and the cost of refilling the stack when the viewer moves by
 // one page.
+// Drapes (BM_DrapeLoad, BM_DrapeFrame): the Grand Canyon's EPSG:4326 DEM draped as a ramp over
+// its EPSG:3857 version (GDAL's warp with the exact transformer, then the ramp), and the frame
+// time with and without a drape, side by side.
 // Figures: docs/benchmarks.md ("Render").
 #include <benchmark/benchmark.h>
 
@@ -26,8 +29,10 @@
 #include <optional>
 #include <thread>
 
+#include <strata/gis/dem_io.hpp>
 #include <strata/gl/objects.hpp>
 #include <strata/gl/state.hpp>
+#include <strata/render/drape.hpp>
 #include <strata/render/screen_error.hpp>
 #include <strata/render/sliding_grid.hpp>
 #include <strata/render/synthetic_dem.hpp>
@@ -349,6 +354,48 @@ BENCHMARK(BM_StreamColdRefill)
     ->UseManualTime()
     ->Unit(benchmark::kMillisecond)
     ->Iterations(32);  // two sweeps of the stretch (a fixed count: the untimed catch-up dominates)
+
+const std::string kDrapeDem = std::string(STRATA_DATA_DIR) + "/grand_canyon/grandcanyon_srtm_3857.tif";
+const std::string kDrapeRaster = std::string(STRATA_DATA_DIR) + "/grand_canyon/grand_canyon_512.tif";
+
+// loadDrape at range(0) texels per DEM cell a side (512^2 cells).
+void BM_DrapeLoad(benchmark::State& state) {
+  auto info = gis::probeDem(kDrapeDem);
+  if (!info) return state.SkipWithError(info.message().c_str());
+  DrapeOptions o;
+  o.texelsPerCell = int(state.range(0));
+  for (auto _ : state) {
+    auto img = loadDrape(kDrapeRaster, info->georef, o);
+    if (!img) return state.SkipWithError(img.message().c_str());
+    benchmark::DoNotOptimize(img->rgba.data());
+  }
+  const double texels = double(info->georef.width) * info->georef.height * o.texelsPerCell * o.texelsPerCell;
+  state.counters["Mtexels"] = texels / 1e6;
+  state.counters["texels/s"] = benchmark::Counter(texels * double(state.iterations()), benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_DrapeLoad)->ArgName("texels_per_cell")->Arg(1)->Arg(4)->Unit(benchmark::kMillisecond);
+
+// The ring renderer (256 circles, 960 x 540) over the 3857 DEM, without (0) and with (1) the drape.
+void BM_DrapeFrame(benchmark::State& state) {
+  strata::bench::sharedContext();
+  auto dem = gis::readDem(kDrapeDem);
+  if (!dem) return state.SkipWithError(dem.message().c_str());
+  auto scene = TerrainScene::create(*dem);
+  if (!scene) return state.SkipWithError(scene.message().c_str());
+  if (state.range(0)) {
+    auto img = loadDrape(kDrapeRaster, scene->georef());
+    if (!img) return state.SkipWithError(img.message().c_str());
+    if (auto st = scene->setDrape(*img); !st) return state.SkipWithError(st.message().c_str());
+  }
+  auto ring = RingRenderer::create({.circles = 256});
+  if (!ring) return state.SkipWithError(ring.message().c_str());
+  const auto& c = scene->georef().transform.c;
+  const double x = c[0] + c[1] * scene->width() * 0.5, y = c[3] + c[5] * scene->height() * 0.8;
+  const CameraPose cam{.lon = x, .lat = y, .heightM = scene->heightAt(x, y) + 3000, .headingDeg = 0, .pitchDeg = -25};
+  state.SetLabel(state.range(0) ? "drape" : "no drape");
+  runFrames(state, **ring, *scene, cam, 960, 540);
+}
+BENCHMARK(BM_DrapeFrame)->ArgName("drape")->Arg(0)->Arg(1)->UseManualTime()->Unit(benchmark::kMillisecond);
 
 }  // namespace
 int main(int argc, char** argv) { return strata::bench::benchGlMain(argc, argv); }
