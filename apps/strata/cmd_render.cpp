@@ -44,6 +44,7 @@ struct RenderArgs {
   std::string drape, drapeRange;
   float drapeOpacity = 1;
   bool drapeHideBelow = false;
+  double graticuleDeg = 0;
   std::string path;
   int frames = 0;
   int clipSize = 512, pageSize = 64, uploadPages = 64;
@@ -230,6 +231,10 @@ void run(const RenderArgs& a) {
     shading.drapeOpacity = a.drapeOpacity;
     std::printf("drape: %s, %dx%d texels\n", image->description.c_str(), image->width, image->height);
   }
+  if (a.graticuleDeg > 0) {
+    if (auto st = scene->enableGraticule(); !st) die("--graticule: " + st.message());
+    shading.graticuleDeg = a.graticuleDeg;
+  }
   auto renderer = makeRenderer(a);
   if (!renderer) die(renderer.message());
   auto target = OffscreenTarget::create(w, h);
@@ -334,6 +339,8 @@ void addRenderCommand(CLI::App& app) {
                   "LOW,HIGH: a single-band drape's values at the ramp's ends (default: its 2nd-98th percentile)");
   cmd->add_flag("--drape-hide-below", a->drapeHideBelow,
                 "Do not draw a single-band drape's values below its range (e.g. dry cells of a depth map)");
+  cmd->add_option("--graticule", a->graticuleDeg, "Lines of longitude and latitude this many degrees apart (e.g. 0.5)")
+      ->check(CLI::Range(0.0, 90.0));
   cmd->add_option("--path", a->path, "Keyframe file (lon lat height heading pitch [fov] per line)");
   cmd->add_option("--frames", a->frames, "Frames to render along --path");
   cmd->add_option("--clip-size", a->clipSize, "Store: texels a side of each streamed level's window")

@@ -27,6 +27,8 @@ uniform int uHasVoidMask;
 layout(binding = SLOT_DRAPE) uniform sampler2D uDrape;  // a raster draped on the terrain (RGBA8), optional
 uniform int uHasDrape;
 uniform float uDrapeOpacity;
+layout(binding = SLOT_LONLAT) uniform sampler2D uLonLat;  // lon/lat (deg) of the cell centres, for the graticule
+uniform float uGraticuleDeg;     // lines of longitude and latitude this far apart (deg); 0: none
 uniform vec3 uSiltColour;        // water colour at high sediment concentration
 uniform float uSiltConcentration; // concentration s / h at which water is 1 - 1/e of the way to silt
 uniform int uHasLayers;
@@ -141,6 +143,16 @@ void main() {
     // not drawn at full strength, so a wet cell's footprint is not a hard-edged square.
     float fade = uWaterFadeM > 0.0 ? smoothstep(0.0, uWaterFadeM, depth) : 1.0;
     colour = mix(colour, water * sunOnWater, (0.55 + 0.45 * k) * fade);
+  }
+  if (uGraticuleDeg > 0.0) {
+    // Distance in pixels to the nearest line of each family (the lon/lat's own screen derivative),
+    // a line 1.5 pixels wide with soft edges; a family whose lines come closer than ~5 pixels
+    // fades out rather than whiten the view.
+    vec2 g = textureLod(uLonLat, uv, 0.0).rg / uGraticuleDeg;
+    vec2 fw = max(fwidth(g), vec2(1e-12));
+    vec2 px = abs(fract(g + 0.5) - 0.5) / fw;
+    vec2 line = (1.0 - smoothstep(0.75, 1.5, px)) * (1.0 - smoothstep(0.1, 0.2, fw));
+    colour = mix(colour, vec3(1.0), 0.8 * max(line.x, line.y));
   }
   if (uFogM > 0.0) colour = mix(colour, uSky.rgb, 1.0 - exp(-length(fs.rel) / uFogM));
 

@@ -9,6 +9,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include <strata/gis/fill_nodata.hpp>
+#include <strata/gis/geodesy.hpp>
 #include <strata/gl/state.hpp>
 #include <strata/render/shader_slots.hpp>
 #include <strata/terrain/tile_store.hpp>
@@ -78,6 +79,9 @@ Status setCommonUniforms(const gl::Program& p, const TerrainScene& scene, const 
   p.set("uHasDrape", scene.drapeTexture() ? 1 : 0);
   p.set("uDrapeOpacity", shading.drapeOpacity);
   if (scene.drapeTexture()) scene.drapeTexture()->bind(slots::kDrape);
+  const bool graticule = scene.lonLatTexture() && shading.graticuleDeg > 0;
+  p.set("uGraticuleDeg", graticule ? float(shading.graticuleDeg) : 0.0f);
+  if (graticule) scene.lonLatTexture()->bind(slots::kLonLat);
   if (scene.voidMaskTexture()) scene.voidMaskTexture()->bind(slots::kVoidMask);
   p.set("uSiltColour", shading.siltColour);
   p.set("uSiltConcentration", shading.siltConcentration);
@@ -333,6 +337,28 @@ Status TerrainScene::setDrape(const DrapeImage& image) {
   drape_ = gl::Texture::create2D(gl::TextureFormat::kRGBA8, image.width, image.height, 0);
   drape_.upload(image.rgba.data());
   drape_.generateMipmap();
+  return {};
+}
+
+Status TerrainScene::enableGraticule() {
+  if (streamed_) return fail("render: a graticule is drawn on whole-DEM scenes only (this one is streamed)");
+  const size_t n = size_t(width()) * size_t(height());
+  std::vector<double> x(n), y(n);
+  const auto& t = georef_.transform;
+  for (int r = 0; r < height(); ++r) {
+    for (int c = 0; c < width(); ++c) {
+      x[size_t(r) * size_t(width()) + size_t(c)] = t.x(c + 0.5, r + 0.5);
+      y[size_t(r) * size_t(width()) + size_t(c)] = t.y(c + 0.5, r + 0.5);
+    }
+  }
+  if (!georef_.geographic) {
+    STRATA_TRY(auto ct, gis::CrsTransform::toGeographic(georef_));
+    (void)ct.transform(n, x.data(), y.data());  // cells without a lon/lat stay NaN: no line there
+  }
+  std::vector<float> packed(n * 2);
+  for (size_t i = 0; i < n; ++i) packed[i * 2] = float(x[i]), packed[i * 2 + 1] = float(y[i]);
+  lonLat_ = gl::Texture::create2D(gl::TextureFormat::kRG32F, width(), height(), 1);
+  lonLat_.upload(packed.data());
   return {};
 }
 

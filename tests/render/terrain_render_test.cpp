@@ -648,6 +648,49 @@ TEST_F(GlTest, ADrapedRastersMarkerIsDrawnUnderTheCameraItIsOn) {
   EXPECT_FALSE(scene->setDrape(wrong));
 }
 
+TEST_F(GlTest, GraticuleLinesLieOnTheirLongitudeOnAProjectedDem) {
+  // The Web Mercator Grand Canyon DEM (CRS metres) looking straight down at 113 W, 36.15 N from
+  // 5 km up: with lines every 0.1 degree, the meridian 113 W runs down the image's centre column
+  // (the nearest parallels, 36.1 and 36.2 N, are 5.5 km away, out of the 2.7 km view).
+  auto dem = gis::readDem(test::dataPath("grand_canyon/grandcanyon_srtm_3857.tif"));
+  ASSERT_TRUE(dem) << dem.message();
+  auto scene = TerrainScene::create(*dem);
+  ASSERT_TRUE(scene) << scene.message();
+  auto ct = gis::CrsTransform::fromGeographic(scene->georef());
+  ASSERT_TRUE(ct) << ct.message();
+  double x = -113.0, y = 36.15;
+  ASSERT_TRUE(ct->transform(1, &x, &y));
+  auto ring = RingRenderer::create({.circles = 64});
+  ASSERT_TRUE(ring) << ring.message();
+  const int w = 64, h = 64;
+  auto target = OffscreenTarget::create(w, h);
+  ASSERT_TRUE(target) << target.message();
+  const CameraPose cam{
+      .lon = x, .lat = y, .heightM = scene->heightAt(x, y) + 5000, .headingDeg = 0, .pitchDeg = -90, .fovYDeg = 30};
+  Shading shading;
+  shading.sunDir = {0, 0, 1};
+  shading.graticuleDeg = 0.1;
+  auto brightness = [&](int px, int py) {
+    const auto c = target->colour();
+    const uint8_t* p = &c[(size_t(py) * size_t(w) + size_t(px)) * 4];
+    return (p[0] + p[1] + p[2]) / 3;
+  };
+  ASSERT_TRUE((*ring)->draw(*scene, cam, shading, *target));  // no lon/lat texture yet: no lines
+  const int plain = brightness(w / 2, h / 2);
+  ASSERT_TRUE(scene->enableGraticule());
+  ASSERT_TRUE((*ring)->draw(*scene, cam, shading, *target));
+  for (int py = 4; py < h - 4; py += 8) {
+    // The centre pair of columns holds the line (1.5 px wide, centred between pixels 31 and 32).
+    const int line = std::max(brightness(w / 2 - 1, py), brightness(w / 2, py));
+    EXPECT_GT(line, 200) << "row " << py;
+    EXPECT_LT(brightness(w / 4, py), 180) << "row " << py;
+    EXPECT_LT(brightness(3 * w / 4, py), 180) << "row " << py;
+  }
+  EXPECT_LT(plain, 180);
+  auto img = colourImage(*target);
+  ASSERT_TRUE(writeImage8((test::outputDir("render") / "graticule_3857.png").string(), w, h, 4, img.pixels));
+}
+
 TEST_F(GlTest, RainierRidgeCloseViewMatchesGoldenImage) {
   // 1.7 m above a ridge cell of the SRTM tile (1781 m, 21 m above the cells two away), 6.6 km
   // south-west of the summit, looking at it. Ground-level views need a larger softening floor

@@ -30,7 +30,10 @@ inline constexpr gl::Binding kVoidMask{"SLOT_VOID_MASK", ResourceKind::kSampler,
 /// A raster draped over the terrain (RGBA8, full mip chain), optional.
 inline constexpr gl::Binding kDrape{"SLOT_DRAPE", ResourceKind::kSampler, 8, "uDrape"};
 
-inline constexpr gl::Binding kAll[] = {kHeight,   kWater,      kLayers,   kClip, kClipPages,
-                                       kSediment, kWaterState, kVoidMask, kDrape};
+/// Lon/lat (deg) of the cell centres (RG32F), for the graticule, optional.
+inline constexpr gl::Binding kLonLat{"SLOT_LONLAT", ResourceKind::kSampler, 9, "uLonLat"};
+
+inline constexpr gl::Binding kAll[] = {kHeight,   kWater,      kLayers,   kClip,  kClipPages,
+                                       kSediment, kWaterState, kVoidMask, kDrape, kLonLat};
 
 }  // namespace strata::render::slots

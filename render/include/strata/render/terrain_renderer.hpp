@@ -52,6 +52,8 @@ struct Shading {
   float siltConcentration = 0.01f;  ///< concentration s / h at which water is 1 - 1/e of the way to siltColour
   float layerOpaqueM = 0.5f;        ///< thickness at which a layer hides 1/e of what is below (m)
   float drapeOpacity = 1;  ///< how much a draped raster (TerrainScene::setDrape) hides the tint, times its alpha
+  /// Lines of longitude and latitude this many degrees apart (TerrainScene::enableGraticule); 0: none.
+  double graticuleDeg = 0;
   std::array<glm::vec3, 4> layerColours{glm::vec3(0.76f, 0.70f, 0.50f), glm::vec3(0.45f, 0.35f, 0.25f),
                                         glm::vec3(0.30f, 0.45f, 0.20f), glm::vec3(0.9f, 0.9f, 0.95f)};
 };
@@ -103,6 +105,9 @@ class TerrainScene {
   /// tint and the material layers, times its alpha and Shading::drapeOpacity, lit by the sun;
   /// water is drawn over it. Whole-DEM scenes only.
   Status setDrape(const DrapeImage& image);
+  /// Lon/lat of every cell centre on the GPU (through the CRS's own datum for projected DEMs), so
+  /// that Shading::graticuleDeg can draw lines of longitude and latitude. Whole-DEM scenes only.
+  Status enableGraticule();
   /// Replaces the elevations of the `patch.width` x `patch.height` cells at (x, y) (m), on the
   /// GPU and in the CPU copy; the mip chain is rebuilt. The patch must lie inside the grid.
   void writeHeights(int x, int y, const gis::Grid<float>& patch);
@@ -143,6 +148,7 @@ class TerrainScene {
   const gl::Texture* sedimentTexture() const { return sediment_ ? &sediment_ : nullptr; }
   const gl::Texture* waterStateTexture() const { return waterState_ ? &waterState_ : nullptr; }
   const gl::Texture* drapeTexture() const { return drape_ ? &drape_ : nullptr; }
+  const gl::Texture* lonLatTexture() const { return lonLat_ ? &lonLat_ : nullptr; }
   /// r32f: 1 where the DEM has data, 0 over voids; null unless voids are drawn as holes.
   const gl::Texture* voidMaskTexture() const { return voidMask_ ? &voidMask_ : nullptr; }
 
@@ -152,7 +158,7 @@ class TerrainScene {
   bool planetary_ = false;
   float minM_ = 0, maxM_ = 0;
   size_t voids_ = 0;
-  gl::Texture height_, water_, layers_, sediment_, waterState_, voidMask_, drape_;
+  gl::Texture height_, water_, layers_, sediment_, waterState_, voidMask_, drape_, lonLat_;
   std::shared_ptr<StreamedElevation> streamed_;
 };
 
