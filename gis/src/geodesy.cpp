@@ -226,6 +226,22 @@ Result<LonLat> pixelToLonLat(const Georef& georef, double col, double row) {
   return LonLat{x, y, 0};
 }
 
+Result<std::array<double, 2>> metresPerCrsUnit(const Georef& georef, double col, double row) {
+  if (georef.geographic) return fail("metres per CRS unit: '" + georef.crsName + "' is geographic (degrees)");
+  const auto& t = georef.transform;
+  // The two ends of a one-cell segment along each grid axis, about (col, row).
+  double x[4] = {t.x(col - 0.5, row), t.x(col + 0.5, row), t.x(col, row - 0.5), t.x(col, row + 0.5)};
+  double y[4] = {t.y(col - 0.5, row), t.y(col + 0.5, row), t.y(col, row - 0.5), t.y(col, row + 0.5)};
+  const double unitsX = std::hypot(x[1] - x[0], y[1] - y[0]), unitsY = std::hypot(x[3] - x[2], y[3] - y[2]);
+  STRATA_TRY(CrsTransform ct, CrsTransform::toGeographic(georef));
+  if (!ct.transform(4, x, y) || !(unitsX > 0) || !(unitsY > 0)) {
+    return fail("metres per CRS unit: grid position (" + std::to_string(col) + ", " + std::to_string(row) +
+                ") has no lon/lat in '" + georef.crsName + "'");
+  }
+  return std::array<double, 2>{geodesicDistanceM({x[0], y[0], 0}, {x[1], y[1], 0}, georef.body) / unitsX,
+                               geodesicDistanceM({x[2], y[2], 0}, {x[3], y[3], 0}, georef.body) / unitsY};
+}
+
 Result<Grid<double>> cellAreasM2(const Georef& georef) {
   if (georef.width <= 0 || georef.height <= 0) return fail("cell areas: empty grid");
   Grid<double> areas(georef.width, georef.height, std::nan(""));

@@ -306,6 +306,37 @@ TEST(CellAreas, AWebMercatorGridFarOffTheEarthFailsAtOnce) {
   EXPECT_NEAR(x[2], 1000 / 6378137.0 * 180 / std::numbers::pi, 1e-9);  // the sane point still goes through
 }
 
+TEST(Geodesy, MetresPerCrsUnitIsTheProjectionsPointScale) {
+  // Web Mercator puts geodetic latitude on a sphere of radius a: along a parallel one unit is
+  // N cos(phi) / a metres of ground, along a meridian M cos(phi) / a (N, M: the ellipsoid's
+  // radii of curvature), 0.81 over the Grand Canyon. The renderer once took it as 1.
+  auto info = probeDem(test::dataFile("grand_canyon/grandcanyon_srtm_3857.tif"));
+  ASSERT_TRUE(info.ok()) << info.message();
+  Georef g = info->georef;
+  const double a = g.body.semiMajorM, e2 = g.body.flattening * (2 - g.body.flattening);
+  for (double latDeg : {0.0, 36.1, 60.0, -75.0}) {
+    const double phi = latDeg * std::numbers::pi / 180.0, s2 = std::sin(phi) * std::sin(phi);
+    const double n = a / std::sqrt(1 - e2 * s2), m = a * (1 - e2) / std::pow(1 - e2 * s2, 1.5);
+    g.transform = GeoTransform{{-12.5e6, 30, 0, a * std::log(std::tan(std::numbers::pi / 4 + phi / 2)), 0, -30}};
+    auto k = metresPerCrsUnit(g, 0.0, 0.0);
+    ASSERT_TRUE(k.ok()) << k.message();
+    EXPECT_NEAR((*k)[0], n * std::cos(phi) / a, 1e-7) << latDeg;
+    EXPECT_NEAR((*k)[1], m * std::cos(phi) / a, 1e-7) << latDeg;
+  }
+  // UTM zone 12 on its central meridian (111 W): the point scale is k0 = 0.9996 both ways, so a
+  // unit is 1 / 0.9996 m of ground.
+  auto utm = describeCrs("EPSG:32612");
+  ASSERT_TRUE(utm.ok()) << utm.message();
+  utm->transform = GeoTransform{{500000, 30, 0, 4000000, 0, -30}};
+  auto k = metresPerCrsUnit(*utm, 0.0, 0.0);
+  ASSERT_TRUE(k.ok()) << k.message();
+  EXPECT_NEAR((*k)[0], 1 / 0.9996, 1e-6);
+  EXPECT_NEAR((*k)[1], 1 / 0.9996, 1e-6);
+  Georef geographic = g;
+  geographic.geographic = true;
+  EXPECT_FALSE(metresPerCrsUnit(geographic, 0, 0).ok());
+}
+
 TEST(Geodesy, CrsTransformErrorsNameTheCrs) {
   auto t = CrsTransform::create("EPSG:4326", "EPSG:999999");
   ASSERT_FALSE(t.ok());

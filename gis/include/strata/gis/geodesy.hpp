@@ -3,6 +3,7 @@
 // local ENU; geodesic distance and polygon area; other CRSs through GDAL/PROJ; per-cell areas.
 // Coordinate frames are types. Angles in degrees, lengths in metres. See docs/gis.md.
 
+#include <array>
 #include <memory>
 #include <span>
 #include <string>
@@ -107,5 +108,12 @@ Result<Georef> describeCrs(const std::string& crs);
 
 /// Geographic lon/lat of a grid position (pixel coordinates, (0,0) = top-left corner).
 Result<LonLat> pixelToLonLat(const Georef& georef, double col, double row);
+
+/// Ground metres per CRS unit along the grid's x (east) and y (north) axes at grid position
+/// (col, row) of a projected grid: the inverse of the projection's point scale, e.g. about
+/// cos(lat) for Web Mercator (0.81 over the Grand Canyon), 1 / 0.9996 on a UTM central
+/// meridian. Measured as geodesic
+/// distances over one cell each way. Fails for geographic grids and CRSs without a lon/lat base.
+Result<std::array<double, 2>> metresPerCrsUnit(const Georef& georef, double col, double row);
 
 }  // namespace strata::gis
