@@ -20,6 +20,8 @@
 #include <strata/viewer/store_io.hpp>
 #include <strata/viewer/viewer.hpp>
 
+#include "../common/map_layers.hpp"
+
 namespace {
 
 using namespace strata;
@@ -38,6 +40,7 @@ struct Args {
   int frames = 0;
   double dtS = 1.0 / 30.0;
   std::string savePath;
+  apps::MapLayerArgs layers;
 };
 
 // GLFW key codes -> the viewer's key names.
@@ -137,6 +140,7 @@ int run(const Args& a) {
   options.rangeM = a.rangeM;
   options.softMinM = a.softMinM;
   options.shading.exaggeration = a.exaggeration;
+  options.scaleBar = a.layers.scaleBar;
   if (a.palette == "rust") options.shading.palette = render::Palette::Rust;
   if (a.palette == "grey") options.shading.palette = render::Palette::Grey;
   if (a.planetary) options.shading.sky = {0, 0, 0, 1};
@@ -146,6 +150,10 @@ int run(const Args& a) {
     return 1;
   }
   Viewer& v = **viewer;
+  if (auto st = apps::applyMapLayers(a.layers, v.scene(), v.shading()); !st) {
+    std::fprintf(stderr, "strata-view: %s\n", st.message().c_str());
+    return 1;
+  }
   if (loaded && !loaded->layers.empty()) {
     if (auto s = v.editor().setLayers(loaded->layers); !s) {
       std::fprintf(stderr, "strata-view: %s\n", s.message().c_str());
@@ -244,6 +252,7 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   app.add_option("--palette", a->palette, "hypsometric, grey or rust")
       ->check(CLI::IsMember({"hypsometric", "grey", "rust"}));
+  apps::addMapLayerOptions(app, a->layers);
   app.add_option("--script", a->script, "Timed commands (docs/viewer.md); the viewer exits after the last");
   app.add_option("--frames", a->frames, "Stop after this many frames (0: run until closed)");
   app.add_option("--dt", a->dtS, "Scripted runs: seconds of flight per frame")->check(CLI::PositiveNumber);

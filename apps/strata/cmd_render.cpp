@@ -13,11 +13,13 @@
 #include <strata/gl/context.hpp>
 #include <strata/render/flight_path.hpp>
 #include <strata/render/image_io.hpp>
+#include <strata/render/overlay.hpp>
 #include <strata/render/sliding_grid.hpp>
 #include <strata/render/synthetic_dem.hpp>
 #include <strata/render/terrain_renderer.hpp>
 #include <strata/terrain/tile_store.hpp>
 
+#include "../common/map_layers.hpp"
 #include "commands.hpp"
 
 namespace strata::app {
@@ -41,10 +43,7 @@ struct RenderArgs {
   std::optional<float> seaLevel;
   std::string palette = "hypsometric";
   float fogM = 0;
-  std::string drape, drapeRange;
-  float drapeOpacity = 1;
-  bool drapeHideBelow = false;
-  double graticuleDeg = 0;
+  apps::MapLayerArgs layers;
   std::string path;
   int frames = 0;
   int clipSize = 512, pageSize = 64, uploadPages = 64;
@@ -214,27 +213,7 @@ void run(const RenderArgs& a) {
                                         {.planetary = a.planetary});
   }();
   if (!scene) die(a.dem + ": " + scene.message());
-  if (!a.drape.empty()) {
-    DrapeOptions o;
-    o.transparentBelow = a.drapeHideBelow;
-    if (!a.drapeRange.empty()) {
-      double lo = 0, hi = 0;
-      char end = 0;
-      if (std::sscanf(a.drapeRange.c_str(), "%lf,%lf%c", &lo, &hi, &end) != 2 || !(lo < hi)) {
-        die("--drape-range '" + a.drapeRange + "': expected LOW,HIGH with LOW < HIGH, e.g. 0.1,10");
-      }
-      o.range = std::array<double, 2>{lo, hi};
-    }
-    auto image = loadDrape(a.drape, scene->georef(), o);
-    if (!image) die("--drape " + image.message());
-    if (auto st = scene->setDrape(*image); !st) die("--drape " + a.drape + ": " + st.message());
-    shading.drapeOpacity = a.drapeOpacity;
-    std::printf("drape: %s, %dx%d texels\n", image->description.c_str(), image->width, image->height);
-  }
-  if (a.graticuleDeg > 0) {
-    if (auto st = scene->enableGraticule(); !st) die("--graticule: " + st.message());
-    shading.graticuleDeg = a.graticuleDeg;
-  }
+  if (auto st = apps::applyMapLayers(a.layers, *scene, shading); !st) die(st.message());
   auto renderer = makeRenderer(a);
   if (!renderer) die(renderer.message());
   auto target = OffscreenTarget::create(w, h);
@@ -251,6 +230,19 @@ void run(const RenderArgs& a) {
   cam.pitchDeg = a.pitch;
   cam.fovYDeg = a.fov;
 
+  // Overlays over the drawn picture (its colour only: depth and elevation keep the terrain's).
+  std::optional<Overlay> overlay;
+  if (a.layers.scaleBar) {
+    auto o = Overlay::create();
+    if (!o) die(o.message());
+    overlay.emplace(std::move(*o));
+  }
+  auto drawOverlays = [&](const CameraPose& pose) {
+    if (!overlay) return;
+    const auto bar = overlay->drawScaleBarOver(*target, *scene, pose, shading);
+    if (bar && a.path.empty()) std::printf("scale bar: %s, %.0f pixels\n", bar->label.c_str(), bar->pixels);
+  };
+
   if (a.path.empty()) {
     if (auto* st = scene->streamed()) {
       // One picture: draw until every page of the windows is resident (each draw copies at
@@ -262,6 +254,7 @@ void run(const RenderArgs& a) {
     } else if (auto s = (*renderer)->draw(*scene, cam, shading, *target); !s) {
       die(s.message());
     }
+    drawOverlays(cam);
     const auto frame = frameGeometry(*scene, cam, shading, w, h);
     if (auto s = writeOutputs(*target, frame, a.output, a.depthOut, a.elevationOut); !s) die(s.message());
     std::printf("%s: %dx%d, %zu triangles (%s)\n", a.output.c_str(), w, h, (*renderer)->trianglesPerFrame(*scene),
@@ -280,6 +273,7 @@ void run(const RenderArgs& a) {
     auto elevName = a.elevationOut.empty() ? Result<std::string>(std::string()) : frameName(a.elevationOut, i);
     if (!depthName) die(depthName.message());
     if (!elevName) die(elevName.message());
+    drawOverlays(pose);
     const auto frame = frameGeometry(*scene, pose, shading, w, h);
     if (auto s = writeOutputs(*target, frame, *name, *depthName, *elevName); !s) die(s.message());
   }
@@ -330,17 +324,7 @@ void addRenderCommand(CLI::App& app) {
   cmd->add_option("--sea-level", a->seaLevel, "Water wherever the terrain is below this elevation (m)");
   cmd->add_option("--palette", a->palette, "hypsometric, grey or rust");
   cmd->add_option("--fog", a->fogM, "Haze distance (m); 0: none");
-  cmd->add_option("--drape", a->drape,
-                  "A georeferenced raster drawn on the terrain (orthophoto: 3-4 Byte bands; hillshade: 1 Byte "
-                  "band; any other single band through a colour ramp), reprojected by GDAL");
-  cmd->add_option("--drape-opacity", a->drapeOpacity, "How much the drape hides the elevation tint")
-      ->check(CLI::Range(0.0, 1.0));
-  cmd->add_option("--drape-range", a->drapeRange,
-                  "LOW,HIGH: a single-band drape's values at the ramp's ends (default: its 2nd-98th percentile)");
-  cmd->add_flag("--drape-hide-below", a->drapeHideBelow,
-                "Do not draw a single-band drape's values below its range (e.g. dry cells of a depth map)");
-  cmd->add_option("--graticule", a->graticuleDeg, "Lines of longitude and latitude this many degrees apart (e.g. 0.5)")
-      ->check(CLI::Range(0.0, 90.0));
+  apps::addMapLayerOptions(*cmd, a->layers);
   cmd->add_option("--path", a->path, "Keyframe file (lon lat height heading pitch [fov] per line)");
   cmd->add_option("--frames", a->frames, "Frames to render along --path");
   cmd->add_option("--clip-size", a->clipSize, "Store: texels a side of each streamed level's window")

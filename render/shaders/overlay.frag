@@ -1,5 +1,5 @@
 #version 450
-// Heads-up display: one flat colour per draw.
+// Overlay (text boxes, the scale bar): one flat colour per draw.
 uniform vec4 uColour;
 layout(location = 0) out vec4 outColour;
 

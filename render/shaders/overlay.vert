@@ -1,7 +1,7 @@
 #version 450
-// Heads-up display quads (strata::render::viewer::HudRenderer): four corners per quad in window
+// Overlay quads (strata::render::Overlay: text boxes, the scale bar): four corners per quad in window
 // pixels (y down) pulled from a buffer, two triangles each.
-layout(std430, binding = SLOT_HUD_CORNERS) readonly buffer Corners { vec2 corners[]; };
+layout(std430, binding = SLOT_OVERLAY_CORNERS) readonly buffer Corners { vec2 corners[]; };
 uniform vec2 uViewport;  // window size (pixels)
 
 void main() {

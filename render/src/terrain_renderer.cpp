@@ -161,6 +161,15 @@ Status setCommonUniforms(const gl::Program& p, const TerrainScene& scene, const 
 
 // ---- TerrainScene ------------------------------------------------------------------------------
 
+namespace {
+// A projected grid's point scale at its centre; 1 where the CRS has no lon/lat base.
+glm::dvec2 metresPerCrsUnitOf(const gis::Georef& g) {
+  if (g.geographic) return {1.0, 1.0};
+  const auto k = gis::metresPerCrsUnit(g, 0.5 * g.width, 0.5 * g.height);
+  return k ? glm::dvec2((*k)[0], (*k)[1]) : glm::dvec2(1.0, 1.0);
+}
+}  // namespace
+
 Result<TerrainScene> TerrainScene::create(const gis::Raster& dem, const SceneOptions& options) {
   const auto& g = dem.georef;
   if (dem.values.width < 2 || dem.values.height < 2) {
@@ -180,6 +189,7 @@ Result<TerrainScene> TerrainScene::create(const gis::Raster& dem, const SceneOpt
   TerrainScene s;
   s.georef_ = g;
   s.planetary_ = options.planetary;
+  s.metresPerUnit_ = metresPerCrsUnitOf(g);
   s.heights_ = dem.values;
   float lo = std::numeric_limits<float>::infinity(), hi = -lo;
   for (float v : s.heights_.data) {
@@ -221,6 +231,7 @@ Result<TerrainScene> TerrainScene::createStreamed(strata::terrain::TileStore sto
   TerrainScene s;
   s.georef_ = g;
   s.planetary_ = options.planetary;
+  s.metresPerUnit_ = metresPerCrsUnitOf(g);
   s.minM_ = streamed->minElevationM();
   s.maxM_ = streamed->maxElevationM();
   s.streamed_ = std::move(streamed);
@@ -393,6 +404,22 @@ double TerrainScene::gridSurfaceAt(double u, double v) const {
 
 // ---- Frame geometry ----------------------------------------------------------------------------
 
+std::optional<glm::dvec3> groundEnuAt(const FrameGeometry& f, const OffscreenTarget& target, int px, int py) {
+  const int w = target.width(), h = target.height();
+  if (px < 0 || py < 0 || px >= w || py >= h) return std::nullopt;
+  const float d = target.depthAt(px, py);
+  if (!(d > 0)) return std::nullopt;
+  // Reversed-Z: eye-space distance along the axis is near / depth; unproject the pixel centre.
+  const double dist = f.nearM / double(d);
+  const glm::dvec4 ndc(2.0 * (px + 0.5) / w - 1.0, 1.0 - 2.0 * (py + 0.5) / h, 1.0, 1.0);  // on the near plane
+  glm::dvec4 eye = glm::inverse(f.projection) * ndc;
+  eye /= eye.w;
+  const glm::dvec3 eyeDir = glm::dvec3(eye) / -eye.z * dist;  // on the plane z_eye = -dist
+  const glm::dvec3 enu = glm::dvec3(glm::inverse(f.view) * glm::dvec4(eyeDir, 0.0));
+  if (!std::isfinite(enu.x) || !std::isfinite(enu.y) || !std::isfinite(enu.z)) return std::nullopt;
+  return enu;
+}
+
 glm::dmat4 reversedInfinitePerspective(double fovYRad, double aspect, double nearM) {
   const double f = 1.0 / std::tan(0.5 * fovYRad);
   glm::dmat4 m(0.0);
@@ -413,7 +440,8 @@ FrameGeometry frameGeometry(const TerrainScene& scene, const CameraPose& camera,
     const double mPerDegLon = radius * std::cos(camera.lat * kDeg) * kDeg, mPerDegLat = radius * kDeg;
     f.uvPerMetre = {1.0 / (c[1] * w * mPerDegLon), 1.0 / (c[5] * h * mPerDegLat)};
   } else {
-    f.uvPerMetre = {1.0 / (c[1] * w), 1.0 / (c[5] * h)};
+    const glm::dvec2 k = scene.metresPerCrsUnit();
+    f.uvPerMetre = {1.0 / (c[1] * w * k.x), 1.0 / (c[5] * h * k.y)};
   }
   f.uvCam = {(camera.lon - c[0]) / c[1] / w, (camera.lat - c[3]) / c[5] / h};
   if (scene.planetary() && isGlobalInLongitude(g)) f.uvCam.x -= std::floor(f.uvCam.x);
@@ -472,10 +500,14 @@ Result<OffscreenTarget> OffscreenTarget::create(int width, int height) {
   t.fbo_.attachColour(1, t.elevation_);
   t.fbo_.attachDepth(t.depth_);
   STRATA_TRY_STATUS(t.fbo_.check());
+  t.colourFbo_ = gl::Framebuffer::create();
+  t.colourFbo_.attachColour(0, t.colour_);
+  STRATA_TRY_STATUS(t.colourFbo_.check());
   return t;
 }
 
 void OffscreenTarget::bind() const { fbo_.bind(); }
+void OffscreenTarget::bindColourOnly() const { colourFbo_.bind(); }
 
 void OffscreenTarget::clear(const glm::vec4& sky) const {
   fbo_.clearColour(0, sky);

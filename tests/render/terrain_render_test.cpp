@@ -4,14 +4,17 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <limits>
+#include <numbers>
 #include <numeric>
 
 #include <strata/gis/dem_io.hpp>
 #include <strata/gis/geodesy.hpp>
 #include <strata/render/drape.hpp>
 #include <strata/render/image_io.hpp>
+#include <strata/render/overlay.hpp>
 #include <strata/render/screen_error.hpp>
 #include <strata/render/shader_slots.hpp>
 #include <strata/render/sliding_grid.hpp>
@@ -32,7 +35,8 @@ TEST_F(GlTest, ShadersUseTheSlotsDeclaredInCpp) {
   test::expectProgramsMatchSlots("render/shaders/", slots::kAll,
                                  {{{"render/shaders/ring.vert", "render/shaders/terrain.frag"}},
                                   {{"render/shaders/grid.vert", "render/shaders/terrain.frag"}},
-                                  {{"render/shaders/sliding.vert", "render/shaders/terrain.frag"}}});
+                                  {{"render/shaders/sliding.vert", "render/shaders/terrain.frag"}},
+                                  {{"render/shaders/overlay.vert", "render/shaders/overlay.frag"}}});
 }
 
 Image8 colourImage(const OffscreenTarget& t) { return {t.width(), t.height(), 4, t.colour()}; }
@@ -689,6 +693,62 @@ TEST_F(GlTest, GraticuleLinesLieOnTheirLongitudeOnAProjectedDem) {
   EXPECT_LT(plain, 180);
   auto img = colourImage(*target);
   ASSERT_TRUE(writeImage8((test::outputDir("render") / "graticule_3857.png").string(), w, h, 4, img.pixels));
+}
+
+TEST_F(GlTest, AScaleBarMeasuresTheGroundAtItsTrueScale) {
+  // A flat Web Mercator DEM at 60 N, 64 x 64 cells of 10 CRS units: Web Mercator stretches the
+  // ground by 1 / cos(60) = 2 there, so it is 320 m of ground a side, not 640. Straight down
+  // from 1000 m with a 30 degree field of view, the 100-row image spans 2 tan(15) 1000 =
+  // 535.9 m: 5.359 m a pixel; the DEM is 59.7 pixels wide and the bar (at most 40 pixels) is
+  // 200 m, 37.3 pixels.
+  auto crs = gis::describeCrs("EPSG:3857");
+  ASSERT_TRUE(crs) << crs.message();
+  gis::Raster dem;
+  dem.georef = *crs;
+  dem.georef.width = dem.georef.height = 64;
+  const double y60 = 6378137.0 * std::log(std::tan(std::numbers::pi / 4 + std::numbers::pi / 6));
+  dem.georef.transform = gis::GeoTransform{{-320, 10, 0, y60 + 320, 0, -10}};
+  dem.values = gis::Grid<float>(64, 64, 100.0f);
+  auto scene = TerrainScene::create(dem);
+  ASSERT_TRUE(scene) << scene.message();
+  EXPECT_NEAR(scene->metresPerCrsUnit().x, 0.5, 0.002);
+  auto ring = RingRenderer::create({.circles = 64});
+  ASSERT_TRUE(ring) << ring.message();
+  const int w = 200, h = 100;
+  auto target = OffscreenTarget::create(w, h);
+  ASSERT_TRUE(target) << target.message();
+  const CameraPose cam{.lon = 0, .lat = y60, .heightM = 1100, .headingDeg = 0, .pitchDeg = -90, .fovYDeg = 30};
+  Shading shading;
+  ASSERT_TRUE((*ring)->draw(*scene, cam, shading, *target));
+  const double mPerPixel = 2 * std::tan(15 * std::numbers::pi / 180) * 1000 / h;
+  int drawn = 0;
+  const auto depth = target->depth();
+  for (int x = 0; x < w; ++x) drawn += depth[size_t(h / 2) * size_t(w) + size_t(x)] > 0 ? 1 : 0;
+  EXPECT_NEAR(drawn, 320 / mPerPixel, 2.0);  // 119 with CRS units taken as metres
+
+  const auto bar = measureScaleBar(*scene, cam, shading, *target, w / 5.0);
+  ASSERT_TRUE(bar);
+  EXPECT_EQ(bar->lengthM, 200);
+  EXPECT_EQ(bar->label, "200 m");
+  EXPECT_NEAR(bar->pixels, 200 / mPerPixel, 0.01 * 200 / mPerPixel);
+
+  // Drawn over the colour alone: white in the bar, the elevation untouched.
+  const auto elevationBefore = target->elevation();
+  auto overlay = Overlay::create();
+  ASSERT_TRUE(overlay) << overlay.message();
+  target->bindColourOnly();
+  overlay->drawScaleBar(*bar, w, h);
+  const auto c = target->colour();
+  auto px = [&](int x, int y) { return &c[(size_t(y) * size_t(w) + size_t(x)) * 4]; };
+  for (int x : {18, 30, 17 + int(bar->pixels) - 1}) {  // along the bar (rows 79-82)
+    EXPECT_EQ(px(x, 81)[0], 255) << x;
+    EXPECT_EQ(px(x, 81)[1], 255) << x;
+  }
+  EXPECT_LT(px(17 + int(bar->pixels) + 4, 81)[0], 200);  // past its end (and edge): the box
+  const auto elevationAfter = target->elevation();
+  EXPECT_EQ(std::memcmp(elevationBefore.data(), elevationAfter.data(), elevationBefore.size() * sizeof(float)), 0);
+  auto img = colourImage(*target);
+  ASSERT_TRUE(writeImage8((test::outputDir("render") / "scale_bar.png").string(), w, h, 4, img.pixels));
 }
 
 TEST_F(GlTest, RainierRidgeCloseViewMatchesGoldenImage) {

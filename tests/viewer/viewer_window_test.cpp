@@ -2,16 +2,20 @@
 // same Command path as a person's input: it flies, chooses a simulation region, places a spring
 // and runs the simulation, raises the terrain with the mouse and undoes it, saving the terrain
 // and taking screenshots between the steps. Screenshots are compared with golden images; the
-// undo must return the terrain to its exact earlier state.
+// undo must return the terrain to its exact earlier state. A second session draws the map layers
+// (a drape, a graticule, a scale bar) from the command line.
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 
 #include <gtest/gtest.h>
 
 #include <strata/gis/dem_io.hpp>
+#include <strata/gis/geodesy.hpp>
 #include <strata/render/image_io.hpp>
 
+#include "../render/drape_raster.hpp"
 #include "strata_test.hpp"
 #include "terrain_fixture.hpp"
 
@@ -97,6 +101,55 @@ TEST(ViewerWindow, ScriptedSessionMatchesGoldensAndUndoIsExact) {
   auto und = render::readImage8(o + "undone.png");
   ASSERT_TRUE(sim && und);
   EXPECT_EQ(sim->pixels, und->pixels) << "same terrain, same (paused) water: the same image";
+}
+
+TEST(ViewerWindow, MapLayersFromTheCommandLineAreDrawn) {
+  // strata-view with the UTM marker raster draped over the Grand Canyon, a 0.05 degree graticule
+  // and a scale bar, looking straight down at the marker from 12 km: the centre is the marker's
+  // red, the graticule's white lines cross the view, the bar sits in the bottom-left corner.
+  if (std::getenv("STRATA_NO_GL")) GTEST_SKIP() << "STRATA_NO_GL set: no GL in this run";
+  ASSERT_EQ(std::system("command -v xvfb-run > /dev/null"), 0) << "xvfb-run is missing (scripts/setup.sh installs it)";
+  const auto out = test::outputDir("viewer");
+  const std::string o = out.string() + "/";
+  std::filesystem::remove(out / "layers.png");
+  ASSERT_TRUE(test::writeUtmMarker(o + "utm_marker.tif"));
+  auto ct = gis::CrsTransform::create("EPSG:32612", "EPSG:4326");
+  ASSERT_TRUE(ct) << ct.message();
+  double lon = test::kMarkerUtm[0], lat = test::kMarkerUtm[1];
+  ASSERT_TRUE(ct->transform(1, &lon, &lat));
+  {
+    std::ofstream script(out / "layers.txt");
+    script.precision(12);
+    script << "0 goto " << lon << " " << lat << " 12000\n0 look 0 -89\n2 screenshot " << o << "layers.png\n";
+  }
+  const char* asan = std::getenv("ASAN_OPTIONS");  // as above: no leak check under GLX
+  const std::string env = std::string("ASAN_OPTIONS='") + (asan ? asan : "") + ":detect_leaks=0' ";
+  const std::string cmd =
+      env + "xvfb-run -a -s '-screen 0 1280x800x24' " + STRATA_VIEW_EXE + " " +
+      test::dataPath("grand_canyon/grand_canyon_512.tif") + " --size 480x320 --circles 128 --drape " + o +
+      "utm_marker.tif --graticule 0.05 --scale-bar --script " + o + "layers.txt > " + o + "layers.log 2>&1";
+  const int rc = std::system(cmd.c_str());
+  std::ifstream logFile(out / "layers.log");
+  const std::string log((std::istreambuf_iterator<char>(logFile)), std::istreambuf_iterator<char>());
+  ASSERT_EQ(rc, 0) << cmd << "\n" << log;
+  EXPECT_NE(log.find("drape: RGB (3 Byte bands)"), std::string::npos) << log;
+  auto image = render::readImage8(o + "layers.png");
+  ASSERT_TRUE(image) << image.message();
+  const int w = image->width, h = image->height;
+  auto px = [&](int x, int y) { return &image->pixels[(size_t(y) * size_t(w) + size_t(x)) * size_t(image->channels)]; };
+  const uint8_t* centre = px(w / 2, h / 2);
+  EXPECT_GT(centre[0], 150);
+  EXPECT_LT(centre[2], 80);
+  int white = 0, whiteInBarCorner = 0;  // lines are 80% white over the drape
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const uint8_t* p = px(x, y);
+      if (p[0] < 150 || p[1] < 150) continue;  // neither the drape's blue nor its red: a line or the bar
+      (x < w / 4 && y > h - 40 ? whiteInBarCorner : white) += 1;
+    }
+  }
+  EXPECT_GT(white, 300) << "graticule lines";  // 0.05 degree lines across a ~14 km view
+  EXPECT_GT(whiteInBarCorner, 60) << "scale bar";
 }
 
 }  // namespace

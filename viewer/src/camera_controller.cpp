@@ -49,8 +49,9 @@ void CameraController::update(double dtS, double exaggeration) {
     if (pose_.lon > 180 && g.transform.c[0] < 0) pose_.lon -= 360;
     if (pose_.lon < -180) pose_.lon += 360;
   } else {
-    pose_.lon += east;
-    pose_.lat += north;
+    const glm::dvec2 k = scene_->metresPerCrsUnit();
+    pose_.lon += east / k.x;
+    pose_.lat += north / k.y;
   }
   pose_.heightM += step * ((keys.up ? 1.0 : 0.0) - (keys.down ? 1.0 : 0.0));
   clampAboveGround(exaggeration);

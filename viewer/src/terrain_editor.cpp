@@ -56,7 +56,10 @@ glm::dvec2 TerrainEditor::cellOf(double lon, double lat) const {
 glm::dvec2 TerrainEditor::radiusCells(double radiusM, double y) const {
   const auto& g = scene_->georef();
   const auto& c = g.transform.c;
-  if (!g.geographic) return {radiusM / c[1], radiusM / -c[5]};
+  if (!g.geographic) {
+    const glm::dvec2 k = scene_->metresPerCrsUnit();
+    return {radiusM / (c[1] * k.x), radiusM / (-c[5] * k.y)};
+  }
   const double lat = c[3] + c[5] * y, r = scene_->radiusM();
   const double dx = r * std::max(std::cos(lat * kDeg), 1e-3) * c[1] * kDeg, dy = r * -c[5] * kDeg;
   return {radiusM / dx, radiusM / dy};

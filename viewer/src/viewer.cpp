@@ -46,14 +46,14 @@ Result<std::unique_ptr<Viewer>> Viewer::create(const gis::Raster& dem, const Vie
   v->target_.emplace(std::move(target));
   STRATA_TRY(auto editor, TerrainEditor::create(v->scene_));
   v->editor_.emplace(std::move(editor));
-  STRATA_TRY(auto hud, HudRenderer::create());
+  STRATA_TRY(auto hud, render::Overlay::create());
   v->hud_.emplace(std::move(hud));
   v->camera_.emplace(v->scene_, options.flight);
   // Start looking at the terrain from above its centre, a sixth of its width away.
   const auto& c = dem.georef.transform.c;
   const double extentM = dem.georef.geographic
                              ? std::abs(c[1]) * dem.values.width * v->scene_.radiusM() * std::numbers::pi / 180.0
-                             : std::abs(c[1]) * dem.values.width;
+                             : std::abs(c[1]) * dem.values.width * v->scene_.metresPerCrsUnit().x;
   auto& pose = v->camera_->pose();
   pose.heightM = options.shading.exaggeration * v->scene_.heightAt(pose.lon, pose.lat) +
                  std::clamp(extentM / 6.0, 200.0, options.planetary ? 1.5 * v->scene_.radiusM() : 5e5);
@@ -71,19 +71,10 @@ Status Viewer::resize(int width, int height) {
 
 std::optional<glm::dvec2> Viewer::pick(double x, double y) const {
   const int w = target_->width(), h = target_->height();
-  const int px = int(std::floor(x)), py = int(std::floor(y));
-  if (px < 0 || py < 0 || px >= w || py >= h) return std::nullopt;
-  const float d = target_->depthAt(px, py);
-  if (!(d > 0)) return std::nullopt;
   const auto f = render::frameGeometry(scene_, camera_->pose(), options_.shading, w, h);
-  // Reversed-Z: eye-space distance along the axis is near / depth; unproject the pixel centre.
-  const double dist = f.nearM / double(d);
-  const glm::dvec4 ndc(2.0 * (px + 0.5) / w - 1.0, 1.0 - 2.0 * (py + 0.5) / h, 1.0, 1.0);  // on the near plane
-  const glm::dmat4 invProj = glm::inverse(f.projection);
-  glm::dvec4 eye = invProj * ndc;
-  eye /= eye.w;
-  const glm::dvec3 eyeDir = glm::dvec3(eye) / -eye.z * dist;  // on the plane z_eye = -dist
-  const glm::dvec3 enu = glm::dvec3(glm::inverse(f.view) * glm::dvec4(eyeDir, 0.0));
+  const auto at = render::groundEnuAt(f, *target_, int(std::floor(x)), int(std::floor(y)));
+  if (!at) return std::nullopt;
+  const glm::dvec3 enu = *at;
   const auto& c = scene_.georef().transform.c;
   if (scene_.planetary()) {
     // The frame is east-north-up at the viewer, with up the ellipsoid normal at its nadir
@@ -469,6 +460,7 @@ Status Viewer::frame(double dtS) {
   if (frameIndex_ >= 2) gpuFrameMs_ = gpuTimers_[(frameIndex_ + 1) % 3].milliseconds();
   timer.begin();
   STRATA_TRY_STATUS(renderer_->draw(scene_, camera_->pose(), options_.shading, *target_));
+  if (options_.scaleBar) hud_->drawScaleBarOver(*target_, scene_, camera_->pose(), options_.shading);
   timer.end();
   ++frameIndex_;
   cpuFrameMs_ = msSince(t0);
@@ -494,12 +486,12 @@ Status Viewer::present(int width, int height) {
   };
   STRATA_TRY_STATUS(capture(false));
   const int scale = height >= 700 ? 2 : 1;
-  if (options_.showHud) hud_->draw(hudLines(), 0, 0, width, height, scale);
+  if (options_.showHud) hud_->drawText(hudLines(), 0, 0, width, height, scale);
   if (showHelp_) {
     const auto help = helpLines();
     int w = 0, h = 0;
-    HudRenderer::measure(help, scale, w, h);
-    hud_->draw(help, std::max(0, width - w), 0, width, height, scale);
+    render::Overlay::measureText(help, scale, w, h);
+    hud_->drawText(help, std::max(0, width - w), 0, width, height, scale);
   }
   STRATA_TRY_STATUS(capture(true));
   pendingScreenshots_.clear();

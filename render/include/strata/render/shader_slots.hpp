@@ -33,7 +33,10 @@ inline constexpr gl::Binding kDrape{"SLOT_DRAPE", ResourceKind::kSampler, 8, "uD
 /// Lon/lat (deg) of the cell centres (RG32F), for the graticule, optional.
 inline constexpr gl::Binding kLonLat{"SLOT_LONLAT", ResourceKind::kSampler, 9, "uLonLat"};
 
-inline constexpr gl::Binding kAll[] = {kHeight,   kWater,      kLayers,   kClip,  kClipPages,
-                                       kSediment, kWaterState, kVoidMask, kDrape, kLonLat};
+/// overlay.vert: the quads' corners (window pixels).
+inline constexpr gl::Binding kOverlayCorners{"SLOT_OVERLAY_CORNERS", ResourceKind::kStorageBuffer, 0, "Corners"};
+
+inline constexpr gl::Binding kAll[] = {kHeight,     kWater,    kLayers, kClip,   kClipPages,     kSediment,
+                                       kWaterState, kVoidMask, kDrape,  kLonLat, kOverlayCorners};
 
 }  // namespace strata::render::slots

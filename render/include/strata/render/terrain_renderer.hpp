@@ -141,6 +141,11 @@ class TerrainScene {
   StreamedElevation* streamed() const { return streamed_.get(); }
   /// Radius of the body (m) used for the local frame and planetary mode.
   double radiusM() const { return georef_.body.semiMajorM; }
+  /// Projected DEMs: ground metres per CRS unit east and north at the DEM's centre (the inverse
+  /// of the projection's point scale: about 0.81 for Web Mercator over the Grand Canyon, 0.9990
+  /// to 1.0004 across a UTM zone); the renderers, the camera and the brushes work in these ground
+  /// metres. 1 for CRSs without a lon/lat base (local grids) and for geographic DEMs.
+  glm::dvec2 metresPerCrsUnit() const { return metresPerUnit_; }
 
   const gl::Texture& heightTexture() const { return height_; }
   const gl::Texture* waterTexture() const { return water_ ? &water_ : nullptr; }
@@ -157,6 +162,7 @@ class TerrainScene {
   gis::Grid<float> heights_;
   bool planetary_ = false;
   float minM_ = 0, maxM_ = 0;
+  glm::dvec2 metresPerUnit_{1.0, 1.0};
   size_t voids_ = 0;
   gl::Texture height_, water_, layers_, sediment_, waterState_, voidMask_, drape_, lonLat_;
   std::shared_ptr<StreamedElevation> streamed_;
@@ -186,6 +192,13 @@ struct FrameGeometry {
 FrameGeometry frameGeometry(const TerrainScene& scene, const CameraPose& camera, const Shading& shading, int width,
                             int height);
 
+class OffscreenTarget;
+
+/// The viewer-relative east-north-up offset (m) of the ground point drawn at pixel (px, py) of
+/// `target` (y from the top row), unprojected from its depth; nullopt where nothing was drawn.
+/// `f` is the geometry of the frame the target holds.
+std::optional<glm::dvec3> groundEnuAt(const FrameGeometry& f, const OffscreenTarget& target, int px, int py);
+
 /// Reversed-Z infinite perspective: clip z = near, w = -z_eye (depth = near / distance along the axis).
 glm::dmat4 reversedInfinitePerspective(double fovYRad, double aspect, double nearM);
 
@@ -197,6 +210,9 @@ class OffscreenTarget {
   int width() const { return width_; }
   int height() const { return height_; }
   void bind() const;
+  /// Binds the colour attachment alone, for overlays drawn over the picture (render::Overlay):
+  /// the elevation and depth keep the terrain's values under them.
+  void bindColourOnly() const;
   /// Clears colour to `sky`, depth to 0 and elevation to NaN.
   void clear(const glm::vec4& sky) const;
   /// Pixels, top row first.
@@ -211,7 +227,7 @@ class OffscreenTarget {
  private:
   int width_ = 0, height_ = 0;
   gl::Texture colour_, elevation_, depth_;
-  gl::Framebuffer fbo_;
+  gl::Framebuffer fbo_, colourFbo_;
 };
 
 /// A terrain renderer. draw() clears `target` and draws the scene.

@@ -1,5 +1,5 @@
 #pragma once
-// The binding slots of viewer/shaders, declared once: the brush and HUD programs are compiled
+// The binding slots of viewer/shaders, declared once: the brush program is compiled
 // with this table as #defines (GLSL writes `layout(binding = SLOT_BRUSH_SRC)`) and bound through
 // it; a GPU test checks every program against it (docs/architecture.md, "The GL layer").
 
@@ -17,9 +17,7 @@ inline constexpr gl::Binding kBrushDst{"SLOT_BRUSH_DST", ResourceKind::kImage, 1
 inline constexpr gl::Binding kBrushStamp{"SLOT_BRUSH_STAMP", ResourceKind::kSampler, 2, "uStamp"};
 /// brush.comp: the scene's layer thicknesses (read and written).
 inline constexpr gl::Binding kBrushLayers{"SLOT_BRUSH_LAYERS", ResourceKind::kImage, 3, "uLayers"};
-/// hud.vert: the quads' corners.
-inline constexpr gl::Binding kHudCorners{"SLOT_HUD_CORNERS", ResourceKind::kStorageBuffer, 0, "Corners"};
 
-inline constexpr gl::Binding kAll[] = {kBrushSrc, kBrushDst, kBrushStamp, kBrushLayers, kHudCorners};
+inline constexpr gl::Binding kAll[] = {kBrushSrc, kBrushDst, kBrushStamp, kBrushLayers};
 
 }  // namespace strata::viewer::slots

@@ -12,11 +12,11 @@
 
 #include <strata/core/result.hpp>
 #include <strata/gis/raster.hpp>
+#include <strata/render/overlay.hpp>
 #include <strata/render/terrain_renderer.hpp>
 #include <strata/sim/gl_solver.hpp>
 #include <strata/viewer/camera_controller.hpp>
 #include <strata/viewer/command.hpp>
-#include <strata/viewer/hud.hpp>
 #include <strata/viewer/terrain_editor.hpp>
 
 namespace strata::viewer {
@@ -30,6 +30,7 @@ struct ViewerOptions {
   double softMinM = 0;            ///< ring renderer softening floor (m); 0: RingParams' default
   FlightParams flight;            ///< fly-through tuning
   bool showHud = true;            ///< draw the HUD (toggled with F2)
+  bool scaleBar = false;          ///< draw a scale bar in the picture's bottom-left corner
 };
 
 /// The live simulation region: a window of the terrain simulated on the GPU.
@@ -85,6 +86,7 @@ class Viewer {
   const Brush& brush() const { return brush_; }
   const SimRegionState* region() const { return region_ ? &*region_ : nullptr; }
   const render::Shading& shading() const { return options_.shading; }
+  render::Shading& shading() { return options_.shading; }
   /// Where save without a path writes (a store folder or a file); set by the app.
   std::string savePath;
   /// Saves the edited terrain: a GeoTIFF (.tif) of the whole grid. (Stores: apps/strata-view.)
@@ -106,7 +108,7 @@ class Viewer {
   std::optional<render::OffscreenTarget> target_;
   std::optional<TerrainEditor> editor_;
   std::optional<CameraController> camera_;
-  std::optional<HudRenderer> hud_;
+  std::optional<render::Overlay> hud_;
   std::optional<SimRegionState> region_;
   Brush brush_;
   glm::dvec2 cursor_{-1, -1}, regionStart_{0, 0};
