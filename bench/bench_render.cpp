@@ -15,6 +15,7 @@
 // Drapes (BM_DrapeLoad, BM_DrapeFrame): the Grand Canyon's EPSG:4326 DEM draped as a ramp over
 // its EPSG:3857 version (GDAL's warp with the exact transformer, then the ramp), and the frame
 // time with and without a drape, side by side.
+// Cast shadows (BM_CastShadows): the horizon search on the CPU at three sun elevations.
 // Figures: docs/benchmarks.md ("Render").
 #include <benchmark/benchmark.h>
 
@@ -35,6 +36,7 @@
 #include <strata/render/drape.hpp>
 #include <strata/render/screen_error.hpp>
 #include <strata/render/sliding_grid.hpp>
+#include <strata/render/sun.hpp>
 #include <strata/render/synthetic_dem.hpp>
 #include <strata/render/terrain_renderer.hpp>
 #include <strata/terrain/ingest.hpp>
@@ -396,6 +398,27 @@ void BM_DrapeFrame(benchmark::State& state) {
   runFrames(state, **ring, *scene, cam, 960, 540);
 }
 BENCHMARK(BM_DrapeFrame)->ArgName("drape")->Arg(0)->Arg(1)->UseManualTime()->Unit(benchmark::kMillisecond);
+
+// Cast shadows on the CPU (castShadows, OpenMP over rows) for the Grand Canyon's 512^2 cells at
+// a sun elevation of range(0) degrees from the west: the lower the sun, the farther each cell's
+// horizon search runs (out to where the DEM's highest point could no longer rise above the sun).
+void BM_CastShadows(benchmark::State& state) {
+  auto dem = gis::readDem(kDrapeRaster);
+  if (!dem) return state.SkipWithError(dem.message().c_str());
+  SunSpec sun;
+  sun.dirEnu = sunDirectionEnu(270.0, double(state.range(0)));
+  double shadowed = 0;
+  for (auto _ : state) {
+    const auto lit = castShadows(dem->values, dem->georef, sun, 1.0f);
+    shadowed = 0;
+    for (float v : lit.data) shadowed += v < 0.5f ? 1 : 0;
+    benchmark::DoNotOptimize(lit.data.data());
+  }
+  const double cells = double(dem->values.size());
+  state.counters["shadowed"] = shadowed / cells;
+  state.counters["cells/s"] = benchmark::Counter(cells * double(state.iterations()), benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_CastShadows)->ArgName("sun_elev_deg")->Arg(5)->Arg(10)->Arg(30)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 int main(int argc, char** argv) { return strata::bench::benchGlMain(argc, argv); }

@@ -20,7 +20,7 @@
 #include <strata/viewer/store_io.hpp>
 #include <strata/viewer/viewer.hpp>
 
-#include "../common/map_layers.hpp"
+#include "../common/view_options.hpp"
 
 namespace {
 
@@ -41,6 +41,7 @@ struct Args {
   double dtS = 1.0 / 30.0;
   std::string savePath;
   apps::MapLayerArgs layers;
+  apps::LightArgs light;
 };
 
 // GLFW key codes -> the viewer's key names.
@@ -154,6 +155,10 @@ int run(const Args& a) {
     std::fprintf(stderr, "strata-view: %s\n", st.message().c_str());
     return 1;
   }
+  if (auto st = apps::applyLight(a.light, v.scene(), v.shading()); !st) {
+    std::fprintf(stderr, "strata-view: %s\n", st.message().c_str());
+    return 1;
+  }
   if (loaded && !loaded->layers.empty()) {
     if (auto s = v.editor().setLayers(loaded->layers); !s) {
       std::fprintf(stderr, "strata-view: %s\n", s.message().c_str());
@@ -253,6 +258,7 @@ int main(int argc, char** argv) {
   app.add_option("--palette", a->palette, "hypsometric, grey or rust")
       ->check(CLI::IsMember({"hypsometric", "grey", "rust"}));
   apps::addMapLayerOptions(app, a->layers);
+  apps::addLightOptions(app, a->light);
   app.add_option("--script", a->script, "Timed commands (docs/viewer.md); the viewer exits after the last");
   app.add_option("--frames", a->frames, "Stop after this many frames (0: run until closed)");
   app.add_option("--dt", a->dtS, "Scripted runs: seconds of flight per frame")->check(CLI::PositiveNumber);

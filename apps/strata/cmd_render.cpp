@@ -19,7 +19,7 @@
 #include <strata/render/terrain_renderer.hpp>
 #include <strata/terrain/tile_store.hpp>
 
-#include "../common/map_layers.hpp"
+#include "../common/view_options.hpp"
 #include "commands.hpp"
 
 namespace strata::app {
@@ -44,6 +44,7 @@ struct RenderArgs {
   std::string palette = "hypsometric";
   float fogM = 0;
   apps::MapLayerArgs layers;
+  apps::LightArgs light;
   std::string path;
   int frames = 0;
   int clipSize = 512, pageSize = 64, uploadPages = 64;
@@ -214,6 +215,7 @@ void run(const RenderArgs& a) {
   }();
   if (!scene) die(a.dem + ": " + scene.message());
   if (auto st = apps::applyMapLayers(a.layers, *scene, shading); !st) die(st.message());
+  if (auto st = apps::applyLight(a.light, *scene, shading); !st) die(st.message());
   auto renderer = makeRenderer(a);
   if (!renderer) die(renderer.message());
   auto target = OffscreenTarget::create(w, h);
@@ -325,6 +327,7 @@ void addRenderCommand(CLI::App& app) {
   cmd->add_option("--palette", a->palette, "hypsometric, grey or rust");
   cmd->add_option("--fog", a->fogM, "Haze distance (m); 0: none");
   apps::addMapLayerOptions(*cmd, a->layers);
+  apps::addLightOptions(*cmd, a->light);
   cmd->add_option("--path", a->path, "Keyframe file (lon lat height heading pitch [fov] per line)");
   cmd->add_option("--frames", a->frames, "Frames to render along --path");
   cmd->add_option("--clip-size", a->clipSize, "Store: texels a side of each streamed level's window")

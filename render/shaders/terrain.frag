@@ -1,7 +1,7 @@
 #version 450
-// Terrain shading shared by the renderers: sun lighting with normals from the height texture,
-// a hypsometric tint, material layers blended by thickness, a draped raster, water coloured by
-// depth, haze.
+// Terrain shading shared by the renderers: sun lighting with normals from the height texture and
+// cast shadows, a hypsometric tint, material layers blended by thickness, a draped raster, water
+// coloured by depth, a graticule, haze.
 #include "terrain_common.glsl"
 
 in VertexData {
@@ -29,6 +29,9 @@ uniform int uHasDrape;
 uniform float uDrapeOpacity;
 layout(binding = SLOT_LONLAT) uniform sampler2D uLonLat;  // lon/lat (deg) of the cell centres, for the graticule
 uniform float uGraticuleDeg;     // lines of longitude and latitude this far apart (deg); 0: none
+layout(binding = SLOT_SHADOW) uniform sampler2D uShadow;  // fraction of the sun each cell sees, optional
+uniform int uHasShadow;
+uniform float uAmbient;          // light where the sun does not reach
 uniform vec3 uSiltColour;        // water colour at high sediment concentration
 uniform float uSiltConcentration; // concentration s / h at which water is 1 - 1/e of the way to silt
 uniform int uHasLayers;
@@ -116,7 +119,9 @@ void main() {
     vec4 d = textureGrad(uDrape, uv, dFdx(q) / uTexSize, dFdy(q) / uTexSize);
     albedo = mix(albedo, d.rgb, d.a * uDrapeOpacity);
   }
-  float light = 0.25 + 0.75 * max(dot(n, uSunDir), 0.0);
+  float sunLit = 1.0;
+  if (uHasShadow != 0) sunLit = textureGrad(uShadow, uv, dFdx(q) / uTexSize, dFdy(q) / uTexSize).r;
+  float light = uAmbient + (1.0 - uAmbient) * max(dot(n, uSunDir), 0.0) * sunLit;
   vec3 colour = albedo * light;
 
   float depth = 0.0, simDepth = 0.0;

@@ -79,6 +79,9 @@ Status setCommonUniforms(const gl::Program& p, const TerrainScene& scene, const 
   p.set("uHasDrape", scene.drapeTexture() ? 1 : 0);
   p.set("uDrapeOpacity", shading.drapeOpacity);
   if (scene.drapeTexture()) scene.drapeTexture()->bind(slots::kDrape);
+  p.set("uHasShadow", scene.shadowTexture() ? 1 : 0);
+  if (scene.shadowTexture()) scene.shadowTexture()->bind(slots::kShadow);
+  p.set("uAmbient", shading.ambient);
   const bool graticule = scene.lonLatTexture() && shading.graticuleDeg > 0;
   p.set("uGraticuleDeg", graticule ? float(shading.graticuleDeg) : 0.0f);
   if (graticule) scene.lonLatTexture()->bind(slots::kLonLat);
@@ -98,7 +101,16 @@ Status setCommonUniforms(const gl::Program& p, const TerrainScene& scene, const 
   if (shading.seaLevelM) tint.x = std::max(tint.x, *shading.seaLevelM);
   p.set("uElevRange", shading.tintRangeM.value_or(tint));
   p.set("uPalette", int(shading.palette));
-  p.set("uSunDir", glm::normalize(shading.sunDir));
+  glm::vec3 sun = glm::normalize(shading.sunDir);
+  if (shading.subsolarLonLat) {
+    // The sun fixed on the body, seen from the viewer's place (a projected DEM's centre).
+    const glm::dvec2 place =
+        scene.georef().geographic ? glm::dvec2(frame.lonRad / kDeg, frame.latRad / kDeg) : scene.centreLonLat();
+    if (std::isfinite(place.x) && std::isfinite(place.y)) {
+      sun = glm::vec3(sunDirectionEnu(*shading.subsolarLonLat, place.x, place.y));
+    }
+  }
+  p.set("uSunDir", sun);
   p.set("uPole", glm::vec3(frame.frameRot * frame.poleAux));
   p.set("uSky", shading.sky);
   p.set("uFogM", shading.fogM);
@@ -168,6 +180,10 @@ glm::dvec2 metresPerCrsUnitOf(const gis::Georef& g) {
   const auto k = gis::metresPerCrsUnit(g, 0.5 * g.width, 0.5 * g.height);
   return k ? glm::dvec2((*k)[0], (*k)[1]) : glm::dvec2(1.0, 1.0);
 }
+glm::dvec2 centreLonLatOf(const gis::Georef& g) {
+  const auto p = gis::pixelToLonLat(g, 0.5 * g.width, 0.5 * g.height);
+  return p ? glm::dvec2(p->lonDeg, p->latDeg) : glm::dvec2(std::numeric_limits<double>::quiet_NaN());
+}
 }  // namespace
 
 Result<TerrainScene> TerrainScene::create(const gis::Raster& dem, const SceneOptions& options) {
@@ -190,6 +206,7 @@ Result<TerrainScene> TerrainScene::create(const gis::Raster& dem, const SceneOpt
   s.georef_ = g;
   s.planetary_ = options.planetary;
   s.metresPerUnit_ = metresPerCrsUnitOf(g);
+  s.centreLonLat_ = centreLonLatOf(g);
   s.heights_ = dem.values;
   float lo = std::numeric_limits<float>::infinity(), hi = -lo;
   for (float v : s.heights_.data) {
@@ -232,6 +249,7 @@ Result<TerrainScene> TerrainScene::createStreamed(strata::terrain::TileStore sto
   s.georef_ = g;
   s.planetary_ = options.planetary;
   s.metresPerUnit_ = metresPerCrsUnitOf(g);
+  s.centreLonLat_ = centreLonLatOf(g);
   s.minM_ = streamed->minElevationM();
   s.maxM_ = streamed->maxElevationM();
   s.streamed_ = std::move(streamed);
@@ -348,6 +366,15 @@ Status TerrainScene::setDrape(const DrapeImage& image) {
   drape_ = gl::Texture::create2D(gl::TextureFormat::kRGBA8, image.width, image.height, 0);
   drape_.upload(image.rgba.data());
   drape_.generateMipmap();
+  return {};
+}
+
+Status TerrainScene::castShadows(const SunSpec& sun, float exaggeration) {
+  if (streamed_) return fail("render: shadows are cast on whole-DEM scenes only (this one is streamed)");
+  const gis::Grid<float> lit = render::castShadows(heights_, georef_, sun, exaggeration, metresPerUnit_);
+  shadow_ = gl::Texture::create2D(gl::TextureFormat::kR32F, width(), height(), 0);
+  shadow_.upload(lit.data.data());
+  shadow_.generateMipmap();
   return {};
 }
 

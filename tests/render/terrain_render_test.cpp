@@ -18,6 +18,7 @@
 #include <strata/render/screen_error.hpp>
 #include <strata/render/shader_slots.hpp>
 #include <strata/render/sliding_grid.hpp>
+#include <strata/render/sun.hpp>
 #include <strata/render/synthetic_dem.hpp>
 #include <strata/render/terrain_renderer.hpp>
 
@@ -749,6 +750,89 @@ TEST_F(GlTest, AScaleBarMeasuresTheGroundAtItsTrueScale) {
   EXPECT_EQ(std::memcmp(elevationBefore.data(), elevationAfter.data(), elevationBefore.size() * sizeof(float)), 0);
   auto img = colourImage(*target);
   ASSERT_TRUE(writeImage8((test::outputDir("render") / "scale_bar.png").string(), w, h, 4, img.pixels));
+}
+
+TEST_F(GlTest, ACastShadowDarkensOnlyTheGroundTheSunCannotSee) {
+  // Flat ground (local metres, 10 m cells) with a north-south wall 100 m high at 500-530 m east;
+  // the sun from the west 30 degrees up casts a 173 m shadow east of the wall's top edge
+  // (525 m). Seen straight down: in the shadow the flat ground keeps the ambient light alone,
+  // 0.25 of 0.25 + 0.75 sin(30) (0.4 of its sunlit brightness); the sunlit ground beyond and the
+  // ground west of the wall do not change.
+  gis::Raster dem;
+  dem.georef.width = 200;
+  dem.georef.height = 40;
+  dem.georef.body = gis::Body::wgs84();
+  dem.georef.transform = gis::GeoTransform{{0, 10, 0, 400, 0, -10}};
+  dem.values = gis::Grid<float>(200, 40, 0.0f);
+  for (int y = 0; y < 40; ++y) {
+    for (int x = 50; x <= 52; ++x) dem.values.at(x, y) = 100.0f;
+  }
+  auto scene = TerrainScene::create(dem);
+  ASSERT_TRUE(scene) << scene.message();
+  auto ring = RingRenderer::create({.circles = 64});
+  ASSERT_TRUE(ring) << ring.message();
+  const int w = 128, h = 64;
+  auto target = OffscreenTarget::create(w, h);
+  ASSERT_TRUE(target) << target.message();
+  const CameraPose cam{.lon = 700, .lat = 200, .heightM = 600, .headingDeg = 0, .pitchDeg = -90, .fovYDeg = 30};
+  Shading shading;
+  shading.sunDir = glm::vec3(sunDirectionEnu(270.0, 30.0));
+  const double mPerPixel = 2 * 600 * std::tan(15 * std::numbers::pi / 180) / h;
+  auto brightnessAt = [&](double eastM) {  // on the image's middle row
+    const auto c = target->colour();
+    const int px = int(w / 2 + (eastM - 700) / mPerPixel);
+    const uint8_t* p = &c[(size_t(h / 2) * size_t(w) + size_t(px)) * 4];
+    return (double(p[0]) + p[1] + p[2]) / 3;
+  };
+  ASSERT_TRUE((*ring)->draw(*scene, cam, shading, *target));
+  const double shadowedBefore = brightnessAt(620), beyondBefore = brightnessAt(760), westBefore = brightnessAt(480);
+  ASSERT_TRUE(
+      scene->castShadows({.subsolarLonLat = std::nullopt, .dirEnu = glm::dvec3(shading.sunDir)}, shading.exaggeration));
+  ASSERT_TRUE((*ring)->draw(*scene, cam, shading, *target));
+  EXPECT_NEAR(brightnessAt(620) / shadowedBefore, 0.25 / (0.25 + 0.75 * 0.5), 0.03);
+  EXPECT_NEAR(brightnessAt(680), brightnessAt(620), 2.0);  // one shadow, as dark all along
+  EXPECT_NEAR(brightnessAt(760), beyondBefore, 1.0);
+  EXPECT_NEAR(brightnessAt(480), westBefore, 1.0);
+  auto img = colourImage(*target);
+  ASSERT_TRUE(writeImage8((test::outputDir("render") / "wall_shadow.png").string(), w, h, 4, img.pixels));
+}
+
+TEST_F(GlTest, TheSunFixedOnTheEarthLightsItsDaySideFromOrbit) {
+  // The Earth from 20,000 km over (90 E, 0) with the sun over (0, 0): the terminator is the
+  // meridian under the viewer, so the western (left) half of the disc is day and the eastern
+  // half night (ambient light only); the sun fixed in the viewer's frame lit both alike.
+  auto dem = gis::readDemLonLat(test::dataPath("earth/etopo20.tif"));
+  ASSERT_TRUE(dem) << dem.message();
+  auto scene = TerrainScene::create(*dem, {.planetary = true});
+  ASSERT_TRUE(scene) << scene.message();
+  auto ring = RingRenderer::create({.circles = 96});
+  ASSERT_TRUE(ring) << ring.message();
+  const int w = 96, h = 96;
+  auto target = OffscreenTarget::create(w, h);
+  ASSERT_TRUE(target) << target.message();
+  const CameraPose cam{.lon = 90, .lat = 0, .heightM = 2e7, .headingDeg = 0, .pitchDeg = -90, .fovYDeg = 40};
+  Shading shading;
+  shading.sky = {0, 0, 0, 1};
+  shading.sunDir = {0, 0, 1};
+  auto halves = [&] {
+    const auto c = target->colour();
+    double left = 0, right = 0;
+    for (int y = h / 2 - 8; y < h / 2 + 8; ++y) {
+      for (int x = w / 2 - 24; x < w / 2 - 4; ++x) left += c[(size_t(y) * w + size_t(x)) * 4 + 1];
+      for (int x = w / 2 + 4; x < w / 2 + 24; ++x) right += c[(size_t(y) * w + size_t(x)) * 4 + 1];
+    }
+    return std::pair(left, right);
+  };
+  ASSERT_TRUE((*ring)->draw(*scene, cam, shading, *target));
+  const auto [fixedLeft, fixedRight] = halves();
+  EXPECT_NEAR(fixedLeft / fixedRight, 1.0, 0.35);
+  shading.subsolarLonLat = glm::dvec2(0, 0);
+  ASSERT_TRUE((*ring)->draw(*scene, cam, shading, *target));
+  const auto [dayLeft, nightRight] = halves();
+  EXPECT_GT(dayLeft / nightRight, 1.8);
+  EXPECT_NEAR(nightRight / fixedRight, 0.25, 0.05);  // ambient only: 0.25 of an overhead sun's light
+  auto img = colourImage(*target);
+  ASSERT_TRUE(writeImage8((test::outputDir("render") / "earth_terminator.png").string(), w, h, 4, img.pixels));
 }
 
 TEST_F(GlTest, RainierRidgeCloseViewMatchesGoldenImage) {

@@ -33,10 +33,13 @@ inline constexpr gl::Binding kDrape{"SLOT_DRAPE", ResourceKind::kSampler, 8, "uD
 /// Lon/lat (deg) of the cell centres (RG32F), for the graticule, optional.
 inline constexpr gl::Binding kLonLat{"SLOT_LONLAT", ResourceKind::kSampler, 9, "uLonLat"};
 
+/// The fraction of the sun each cell sees (r32f, cast shadows), optional.
+inline constexpr gl::Binding kShadow{"SLOT_SHADOW", ResourceKind::kSampler, 10, "uShadow"};
+
 /// overlay.vert: the quads' corners (window pixels).
 inline constexpr gl::Binding kOverlayCorners{"SLOT_OVERLAY_CORNERS", ResourceKind::kStorageBuffer, 0, "Corners"};
 
-inline constexpr gl::Binding kAll[] = {kHeight,     kWater,    kLayers, kClip,   kClipPages,     kSediment,
-                                       kWaterState, kVoidMask, kDrape,  kLonLat, kOverlayCorners};
+inline constexpr gl::Binding kAll[] = {kHeight,     kWater,    kLayers, kClip,   kClipPages, kSediment,
+                                       kWaterState, kVoidMask, kDrape,  kLonLat, kShadow,    kOverlayCorners};
 
 }  // namespace strata::render::slots

@@ -20,6 +20,7 @@
 #include <strata/render/drape.hpp>
 #include <strata/render/ring_mesh.hpp>
 #include <strata/render/streamed_elevation.hpp>
+#include <strata/render/sun.hpp>
 
 namespace strata::render {
 
@@ -54,6 +55,11 @@ struct Shading {
   float drapeOpacity = 1;  ///< how much a draped raster (TerrainScene::setDrape) hides the tint, times its alpha
   /// Lines of longitude and latitude this many degrees apart (TerrainScene::enableGraticule); 0: none.
   double graticuleDeg = 0;
+  /// The point (lon, lat, deg) where the sun stands overhead: the sun is then fixed on the body
+  /// and `sunDir` is derived each frame in the viewer's frame (at the viewer's place on a
+  /// geographic DEM, at the DEM's centre on a projected one), so a body shows its night side.
+  std::optional<glm::dvec2> subsolarLonLat;
+  float ambient = 0.25f;  ///< light on surfaces facing away from the sun or in shadow, 0 to 1
   std::array<glm::vec3, 4> layerColours{glm::vec3(0.76f, 0.70f, 0.50f), glm::vec3(0.45f, 0.35f, 0.25f),
                                         glm::vec3(0.30f, 0.45f, 0.20f), glm::vec3(0.9f, 0.9f, 0.95f)};
 };
@@ -105,6 +111,10 @@ class TerrainScene {
   /// tint and the material layers, times its alpha and Shading::drapeOpacity, lit by the sun;
   /// water is drawn over it. Whole-DEM scenes only.
   Status setDrape(const DrapeImage& image);
+  /// Cast shadows for `sun` at vertical exaggeration `exaggeration` (render::castShadows on the
+  /// CPU, a lit-fraction texture the lighting multiplies): recast them when the sun, the
+  /// exaggeration or the heights change. Whole-DEM scenes only.
+  Status castShadows(const SunSpec& sun, float exaggeration);
   /// Lon/lat of every cell centre on the GPU (through the CRS's own datum for projected DEMs), so
   /// that Shading::graticuleDeg can draw lines of longitude and latitude. Whole-DEM scenes only.
   Status enableGraticule();
@@ -154,6 +164,10 @@ class TerrainScene {
   const gl::Texture* waterStateTexture() const { return waterState_ ? &waterState_ : nullptr; }
   const gl::Texture* drapeTexture() const { return drape_ ? &drape_ : nullptr; }
   const gl::Texture* lonLatTexture() const { return lonLat_ ? &lonLat_ : nullptr; }
+  const gl::Texture* shadowTexture() const { return shadow_ ? &shadow_ : nullptr; }
+  /// Lon/lat (deg) of the DEM's centre (its own for geographic DEMs; through its CRS otherwise,
+  /// NaN where that fails).
+  glm::dvec2 centreLonLat() const { return centreLonLat_; }
   /// r32f: 1 where the DEM has data, 0 over voids; null unless voids are drawn as holes.
   const gl::Texture* voidMaskTexture() const { return voidMask_ ? &voidMask_ : nullptr; }
 
@@ -164,7 +178,8 @@ class TerrainScene {
   float minM_ = 0, maxM_ = 0;
   glm::dvec2 metresPerUnit_{1.0, 1.0};
   size_t voids_ = 0;
-  gl::Texture height_, water_, layers_, sediment_, waterState_, voidMask_, drape_, lonLat_;
+  gl::Texture height_, water_, layers_, sediment_, waterState_, voidMask_, drape_, lonLat_, shadow_;
+  glm::dvec2 centreLonLat_{0.0, 0.0};
   std::shared_ptr<StreamedElevation> streamed_;
 };
 
