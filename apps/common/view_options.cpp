@@ -3,9 +3,11 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <numbers>
 #include <optional>
 
+#include <strata/render/colour_ramp.hpp>
 #include <strata/render/drape.hpp>
 #include <strata/render/sun.hpp>
 
@@ -21,7 +23,6 @@ Result<std::array<double, 2>> parsePair(const std::string& text, const std::stri
   }
   return std::array<double, 2>{a, b};
 }
-}  // namespace
 
 void addMapLayerOptions(CLI::App& cmd, MapLayerArgs& a) {
   cmd.add_option("--drape", a.drape,
@@ -110,6 +111,44 @@ Status applyLight(const LightArgs& a, render::TerrainScene& scene, render::Shadi
     if (auto st = scene.castShadows(sun, shading.exaggeration); !st) return fail("--shadows: " + st.message());
   }
   return {};
+}
+
+Status applyPalette(const std::string& palette, const render::TerrainScene& scene, render::Shading& shading) {
+  using render::Palette;
+  if (palette.empty()) {
+    shading.palette = render::paletteFor(scene.georef().body);
+  } else if (palette == "hypsometric") {
+    shading.palette = Palette::Hypsometric;
+  } else if (palette == "grey") {
+    shading.palette = Palette::Grey;
+  } else if (palette == "rust") {
+    shading.palette = Palette::Rust;
+  } else if (std::filesystem::is_regular_file(palette)) {
+    STRATA_TRY(shading.ramp, render::loadColourRamp(palette, scene.minElevationM(), scene.maxElevationM()));
+    shading.palette = Palette::Ramp;
+    std::printf("palette: %s, %zu stops from %g to %g m\n", palette.c_str(), shading.ramp.elevationsM.size(),
+                double(shading.ramp.elevationsM.front()), double(shading.ramp.elevationsM.back()));
+  } else {
+    return fail("--palette '" + palette +
+                "': expected hypsometric, grey, rust or a gdaldem color-relief file (there is no such file)");
+  }
+  return {};
+}
+
+}  // namespace
+
+void addViewOptions(CLI::App& cmd, ViewArgs& a) {
+  cmd.add_option("--palette", a.palette,
+                 "Elevation colours: hypsometric, grey, rust or a gdaldem color-relief file (default: the body's: grey "
+                 "on the Moon, rust on Mars)");
+  addMapLayerOptions(cmd, a.layers);
+  addLightOptions(cmd, a.light);
+}
+
+Status applyView(const ViewArgs& a, render::TerrainScene& scene, render::Shading& shading) {
+  STRATA_TRY_STATUS(applyPalette(a.palette, scene, shading));
+  STRATA_TRY_STATUS(applyMapLayers(a.layers, scene, shading));
+  return applyLight(a.light, scene, shading);
 }
 
 }  // namespace strata::apps

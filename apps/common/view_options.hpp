@@ -20,14 +20,6 @@ struct MapLayerArgs {
   bool scaleBar = false;
 };
 
-/// --drape, --drape-opacity, --drape-range, --drape-hide-below, --graticule, --scale-bar.
-void addMapLayerOptions(CLI::App& cmd, MapLayerArgs& a);
-
-/// Loads the drape and the graticule's lon/lat onto `scene` and sets `shading` for them (the
-/// scale bar is drawn by the caller after each frame); fails naming the option and the file.
-/// Prints what it loaded.
-Status applyMapLayers(const MapLayerArgs& a, render::TerrainScene& scene, render::Shading& shading);
-
 struct LightArgs {
   std::string sun;    ///< "AZ,EL" (deg)
   std::string sunAt;  ///< "LON,LAT": the subsolar point (deg)
@@ -36,11 +28,20 @@ struct LightArgs {
   float ambient = 0.25f;
 };
 
-/// --sun, --sun-at, --time, --shadows, --ambient.
-void addLightOptions(CLI::App& cmd, LightArgs& a);
+struct ViewArgs {
+  std::string palette;  ///< hypsometric, grey, rust or a gdaldem color-relief file; empty: the body's
+  MapLayerArgs layers;
+  LightArgs light;
+};
 
-/// Sets the sun on `shading` and casts shadows on `scene` (at shading.exaggeration, so set that
-/// first); fails naming the option. Prints where the sun is.
-Status applyLight(const LightArgs& a, render::TerrainScene& scene, render::Shading& shading);
+/// --palette; --drape, --drape-opacity, --drape-range, --drape-hide-below, --graticule,
+/// --scale-bar; --sun, --sun-at, --time, --shadows, --ambient.
+void addViewOptions(CLI::App& cmd, ViewArgs& a);
+
+/// Sets the palette (by default the body's: grey for the Moon, rust for Mars, hypsometric
+/// otherwise), loads the drape and the graticule's lon/lat onto `scene`, places the sun and casts
+/// shadows (at shading.exaggeration, so set that first). The scale bar is drawn by the caller
+/// after each frame. Fails naming the option and the file; prints what it loaded.
+Status applyView(const ViewArgs& a, render::TerrainScene& scene, render::Shading& shading);
 
 }  // namespace strata::apps

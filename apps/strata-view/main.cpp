@@ -36,12 +36,10 @@ struct Args {
   float exaggeration = 1;
   int circles = 256;
   double rangeM = 0, softMinM = 0;
-  std::string palette = "hypsometric";
   int frames = 0;
   double dtS = 1.0 / 30.0;
   std::string savePath;
-  apps::MapLayerArgs layers;
-  apps::LightArgs light;
+  apps::ViewArgs view;
 };
 
 // GLFW key codes -> the viewer's key names.
@@ -141,9 +139,7 @@ int run(const Args& a) {
   options.rangeM = a.rangeM;
   options.softMinM = a.softMinM;
   options.shading.exaggeration = a.exaggeration;
-  options.scaleBar = a.layers.scaleBar;
-  if (a.palette == "rust") options.shading.palette = render::Palette::Rust;
-  if (a.palette == "grey") options.shading.palette = render::Palette::Grey;
+  options.scaleBar = a.view.layers.scaleBar;
   if (a.planetary) options.shading.sky = {0, 0, 0, 1};
   auto viewer = Viewer::create(dem, options);
   if (!viewer) {
@@ -151,11 +147,7 @@ int run(const Args& a) {
     return 1;
   }
   Viewer& v = **viewer;
-  if (auto st = apps::applyMapLayers(a.layers, v.scene(), v.shading()); !st) {
-    std::fprintf(stderr, "strata-view: %s\n", st.message().c_str());
-    return 1;
-  }
-  if (auto st = apps::applyLight(a.light, v.scene(), v.shading()); !st) {
+  if (auto st = apps::applyView(a.view, v.scene(), v.shading()); !st) {
     std::fprintf(stderr, "strata-view: %s\n", st.message().c_str());
     return 1;
   }
@@ -255,10 +247,7 @@ int main(int argc, char** argv) {
   app.add_option("--soft-min", a->softMinM,
                  "Floor of the softened viewer height f(h) = max(5h, this) (m); default: a twelfth of the range")
       ->check(CLI::NonNegativeNumber);
-  app.add_option("--palette", a->palette, "hypsometric, grey or rust")
-      ->check(CLI::IsMember({"hypsometric", "grey", "rust"}));
-  apps::addMapLayerOptions(app, a->layers);
-  apps::addLightOptions(app, a->light);
+  apps::addViewOptions(app, a->view);
   app.add_option("--script", a->script, "Timed commands (docs/viewer.md); the viewer exits after the last");
   app.add_option("--frames", a->frames, "Stop after this many frames (0: run until closed)");
   app.add_option("--dt", a->dtS, "Scripted runs: seconds of flight per frame")->check(CLI::PositiveNumber);

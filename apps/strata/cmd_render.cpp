@@ -41,10 +41,8 @@ struct RenderArgs {
   std::string voids = "fill";
   float exaggeration = 1;
   std::optional<float> seaLevel;
-  std::string palette = "hypsometric";
   float fogM = 0;
-  apps::MapLayerArgs layers;
-  apps::LightArgs light;
+  apps::ViewArgs view;
   std::string path;
   int frames = 0;
   int clipSize = 512, pageSize = 64, uploadPages = 64;
@@ -187,13 +185,6 @@ void run(const RenderArgs& a) {
   shading.exaggeration = a.exaggeration;
   shading.seaLevelM = a.seaLevel;
   shading.fogM = a.fogM;
-  if (a.palette == "grey") {
-    shading.palette = Palette::Grey;
-  } else if (a.palette == "rust") {
-    shading.palette = Palette::Rust;
-  } else if (a.palette != "hypsometric") {
-    die("--palette '" + a.palette + "': expected hypsometric, grey or rust");
-  }
   if (a.planetary) shading.sky = {0, 0, 0, 1};
   const VoidMode voids = a.voids == "holes" ? VoidMode::kHoles : VoidMode::kFill;
 
@@ -214,8 +205,7 @@ void run(const RenderArgs& a) {
                                         {.planetary = a.planetary});
   }();
   if (!scene) die(a.dem + ": " + scene.message());
-  if (auto st = apps::applyMapLayers(a.layers, *scene, shading); !st) die(st.message());
-  if (auto st = apps::applyLight(a.light, *scene, shading); !st) die(st.message());
+  if (auto st = apps::applyView(a.view, *scene, shading); !st) die(st.message());
   auto renderer = makeRenderer(a);
   if (!renderer) die(renderer.message());
   auto target = OffscreenTarget::create(w, h);
@@ -234,7 +224,7 @@ void run(const RenderArgs& a) {
 
   // Overlays over the drawn picture (its colour only: depth and elevation keep the terrain's).
   std::optional<Overlay> overlay;
-  if (a.layers.scaleBar) {
+  if (a.view.layers.scaleBar) {
     auto o = Overlay::create();
     if (!o) die(o.message());
     overlay.emplace(std::move(*o));
@@ -324,10 +314,8 @@ void addRenderCommand(CLI::App& app) {
       ->check(CLI::IsMember({"fill", "holes"}));
   cmd->add_option("--exaggeration", a->exaggeration, "Vertical exaggeration");
   cmd->add_option("--sea-level", a->seaLevel, "Water wherever the terrain is below this elevation (m)");
-  cmd->add_option("--palette", a->palette, "hypsometric, grey or rust");
   cmd->add_option("--fog", a->fogM, "Haze distance (m); 0: none");
-  apps::addMapLayerOptions(*cmd, a->layers);
-  apps::addLightOptions(*cmd, a->light);
+  apps::addViewOptions(*cmd, a->view);
   cmd->add_option("--path", a->path, "Keyframe file (lon lat height heading pitch [fov] per line)");
   cmd->add_option("--frames", a->frames, "Frames to render along --path");
   cmd->add_option("--clip-size", a->clipSize, "Store: texels a side of each streamed level's window")

@@ -42,7 +42,10 @@ uniform float uWaterFadeM;       // water shallower than this fades out (0: none
 uniform float uLayerOpaqueM;     // thickness at which a layer hides 1/e of what is below
 uniform vec3 uLayerColour[4];
 uniform vec2 uElevRange;         // elevations (m) at the two ends of the tint
-uniform int uPalette;            // 0: hypsometric (Earth), 1: grey (airless bodies), 2: rust (Mars)
+uniform int uPalette;            // 0: hypsometric (Earth), 1: grey (airless bodies), 2: rust (Mars), 3: uRamp*
+uniform int uRampCount;          // a user's ramp (gdaldem color-relief stops, ascending)
+uniform float uRampElev[64];
+uniform vec3 uRampColour[64];
 uniform vec3 uSunDir;            // unit, towards the sun, in the viewer's ENU frame
 uniform vec3 uPole;              // planetary: unit vector to the north pole, viewer's ENU frame
 uniform vec4 uSky;               // haze colour
@@ -59,6 +62,18 @@ vec3 hypsometric(float t) {
   if (t < 0.6) return mix(c1, c2, (t - 0.3) / 0.3);
   if (t < 0.85) return mix(c2, c3, (t - 0.6) / 0.25);
   return mix(c3, c4, (t - 0.85) / 0.15);
+}
+
+// A user's ramp: linear between stops, the end colours beyond them (gdaldem color-relief).
+vec3 userRamp(float e) {
+  if (!(e > uRampElev[0])) return uRampColour[0];
+  for (int i = 1; i < uRampCount; ++i) {
+    if (e < uRampElev[i]) {
+      float t = (e - uRampElev[i - 1]) / max(uRampElev[i] - uRampElev[i - 1], 1e-6);
+      return mix(uRampColour[i - 1], uRampColour[i], t);
+    }
+  }
+  return uRampColour[uRampCount - 1];
 }
 
 void main() {
@@ -108,6 +123,7 @@ void main() {
   float t = clamp((elev - uElevRange.x) / max(uElevRange.y - uElevRange.x, 1.0), 0.0, 1.0);
   vec3 albedo = uPalette == 1   ? mix(vec3(0.30), vec3(0.80), t)
                 : uPalette == 2 ? mix(vec3(0.42, 0.20, 0.10), vec3(0.85, 0.62, 0.42), t)
+                : uPalette == 3 ? userRamp(elev)
                                 : hypsometric(t);
   if (uHasLayers != 0) {
     vec4 thick = textureLod(uLayers, uv, lod);

@@ -50,6 +50,16 @@ FrameState::~FrameState() {
   previous_.restore();
 }
 
+}  // namespace detail
+
+Palette paletteFor(const gis::Body& body) {
+  if (body.name == gis::Body::moon().name) return Palette::Grey;
+  if (body.name == gis::Body::mars().name) return Palette::Rust;
+  return Palette::Hypsometric;
+}
+
+namespace detail {
+
 Status setCommonUniforms(const gl::Program& p, const TerrainScene& scene, const FrameGeometry& frame,
                          const Shading& shading, const glm::dmat4& viewProj) {
   const auto& c = scene.georef().transform.c;
@@ -101,6 +111,16 @@ Status setCommonUniforms(const gl::Program& p, const TerrainScene& scene, const 
   if (shading.seaLevelM) tint.x = std::max(tint.x, *shading.seaLevelM);
   p.set("uElevRange", shading.tintRangeM.value_or(tint));
   p.set("uPalette", int(shading.palette));
+  if (shading.palette == Palette::Ramp) {
+    const int n = int(std::min(shading.ramp.elevationsM.size(), size_t(ColourRamp::kMaxStops)));
+    if (n == 0) return fail("render: the user colour ramp has no stops");
+    p.set("uRampCount", n);
+    for (int k = 0; k < n; ++k) {
+      const std::string i = "[" + std::to_string(k) + "]";
+      p.set(("uRampElev" + i).c_str(), shading.ramp.elevationsM[size_t(k)]);
+      p.set(("uRampColour" + i).c_str(), shading.ramp.colours[size_t(k)]);
+    }
+  }
   glm::vec3 sun = glm::normalize(shading.sunDir);
   if (shading.subsolarLonLat) {
     // The sun fixed on the body, seen from the viewer's place (a projected DEM's centre).

@@ -99,7 +99,9 @@ TEST(Sun, AWallsShadowIsItsHeightOverTheTangentOfTheSunsElevation) {
     // Twice the exaggeration, twice the shadow.
     const auto lit2 = castShadows(heights, g, sun, 2.0f);
     const int x2 = int((topEdgeM + 1.8 * length) / 10);
-    if (x2 < 200) EXPECT_LT(lit2.at(x2, 20), 0.05f) << elev;
+    if (x2 < 200) {
+      EXPECT_LT(lit2.at(x2, 20), 0.05f) << elev;
+    }
   }
   // From the east the wall shades the west side instead; the sun below the horizon lights nothing.
   SunSpec east;
@@ -129,8 +131,11 @@ TEST(Sun, ASubsolarPointLightsEachCellOfAGlobalGridFromItsOwnSky) {
     for (int x = 0; x < 180; ++x) {
       const double lon = -180 + 2 * (x + 0.5), lat = 90 - 2 * (y + 0.5);
       const double cosAngle = std::cos(lon * std::numbers::pi / 180) * std::cos(lat * std::numbers::pi / 180);
-      if (cosAngle > 0.02) EXPECT_EQ(lit.at(x, y), 1.0f) << lon << " " << lat;
-      if (cosAngle < -0.02) EXPECT_EQ(lit.at(x, y), 0.0f) << lon << " " << lat;
+      if (cosAngle > 0.02) {
+        EXPECT_EQ(lit.at(x, y), 1.0f) << lon << " " << lat;
+      } else if (cosAngle < -0.02) {
+        EXPECT_EQ(lit.at(x, y), 0.0f) << lon << " " << lat;
+      }
     }
   }
 }

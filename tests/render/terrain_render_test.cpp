@@ -12,6 +12,7 @@
 
 #include <strata/gis/dem_io.hpp>
 #include <strata/gis/geodesy.hpp>
+#include <strata/render/colour_ramp.hpp>
 #include <strata/render/drape.hpp>
 #include <strata/render/image_io.hpp>
 #include <strata/render/overlay.hpp>
@@ -833,6 +834,49 @@ TEST_F(GlTest, TheSunFixedOnTheEarthLightsItsDaySideFromOrbit) {
   EXPECT_NEAR(nightRight / fixedRight, 0.25, 0.05);  // ambient only: 0.25 of an overhead sun's light
   auto img = colourImage(*target);
   ASSERT_TRUE(writeImage8((test::outputDir("render") / "earth_terminator.png").string(), w, h, 4, img.pixels));
+}
+
+TEST_F(GlTest, AUserRampColoursEachTerraceByItsElevation) {
+  // Three flat terraces (100, 550 and 1400 m) seen from above under an overhead sun (full light):
+  // each terrace's pixels are the gdaldem-format ramp's colour at its elevation (2/255), the
+  // 550 m one half way between the 100 and 1000 m stops.
+  gis::Raster dem;
+  dem.georef.width = 60;
+  dem.georef.height = 20;
+  dem.georef.body = gis::Body::wgs84();
+  dem.georef.transform = gis::GeoTransform{{0, 10, 0, 200, 0, -10}};
+  dem.values = gis::Grid<float>(60, 20, 100.0f);
+  for (int y = 0; y < 20; ++y) {
+    for (int x = 20; x < 60; ++x) dem.values.at(x, y) = x < 40 ? 550.0f : 1400.0f;
+  }
+  auto scene = TerrainScene::create(dem);
+  ASSERT_TRUE(scene) << scene.message();
+  const auto path = test::tempDir("ramp_gl") / "ramp.txt";
+  std::ofstream(path) << "100 200 40 40\n1000 40 40 200\n1200 40 200 40\n";
+  Shading shading;
+  auto ramp = loadColourRamp(path.string(), scene->minElevationM(), scene->maxElevationM());
+  ASSERT_TRUE(ramp) << ramp.message();
+  shading.ramp = *ramp;
+  shading.palette = Palette::Ramp;
+  shading.sunDir = {0, 0, 1};
+  auto ring = RingRenderer::create({.circles = 64});
+  ASSERT_TRUE(ring) << ring.message();
+  const int w = 120, h = 40;
+  auto target = OffscreenTarget::create(w, h);
+  ASSERT_TRUE(target) << target.message();
+  // 600 m wide view of the 600 m strip: 5 m a pixel, terraces 40 pixels each.
+  const double fov = 2 * std::atan(300.0 * h / w / 3000.0) * 180 / std::numbers::pi;
+  const CameraPose cam{.lon = 300, .lat = 100, .heightM = 4400, .headingDeg = 0, .pitchDeg = -90, .fovYDeg = fov};
+  ASSERT_TRUE((*ring)->draw(*scene, cam, shading, *target));
+  const auto c = target->colour();
+  for (const auto& [x, e] : {std::pair{20, 100.0f}, {60, 550.0f}, {100, 1400.0f}}) {
+    const glm::vec3 want = 255.0f * ramp->at(e);
+    const uint8_t* p = &c[(size_t(h / 2) * size_t(w) + size_t(x)) * 4];
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(p[k], want[k], 2.0) << "terrace " << e << " channel " << k;
+  }
+  EXPECT_EQ(paletteFor(gis::Body::moon()), Palette::Grey);
+  EXPECT_EQ(paletteFor(gis::Body::mars()), Palette::Rust);
+  EXPECT_EQ(paletteFor(gis::Body::wgs84()), Palette::Hypsometric);
 }
 
 TEST_F(GlTest, RainierRidgeCloseViewMatchesGoldenImage) {

@@ -17,6 +17,7 @@
 #include <strata/core/result.hpp>
 #include <strata/gis/raster.hpp>
 #include <strata/gl/objects.hpp>
+#include <strata/render/colour_ramp.hpp>
 #include <strata/render/drape.hpp>
 #include <strata/render/ring_mesh.hpp>
 #include <strata/render/streamed_elevation.hpp>
@@ -34,8 +35,10 @@ struct CameraPose {
   double fovYDeg = 45;    ///< vertical field of view (deg)
 };
 
-/// Colour ramp over elevation.
-enum class Palette { Hypsometric, Grey, Rust };
+/// Colour ramp over elevation: Ramp is Shading::ramp (a user's gdaldem color-relief file).
+enum class Palette { Hypsometric, Grey, Rust, Ramp };
+/// A body's own colours: grey (albedo-like) for the Moon, rust for Mars, hypsometric otherwise.
+Palette paletteFor(const gis::Body& body);
 
 /// How the terrain looks; uniform over a frame.
 struct Shading {
@@ -60,6 +63,7 @@ struct Shading {
   /// geographic DEM, at the DEM's centre on a projected one), so a body shows its night side.
   std::optional<glm::dvec2> subsolarLonLat;
   float ambient = 0.25f;  ///< light on surfaces facing away from the sun or in shadow, 0 to 1
+  ColourRamp ramp;        ///< the elevation colours when palette is Palette::Ramp
   std::array<glm::vec3, 4> layerColours{glm::vec3(0.76f, 0.70f, 0.50f), glm::vec3(0.45f, 0.35f, 0.25f),
                                         glm::vec3(0.30f, 0.45f, 0.20f), glm::vec3(0.9f, 0.9f, 0.95f)};
 };
