@@ -16,6 +16,7 @@
 // its EPSG:3857 version (GDAL's warp with the exact transformer, then the ramp), and the frame
 // time with and without a drape, side by side.
 // Cast shadows (BM_CastShadows): the horizon search on the CPU at three sun elevations.
+// The look (BM_LookFrame): frames plain, with sky and air, with cast shadows, with MSAA 4.
 // Figures: docs/benchmarks.md ("Render").
 #include <benchmark/benchmark.h>
 
@@ -73,13 +74,12 @@ Setup& synthetic(int size) {
 // Renders with `renderer` until the benchmark is done; reports GPU time as the iteration time
 // and the CPU submission time, triangles/s and screen-space error as counters.
 void runFrames(benchmark::State& state, TerrainRenderer& renderer, const TerrainScene& scene, const CameraPose& camera,
-               int w, int h) {
-  auto target = OffscreenTarget::create(w, h);
+               int w, int h, const Shading& shading = {}, int samples = 1) {
+  auto target = OffscreenTarget::create(w, h, samples);
   if (!target) {
     state.SkipWithError(target.message().c_str());
     return;
   }
-  const Shading shading;
   if (auto s = renderer.draw(scene, camera, shading, *target); !s) {  // warm-up: compiles, uploads
     state.SkipWithError(s.message().c_str());
     return;
@@ -398,6 +398,36 @@ void BM_DrapeFrame(benchmark::State& state) {
   runFrames(state, **ring, *scene, cam, 960, 540);
 }
 BENCHMARK(BM_DrapeFrame)->ArgName("drape")->Arg(0)->Arg(1)->UseManualTime()->Unit(benchmark::kMillisecond);
+
+// The look's costs side by side (ring 256 circles, 960 x 540, the Grand Canyon from 3 km):
+// 0 plain, 1 the sky pass and aerial perspective (Earth's air), 2 cast shadows (the lighting's
+// extra texture read), 3 MSAA with 4 samples.
+void BM_LookFrame(benchmark::State& state) {
+  strata::bench::sharedContext();
+  auto dem = gis::readDem(kDrapeRaster);
+  if (!dem) return state.SkipWithError(dem.message().c_str());
+  auto scene = TerrainScene::create(*dem);
+  if (!scene) return state.SkipWithError(scene.message().c_str());
+  auto ring = RingRenderer::create({.circles = 256});
+  if (!ring) return state.SkipWithError(ring.message().c_str());
+  Shading shading;
+  int samples = 1;
+  const char* labels[] = {"plain", "sky and air", "cast shadows", "MSAA 4"};
+  if (state.range(0) == 1) shading.atmosphere = atmosphereFor(scene->georef().body);
+  if (state.range(0) == 2) {
+    shading.sunDir = glm::vec3(sunDirectionEnu(250.0, 20.0));
+    if (auto st = scene->castShadows({.subsolarLonLat = std::nullopt, .dirEnu = glm::dvec3(shading.sunDir)}, 1.0f);
+        !st) {
+      return state.SkipWithError(st.message().c_str());
+    }
+  }
+  if (state.range(0) == 3) samples = 4;
+  const double x = -112.3, y = 36.3;
+  const CameraPose cam{.lon = x, .lat = y, .heightM = scene->heightAt(x, y) + 2500, .headingDeg = 120, .pitchDeg = -10};
+  state.SetLabel(labels[state.range(0)]);
+  runFrames(state, **ring, *scene, cam, 960, 540, shading, samples);
+}
+BENCHMARK(BM_LookFrame)->ArgName("look")->DenseRange(0, 3)->UseManualTime()->Unit(benchmark::kMillisecond);
 
 // Cast shadows on the CPU (castShadows, OpenMP over rows) for the Grand Canyon's 512^2 cells at
 // a sun elevation of range(0) degrees from the west: the lower the sun, the farther each cell's

@@ -138,6 +138,12 @@ Status applyPalette(const std::string& palette, const render::TerrainScene& scen
 }  // namespace
 
 void addViewOptions(CLI::App& cmd, ViewArgs& a) {
+  cmd.add_option("--sky", a.sky,
+                 "air (a sky and aerial perspective from the body's atmosphere; the default on the Earth and Mars) or "
+                 "flat (one colour, with --fog's haze)")
+      ->check(CLI::IsMember({"air", "flat"}));
+  cmd.add_option("--msaa", a.msaa, "Samples a pixel: 1 (none), 2, 4 or 8 (antialiased edges)")
+      ->check(CLI::IsMember({1, 2, 4, 8}));
   cmd.add_option("--palette", a.palette,
                  "Elevation colours: hypsometric, grey, rust or a gdaldem color-relief file (default: the body's: grey "
                  "on the Moon, rust on Mars)");
@@ -147,6 +153,10 @@ void addViewOptions(CLI::App& cmd, ViewArgs& a) {
 
 Status applyView(const ViewArgs& a, render::TerrainScene& scene, render::Shading& shading) {
   STRATA_TRY_STATUS(applyPalette(a.palette, scene, shading));
+  const auto& body = scene.georef().body;
+  shading.atmosphere = a.sky == "flat" ? std::nullopt : render::atmosphereFor(body);
+  if (a.sky == "air" && !shading.atmosphere)
+    return fail("--sky air: " + body.name + " has no atmosphere known to Strata");
   STRATA_TRY_STATUS(applyMapLayers(a.layers, scene, shading));
   return applyLight(a.light, scene, shading);
 }

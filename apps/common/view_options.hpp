@@ -30,18 +30,20 @@ struct LightArgs {
 
 struct ViewArgs {
   std::string palette;  ///< hypsometric, grey, rust or a gdaldem color-relief file; empty: the body's
+  std::string sky;      ///< air or flat; empty: air where the body has an atmosphere
+  int msaa = 1;         ///< samples a pixel (the caller creates its target with them)
   MapLayerArgs layers;
   LightArgs light;
 };
 
-/// --palette; --drape, --drape-opacity, --drape-range, --drape-hide-below, --graticule,
+/// --palette, --sky, --msaa; --drape, --drape-opacity, --drape-range, --drape-hide-below, --graticule,
 /// --scale-bar; --sun, --sun-at, --time, --shadows, --ambient.
 void addViewOptions(CLI::App& cmd, ViewArgs& a);
 
 /// Sets the palette (by default the body's: grey for the Moon, rust for Mars, hypsometric
-/// otherwise), loads the drape and the graticule's lon/lat onto `scene`, places the sun and casts
-/// shadows (at shading.exaggeration, so set that first). The scale bar is drawn by the caller
-/// after each frame. Fails naming the option and the file; prints what it loaded.
+/// otherwise) and the sky (by default the body's air, if it has one), loads the drape and the graticule's lon/lat onto
+/// `scene`, places the sun and casts shadows (at shading.exaggeration, so set that first). The scale bar is drawn by
+/// the caller after each frame. Fails naming the option and the file; prints what it loaded.
 Status applyView(const ViewArgs& a, render::TerrainScene& scene, render::Shading& shading);
 
 }  // namespace strata::apps

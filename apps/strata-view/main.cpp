@@ -140,6 +140,7 @@ int run(const Args& a) {
   options.softMinM = a.softMinM;
   options.shading.exaggeration = a.exaggeration;
   options.scaleBar = a.view.layers.scaleBar;
+  options.samples = a.view.msaa;
   if (a.planetary) options.shading.sky = {0, 0, 0, 1};
   auto viewer = Viewer::create(dem, options);
   if (!viewer) {

@@ -208,7 +208,7 @@ void run(const RenderArgs& a) {
   if (auto st = apps::applyView(a.view, *scene, shading); !st) die(st.message());
   auto renderer = makeRenderer(a);
   if (!renderer) die(renderer.message());
-  auto target = OffscreenTarget::create(w, h);
+  auto target = OffscreenTarget::create(w, h, a.view.msaa);
   if (!target) die(target.message());
 
   // The camera: default over the DEM's centre, 1000 m above the ground.

@@ -111,6 +111,19 @@ Texture Texture::create2D(TextureFormat format, int width, int height, int level
   return t;
 }
 
+Texture Texture::create2DMultisample(TextureFormat format, int width, int height, int samples) {
+  STRATA_CHECK(width > 0 && height > 0 && samples >= 1)
+      << "multisample texture " << width << "x" << height << " x" << samples;
+  Texture t;
+  static_cast<Object&>(t) = Object(createTexture(GL_TEXTURE_2D_MULTISAMPLE));
+  t.format_ = format;
+  t.width_ = width;
+  t.height_ = height;
+  t.levels_ = 1;
+  glTextureStorage2DMultisample(t.id(), samples, detail::glFormat(format).internal, width, height, GL_TRUE);
+  return t;
+}
+
 Texture Texture::create2DArray(TextureFormat format, int width, int height, int layers, int levels) {
   STRATA_CHECK(width > 0 && height > 0 && layers > 0) << "texture array " << width << "x" << height << "x" << layers;
   Texture t;
@@ -261,6 +274,24 @@ void Framebuffer::blitColourToWindow(int index, glm::ivec2 from, glm::ivec2 to, 
   glNamedFramebufferReadBuffer(id(), GLenum(GL_COLOR_ATTACHMENT0 + index));
   glBlitNamedFramebuffer(id(), 0, 0, 0, from.x, from.y, 0, 0, to.x, to.y, GL_COLOR_BUFFER_BIT,
                          filter == Filter::kNearest ? GL_NEAREST : GL_LINEAR);
+}
+
+void Framebuffer::resolveTo(const Framebuffer& dst, glm::ivec2 size) const {
+  // A blit writes every draw buffer of the destination: one attachment at a time, then the
+  // destination's draw buffers as attachColour set them.
+  for (int i = 0; i < 8; ++i) {
+    if (!((colourMask_ >> i) & 1u) || !((dst.colourMask_ >> i) & 1u)) continue;
+    glNamedFramebufferReadBuffer(id(), GLenum(GL_COLOR_ATTACHMENT0 + i));
+    glNamedFramebufferDrawBuffer(dst.id(), GLenum(GL_COLOR_ATTACHMENT0 + i));
+    glBlitNamedFramebuffer(id(), dst.id(), 0, 0, size.x, size.y, 0, 0, size.x, size.y, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+  }
+  glBlitNamedFramebuffer(id(), dst.id(), 0, 0, size.x, size.y, 0, 0, size.x, size.y, GL_DEPTH_BUFFER_BIT, GL_NEAREST);
+  GLenum buffers[8];
+  int count = 0;
+  for (int i = 0; i < 8 && (dst.colourMask_ >> i); ++i) {
+    buffers[count++] = (dst.colourMask_ >> i) & 1u ? GLenum(GL_COLOR_ATTACHMENT0 + i) : GLenum(GL_NONE);
+  }
+  glNamedFramebufferDrawBuffers(dst.id(), count, buffers);
 }
 
 VertexArray VertexArray::create() {

@@ -3,6 +3,7 @@
 // cast shadows, a hypsometric tint, material layers blended by thickness, a draped raster, water
 // coloured by depth, a graticule, haze.
 #include "terrain_common.glsl"
+#include "atmosphere.glsl"
 
 in VertexData {
   vec3 rel;
@@ -174,6 +175,16 @@ void main() {
     vec2 px = abs(fract(g + 0.5) - 0.5) / fw;
     vec2 line = (1.0 - smoothstep(0.75, 1.5, px)) * (1.0 - smoothstep(0.1, 0.2, fw));
     colour = mix(colour, vec3(1.0), 0.8 * max(line.x, line.y));
+  }
+  if (uHasAir != 0) {
+    // Aerial perspective: the air between the viewer and the point dims it and adds the light it
+    // scatters (atmosphere.glsl), from the viewer's altitude to the point's.
+    float len = length(fs.rel);
+    float z1 = uPlanetary == 0 ? uCamZ + fs.rel.z : elev * uExaggeration;
+    vec3 transmittance;
+    vec3 air = airLight(airColumn(uCamZ, z1, len, uAirRayleighScaleM), airColumn(uCamZ, z1, len, uAirHazeScaleM),
+                        airSunAt(up, uSunDir), transmittance);
+    colour = colour * transmittance + air;
   }
   if (uFogM > 0.0) colour = mix(colour, uSky.rgb, 1.0 - exp(-length(fs.rel) / uFogM));
 

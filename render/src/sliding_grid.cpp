@@ -79,6 +79,7 @@ Result<std::unique_ptr<SlidingGridRenderer>> SlidingGridRenderer::create(const S
   auto r = std::make_unique<SlidingGridRenderer>();
   r->params_ = params;
   r->program_ = std::move(program);
+  STRATA_TRY(r->sky_, detail::createSkyProgram());
   const auto mesh = SlidingGridMesh::build(params);
   r->vertices_ = gl::Buffer::from(std::span<const glm::vec3>(mesh.vertices), gl::BufferStorage::kImmutable);
   r->indices_ = gl::Buffer::from(std::span<const uint32_t>(mesh.triangles), gl::BufferStorage::kImmutable);
@@ -98,6 +99,7 @@ Status SlidingGridRenderer::draw(const TerrainScene& scene, const CameraPose& ca
   const double step = double(1 << (params_.levels - 1));
   const glm::dvec2 origin = glm::round(tCam / step) * step;
   detail::FrameState state(target, shading.sky);
+  detail::drawSky(sky_, vao_, scene, frame, shading, observer ? *observer : frame.viewProj());
   STRATA_TRY_STATUS(
       detail::setCommonUniforms(program_, scene, frame, shading, observer ? *observer : frame.viewProj()));
   program_.set("uOriginFromViewer", glm::vec2(origin - tCam));

@@ -35,7 +35,7 @@ bool isGlobalInLongitude(const gis::Georef& g) {
 namespace detail {
 
 FrameState::FrameState(const OffscreenTarget& target, const glm::vec4& sky)
-    : previous_(gl::FramebufferBinding::current()) {
+    : previous_(gl::FramebufferBinding::current()), target_(target) {
   target.bind();
   gl::setViewport({0, 0, target.width(), target.height()});
   gl::setClipDepth(gl::ClipDepth::kZeroToOne);
@@ -45,6 +45,7 @@ FrameState::FrameState(const OffscreenTarget& target, const glm::vec4& sky)
 }
 
 FrameState::~FrameState() {
+  target_.resolve();
   gl::setClipDepth(gl::ClipDepth::kMinusOneToOne);
   gl::setDepthTest(gl::DepthTest::kOff);
   previous_.restore();
@@ -59,6 +60,57 @@ Palette paletteFor(const gis::Body& body) {
 }
 
 namespace detail {
+
+namespace {
+// Towards the sun in the viewer's frame: Shading::sunDir, or from the subsolar point at the
+// viewer's place (a projected DEM's centre).
+glm::vec3 sunInViewerFrame(const TerrainScene& scene, const FrameGeometry& frame, const Shading& shading) {
+  glm::vec3 sun = glm::normalize(shading.sunDir);
+  if (shading.subsolarLonLat) {
+    const glm::dvec2 place =
+        scene.georef().geographic ? glm::dvec2(frame.lonRad / kDeg, frame.latRad / kDeg) : scene.centreLonLat();
+    if (std::isfinite(place.x) && std::isfinite(place.y)) {
+      sun = glm::vec3(sunDirectionEnu(*shading.subsolarLonLat, place.x, place.y));
+    }
+  }
+  return sun;
+}
+
+// atmosphere.glsl's uniforms.
+void setAirUniforms(const gl::Program& p, const TerrainScene& scene, const FrameGeometry& frame, const Shading& shading,
+                    const glm::vec3& sun) {
+  p.set("uHasAir", shading.atmosphere ? 1 : 0);
+  if (!shading.atmosphere) return;
+  const Atmosphere& a = *shading.atmosphere;
+  p.set("uAirRayleigh", a.rayleighPerM);
+  p.set("uAirRayleighScaleM", a.rayleighScaleM);
+  p.set("uAirHaze", a.hazePerM);
+  p.set("uAirHazeScaleM", a.hazeScaleM);
+  p.set("uAirHazeColour", a.hazeColour);
+  p.set("uAirBrightness", a.brightness);
+  p.set("uAirRadius", float(scene.radiusM()));
+  // Sunlight on the air at the viewer, as atmosphere.glsl's airSunAt.
+  const float s = std::clamp((sun.z + 0.1f) / 0.24f, 0.0f, 1.0f);
+  p.set("uAirSun", s * s * (3 - 2 * s));
+  (void)frame;
+}
+}  // namespace
+
+Result<gl::Program> createSkyProgram() {
+  return gl::Program::graphics("render/shaders/sky.vert", "render/shaders/sky.frag", gl::definesFor(slots::kAll));
+}
+
+void drawSky(const gl::Program& sky, const gl::VertexArray& vao, const TerrainScene& scene, const FrameGeometry& frame,
+             const Shading& shading, const glm::dmat4& viewProj) {
+  if (!shading.atmosphere) return;
+  sky.use();
+  sky.set("uInvViewProj", toFloat(glm::inverse(viewProj)));
+  sky.set("uSkyAltM", float(frame.camZ));
+  setAirUniforms(sky, scene, frame, shading, sunInViewerFrame(scene, frame, shading));
+  gl::setDepthTest(gl::DepthTest::kOff);
+  vao.drawArrays(gl::Primitive::kTriangles, 0, 3);
+  gl::setDepthTest(gl::DepthTest::kGreater, true);
+}
 
 Status setCommonUniforms(const gl::Program& p, const TerrainScene& scene, const FrameGeometry& frame,
                          const Shading& shading, const glm::dmat4& viewProj) {
@@ -121,16 +173,9 @@ Status setCommonUniforms(const gl::Program& p, const TerrainScene& scene, const 
       p.set(("uRampColour" + i).c_str(), shading.ramp.colours[size_t(k)]);
     }
   }
-  glm::vec3 sun = glm::normalize(shading.sunDir);
-  if (shading.subsolarLonLat) {
-    // The sun fixed on the body, seen from the viewer's place (a projected DEM's centre).
-    const glm::dvec2 place =
-        scene.georef().geographic ? glm::dvec2(frame.lonRad / kDeg, frame.latRad / kDeg) : scene.centreLonLat();
-    if (std::isfinite(place.x) && std::isfinite(place.y)) {
-      sun = glm::vec3(sunDirectionEnu(*shading.subsolarLonLat, place.x, place.y));
-    }
-  }
+  const glm::vec3 sun = sunInViewerFrame(scene, frame, shading);
   p.set("uSunDir", sun);
+  setAirUniforms(p, scene, frame, shading, sun);
   p.set("uPole", glm::vec3(frame.frameRot * frame.poleAux));
   p.set("uSky", shading.sky);
   p.set("uFogM", shading.fogM);
@@ -532,13 +577,25 @@ FrameGeometry frameGeometry(const TerrainScene& scene, const CameraPose& camera,
 
 // ---- OffscreenTarget ---------------------------------------------------------------------------
 
-Result<OffscreenTarget> OffscreenTarget::create(int width, int height) {
+Result<OffscreenTarget> OffscreenTarget::create(int width, int height, int samples) {
   if (width <= 0 || height <= 0 || width > 16384 || height > 16384) {
     return fail("render: image size " + std::to_string(width) + "x" + std::to_string(height) + " out of range");
   }
+  if (samples < 1 || samples > 8) return fail("render: " + std::to_string(samples) + " samples a pixel: 1 to 8");
   OffscreenTarget t;
   t.width_ = width;
   t.height_ = height;
+  t.samples_ = samples;
+  if (samples > 1) {
+    t.msColour_ = gl::Texture::create2DMultisample(gl::TextureFormat::kRGBA8, width, height, samples);
+    t.msElevation_ = gl::Texture::create2DMultisample(gl::TextureFormat::kR32F, width, height, samples);
+    t.msDepth_ = gl::Texture::create2DMultisample(gl::TextureFormat::kDepth32F, width, height, samples);
+    t.msFbo_ = gl::Framebuffer::create();
+    t.msFbo_.attachColour(0, t.msColour_);
+    t.msFbo_.attachColour(1, t.msElevation_);
+    t.msFbo_.attachDepth(t.msDepth_);
+    STRATA_TRY_STATUS(t.msFbo_.check());
+  }
   t.colour_ = gl::Texture::create2D(gl::TextureFormat::kRGBA8, width, height, 1);
   t.elevation_ = gl::Texture::create2D(gl::TextureFormat::kR32F, width, height, 1);
   t.depth_ = gl::Texture::create2D(gl::TextureFormat::kDepth32F, width, height, 1);
@@ -553,13 +610,18 @@ Result<OffscreenTarget> OffscreenTarget::create(int width, int height) {
   return t;
 }
 
-void OffscreenTarget::bind() const { fbo_.bind(); }
+void OffscreenTarget::bind() const { (samples_ > 1 ? msFbo_ : fbo_).bind(); }
+
+void OffscreenTarget::resolve() const {
+  if (samples_ > 1) msFbo_.resolveTo(fbo_, {width_, height_});
+}
 void OffscreenTarget::bindColourOnly() const { colourFbo_.bind(); }
 
 void OffscreenTarget::clear(const glm::vec4& sky) const {
-  fbo_.clearColour(0, sky);
-  fbo_.clearColour(1, glm::vec4(std::numeric_limits<float>::quiet_NaN(), 0, 0, 0));
-  fbo_.clearDepth(0.0f);
+  const gl::Framebuffer& f = samples_ > 1 ? msFbo_ : fbo_;
+  f.clearColour(0, sky);
+  f.clearColour(1, glm::vec4(std::numeric_limits<float>::quiet_NaN(), 0, 0, 0));
+  f.clearDepth(0.0f);
 }
 
 namespace {
@@ -615,6 +677,7 @@ Result<std::unique_ptr<RingRenderer>> RingRenderer::create(const RingParams& par
   auto r = std::make_unique<RingRenderer>();
   r->params_ = params;
   r->program_ = std::move(program);
+  STRATA_TRY(r->sky_, detail::createSkyProgram());
   const auto mesh = RingMesh::build(params.circles);
   r->vertices_ = gl::Buffer::from(std::span<const glm::vec2>(mesh.vertices), gl::BufferStorage::kImmutable);
   r->indices_ = gl::Buffer::from(std::span<const uint32_t>(mesh.strip), gl::BufferStorage::kImmutable);
@@ -666,6 +729,7 @@ Status RingRenderer::draw(const TerrainScene& scene, const CameraPose& camera, c
   const FrameGeometry frame = frameGeometry(scene, camera, shading, target.width(), target.height());
   const RingLayout l = layout(scene, frame);
   detail::FrameState state(target, shading.sky);
+  detail::drawSky(sky_, vao_, scene, frame, shading, observer ? *observer : frame.viewProj());
   const auto& p = program_;
   STRATA_TRY_STATUS(detail::setCommonUniforms(p, scene, frame, shading, observer ? *observer : frame.viewProj()));
   p.set("uCircles", float(params_.circles));
@@ -688,6 +752,7 @@ Result<std::unique_ptr<GridRenderer>> GridRenderer::create() {
                                                  gl::definesFor(slots::kAll)));
   auto r = std::make_unique<GridRenderer>();
   r->program_ = std::move(program);
+  STRATA_TRY(r->sky_, detail::createSkyProgram());
   r->vao_ = gl::VertexArray::create();
   return r;
 }
@@ -714,6 +779,7 @@ Status GridRenderer::draw(const TerrainScene& scene, const CameraPose& camera, c
   }
   const FrameGeometry frame = frameGeometry(scene, camera, shading, target.width(), target.height());
   detail::FrameState state(target, shading.sky);
+  detail::drawSky(sky_, vao_, scene, frame, shading, observer ? *observer : frame.viewProj());
   STRATA_TRY_STATUS(
       detail::setCommonUniforms(program_, scene, frame, shading, observer ? *observer : frame.viewProj()));
   program_.use();

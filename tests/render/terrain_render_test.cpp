@@ -38,7 +38,8 @@ TEST_F(GlTest, ShadersUseTheSlotsDeclaredInCpp) {
                                  {{{"render/shaders/ring.vert", "render/shaders/terrain.frag"}},
                                   {{"render/shaders/grid.vert", "render/shaders/terrain.frag"}},
                                   {{"render/shaders/sliding.vert", "render/shaders/terrain.frag"}},
-                                  {{"render/shaders/overlay.vert", "render/shaders/overlay.frag"}}});
+                                  {{"render/shaders/overlay.vert", "render/shaders/overlay.frag"}},
+                                  {{"render/shaders/sky.vert", "render/shaders/sky.frag"}, std::nullopt, true}});
 }
 
 Image8 colourImage(const OffscreenTarget& t) { return {t.width(), t.height(), 4, t.colour()}; }
@@ -877,6 +878,155 @@ TEST_F(GlTest, AUserRampColoursEachTerraceByItsElevation) {
   EXPECT_EQ(paletteFor(gis::Body::moon()), Palette::Grey);
   EXPECT_EQ(paletteFor(gis::Body::mars()), Palette::Rust);
   EXPECT_EQ(paletteFor(gis::Body::wgs84()), Palette::Hypsometric);
+}
+
+TEST_F(GlTest, TheAirMakesABlueSkyAWhiteHorizonAndHazesDistantGround) {
+  // A flat plain 300 km across (1 km cells, 0 m) on the Earth, the sun high. From 1000 m up,
+  // looking 3 degrees down: the top of the sky is blue (blue well above red), the sky just above
+  // the horizon whiter and brighter; the ground just below the horizon (tens of km away) is less
+  // than half as far from that sky colour as the ground at the image's bottom (2.4 km away);
+  // no elevation in the sky. From 100 km up, the sky overhead is near black (no air above).
+  // Mars's horizon is butterscotch (red above blue); the Moon has no air.
+  gis::Raster dem;
+  dem.georef.width = dem.georef.height = 300;
+  dem.georef.body = gis::Body::wgs84();
+  dem.georef.transform = gis::GeoTransform{{0, 1000, 0, 300000, 0, -1000}};
+  dem.values = gis::Grid<float>(300, 300, 0.0f);
+  auto scene = TerrainScene::create(dem);
+  ASSERT_TRUE(scene) << scene.message();
+  auto ring = RingRenderer::create({.circles = 128});
+  ASSERT_TRUE(ring) << ring.message();
+  const int w = 64, h = 96;
+  auto target = OffscreenTarget::create(w, h);
+  ASSERT_TRUE(target) << target.message();
+  Shading shading;
+  shading.sunDir = glm::normalize(glm::vec3(0.3f, 0.2f, 1.0f));
+  shading.atmosphere = atmosphereFor(gis::Body::wgs84());
+  ASSERT_TRUE(shading.atmosphere);
+  CameraPose cam{.lon = 150000, .lat = 150000, .heightM = 1000, .headingDeg = 0, .pitchDeg = -3, .fovYDeg = 40};
+  ASSERT_TRUE((*ring)->draw(*scene, cam, shading, *target));
+  auto c = target->colour();
+  const auto elevation = target->elevation();
+  auto px = [&](int y) {
+    return glm::vec3(c[(size_t(y) * w + w / 2) * 4], c[(size_t(y) * w + w / 2) * 4 + 1],
+                     c[(size_t(y) * w + w / 2) * 4 + 2]);
+  };
+  const glm::vec3 top = px(1);
+  EXPECT_GT(top.b, 1.5f * top.r) << top.r << " " << top.g << " " << top.b;
+  EXPECT_TRUE(std::isnan(elevation[size_t(1) * w + w / 2]));
+  // The sky's last row above the ground, and the ground's distance row by row below it.
+  const auto frame = frameGeometry(*scene, cam, shading, w, h);
+  int horizon = -1;
+  for (int y = 0; y < h && horizon < 0; ++y) {
+    if (groundEnuAt(frame, *target, w / 2, y)) horizon = y - 1;
+  }
+  ASSERT_GT(horizon, 1);
+  const glm::vec3 skyLow = px(horizon);
+  EXPECT_GT(skyLow.r + skyLow.g + skyLow.b, top.r + top.g + top.b);
+  EXPECT_LT(skyLow.b - skyLow.r, top.b - top.r);  // whiter
+  // The first ground row (tens of km away) is nearer the sky's colour than the bottom row
+  // (2.4 km away): the air between hazes it.
+  const double farM = glm::length(*groundEnuAt(frame, *target, w / 2, horizon + 1));
+  const double nearM = glm::length(*groundEnuAt(frame, *target, w / 2, h - 1));
+  EXPECT_GT(farM, 10000.0);
+  EXPECT_LT(nearM, 3000.0);
+  const float farDiff = glm::length(px(horizon + 1) - skyLow), nearDiff = glm::length(px(h - 1) - skyLow);
+  EXPECT_LT(farDiff, 0.5f * nearDiff) << farM << " m: " << farDiff << ", " << nearM << " m: " << nearDiff;
+  EXPECT_EQ(elevation[size_t(h - 1) * w + w / 2], 0.0f);
+
+  cam.heightM = 1e5;
+  cam.pitchDeg = 60;
+  ASSERT_TRUE((*ring)->draw(*scene, cam, shading, *target));
+  c = target->colour();
+  const glm::vec3 space = px(1);
+  EXPECT_LT(space.r + space.g + space.b, 0.1f * (top.r + top.g + top.b));
+
+  auto mars = atmosphereFor(gis::Body::mars());
+  ASSERT_TRUE(mars);
+  dem.georef.body = gis::Body::mars();
+  auto marsScene = TerrainScene::create(dem);
+  ASSERT_TRUE(marsScene) << marsScene.message();
+  shading.atmosphere = mars;
+  cam = {.lon = 150000, .lat = 150000, .heightM = 1000, .headingDeg = 0, .pitchDeg = -3, .fovYDeg = 40};
+  ASSERT_TRUE((*ring)->draw(*marsScene, cam, shading, *target));
+  c = target->colour();
+  const glm::vec3 marsHorizon = px(horizon);
+  EXPECT_GT(marsHorizon.r, marsHorizon.b + 20) << marsHorizon.r << " " << marsHorizon.g << " " << marsHorizon.b;
+  EXPECT_FALSE(atmosphereFor(gis::Body::moon()));
+  auto img = colourImage(*target);
+  ASSERT_TRUE(writeImage8((test::outputDir("render") / "mars_horizon.png").string(), w, h, 4, img.pixels));
+}
+
+TEST_F(GlTest, MultisamplingBlendsTheEdgesItCrosses) {
+  // A face rising 1.5 m a metre eastwards from 200 m east to a plateau, the whole tilted up
+  // northwards, all one flat grey (ambient light only), seen from the west below its top: the
+  // skyline crosses the view slantwise. MSAA antialiases what triangles cover (not what the
+  // fragment shader discards): with 4 samples over a third of the columns' skyline pixels mix
+  // sky and terrain, without it under a twentieth; away from the skyline the pictures agree;
+  // elevation and depth are resolved.
+  gis::Raster dem;
+  dem.georef.width = dem.georef.height = 100;
+  dem.georef.body = gis::Body::wgs84();
+  dem.georef.transform = gis::GeoTransform{{0, 10, 0, 1000, 0, -10}};
+  dem.values = gis::Grid<float>(100, 100, 0.0f);
+  for (int y = 0; y < 100; ++y) {
+    for (int x = 0; x < 100; ++x) {
+      const double east = (x + 0.5) * 10, north = 1000 - (y + 0.5) * 10;
+      dem.values.at(x, y) = float(std::clamp(1.5 * (east - 200), 0.0, 750.0) + 0.3 * north);
+    }
+  }
+  auto scene = TerrainScene::create(dem);
+  ASSERT_TRUE(scene) << scene.message();
+  auto ring = RingRenderer::create({.circles = 128});
+  ASSERT_TRUE(ring) << ring.message();
+  Shading shading;
+  shading.ambient = 1;  // every surface the same colour: the tint's dark end
+  shading.palette = Palette::Grey;
+  shading.tintRangeM = glm::vec2(1e6f, 1e6f + 1);
+  const CameraPose cam{.lon = 100, .lat = 500, .heightM = 400, .headingDeg = 90, .pitchDeg = 25, .fovYDeg = 50};
+  const int w = 192, h = 128;
+  const glm::vec3 sky = 255.0f * glm::vec3(shading.sky);
+  // Per column, the skyline pixel (the first from the top that is not sky) as a mix of the sky
+  // and the terrain two pixels below it: its sky fraction is 0 without antialiasing (the pixel
+  // is terrain) and the covered fraction with it.
+  auto blendedColumns = [&](const OffscreenTarget& t) {
+    const auto c = t.colour();
+    auto at = [&](int x, int y) {
+      const uint8_t* p = &c[(size_t(y) * w + size_t(x)) * 4];
+      return glm::vec3(p[0], p[1], p[2]);
+    };
+    int count = 0;
+    for (int x = 0; x < w; ++x) {
+      for (int y = 0; y + 2 < h; ++y) {
+        if (glm::length(at(x, y) - sky) <= 6) continue;
+        const glm::vec3 terrain = at(x, y + 2), d = sky - terrain;
+        const float f = glm::dot(at(x, y) - terrain, d) / std::max(glm::dot(d, d), 1.0f);
+        if (f > 0.15f && f < 0.85f) ++count;
+        break;
+      }
+    }
+    return count;
+  };
+  auto plain = OffscreenTarget::create(w, h);
+  ASSERT_TRUE(plain) << plain.message();
+  ASSERT_TRUE((*ring)->draw(*scene, cam, shading, *plain));
+  auto msaa = OffscreenTarget::create(w, h, 4);
+  ASSERT_TRUE(msaa) << msaa.message();
+  EXPECT_EQ(msaa->samples(), 4);
+  ASSERT_TRUE((*ring)->draw(*scene, cam, shading, *msaa));
+  const int plainCount = blendedColumns(*plain), msaaCount = blendedColumns(*msaa);
+  EXPECT_LT(plainCount, w / 20);
+  EXPECT_GT(msaaCount, w / 3);
+  const auto a = plain->colour(), b = msaa->colour();
+  EXPECT_EQ(a[(size_t(h - 4) * w + w / 2) * 4 + 1], b[(size_t(h - 4) * w + w / 2) * 4 + 1]);
+  EXPECT_EQ(a[(size_t(2) * w + w / 2) * 4 + 2], b[(size_t(2) * w + w / 2) * 4 + 2]);
+  EXPECT_GT(msaa->elevation()[size_t(h - 4) * w + w / 2], 0.0f);
+  EXPECT_GT(msaa->depthAt(w / 2, h - 4), 0.0f);
+  EXPECT_FALSE(OffscreenTarget::create(w, h, 9));
+  auto img = colourImage(*msaa);
+  ASSERT_TRUE(writeImage8((test::outputDir("render") / "msaa_edge.png").string(), w, h, 4, img.pixels));
+  img = colourImage(*plain);
+  ASSERT_TRUE(writeImage8((test::outputDir("render") / "msaa_edge_plain.png").string(), w, h, 4, img.pixels));
 }
 
 TEST_F(GlTest, RainierRidgeCloseViewMatchesGoldenImage) {

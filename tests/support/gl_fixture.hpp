@@ -32,6 +32,7 @@ class GlTest : public ::testing::Test {
 struct SlotProgram {
   std::vector<std::string> shaders;                       ///< {comp} or {vert, frag}
   std::optional<gl::ShaderSource> source = std::nullopt;  ///< instead of `shaders`: a compute source (e.g. spliced)
+  bool bindsNothing = false;  ///< the program has no block, sampler or image (uniforms only): checked to have none
 };
 
 /// The binding-slot check of one library (docs/architecture.md, "The GL layer"): every program

@@ -42,7 +42,7 @@ Result<std::unique_ptr<Viewer>> Viewer::create(const gis::Raster& dem, const Vie
   std::unique_ptr<Viewer> v(new Viewer(std::move(scene), options));
   STRATA_TRY(v->renderer_, render::RingRenderer::create(
                                {.circles = options.circles, .softMinM = options.softMinM, .rangeM = options.rangeM}));
-  STRATA_TRY(auto target, render::OffscreenTarget::create(options.width, options.height));
+  STRATA_TRY(auto target, render::OffscreenTarget::create(options.width, options.height, options.samples));
   v->target_.emplace(std::move(target));
   STRATA_TRY(auto editor, TerrainEditor::create(v->scene_));
   v->editor_.emplace(std::move(editor));
@@ -64,7 +64,7 @@ Result<std::unique_ptr<Viewer>> Viewer::create(const gis::Raster& dem, const Vie
 
 Status Viewer::resize(int width, int height) {
   if (width == target_->width() && height == target_->height()) return {};
-  STRATA_TRY(auto target, render::OffscreenTarget::create(width, height));
+  STRATA_TRY(auto target, render::OffscreenTarget::create(width, height, options_.samples));
   target_.emplace(std::move(target));
   return {};
 }

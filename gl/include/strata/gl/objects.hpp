@@ -125,6 +125,9 @@ class Texture : public Object<detail::deleteTexture> {
   /// levels = 0: the full mip chain.
   static Texture create2D(TextureFormat format, int width, int height, int levels = 1);
   static Texture create2DArray(TextureFormat format, int width, int height, int layers, int levels = 1);
+  /// A multisampled 2D texture (`samples` per texel, fixed sample locations): a render target
+  /// to resolve into a plain texture (Framebuffer::resolveTo), not sampled or read directly.
+  static Texture create2DMultisample(TextureFormat format, int width, int height, int samples);
 
   int width() const { return width_; }
   int height() const { return height_; }
@@ -200,6 +203,10 @@ class Framebuffer : public Object<detail::deleteFramebuffer> {
   /// Copies colour attachment `index` (`from` pixels) to the window's framebuffer, scaled to
   /// `to` pixels with `filter`.
   void blitColourToWindow(int index, glm::ivec2 from, glm::ivec2 to, Filter filter) const;
+  /// Resolves this (multisampled) framebuffer into `dst` of the same size: each colour
+  /// attachment i into dst's attachment i (colours averaged over the samples) and the depth
+  /// (one sample).
+  void resolveTo(const Framebuffer& dst, glm::ivec2 size) const;
 
  private:
   uint32_t colourMask_ = 0;  // attached colour attachments

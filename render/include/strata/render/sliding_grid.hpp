@@ -42,7 +42,7 @@ class SlidingGridRenderer final : public TerrainRenderer {
 
  private:
   SlidingGridParams params_;
-  gl::Program program_;
+  gl::Program program_, sky_;
   gl::VertexArray vao_;
   gl::Buffer vertices_, indices_;
   int indexCount_ = 0;

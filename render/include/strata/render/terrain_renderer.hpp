@@ -17,6 +17,7 @@
 #include <strata/core/result.hpp>
 #include <strata/gis/raster.hpp>
 #include <strata/gl/objects.hpp>
+#include <strata/render/atmosphere.hpp>
 #include <strata/render/colour_ramp.hpp>
 #include <strata/render/drape.hpp>
 #include <strata/render/ring_mesh.hpp>
@@ -64,6 +65,9 @@ struct Shading {
   std::optional<glm::dvec2> subsolarLonLat;
   float ambient = 0.25f;  ///< light on surfaces facing away from the sun or in shadow, 0 to 1
   ColourRamp ramp;        ///< the elevation colours when palette is Palette::Ramp
+  /// The body's air (atmosphereFor): a sky along each pixel's ray and aerial perspective on the
+  /// terrain instead of the flat `sky` colour; none: the flat sky and `fogM`'s haze.
+  std::optional<Atmosphere> atmosphere;
   std::array<glm::vec3, 4> layerColours{glm::vec3(0.76f, 0.70f, 0.50f), glm::vec3(0.45f, 0.35f, 0.25f),
                                         glm::vec3(0.30f, 0.45f, 0.20f), glm::vec3(0.9f, 0.9f, 0.95f)};
 };
@@ -225,7 +229,13 @@ glm::dmat4 reversedInfinitePerspective(double fovYRad, double aspect, double nea
 /// 32F (reversed: 1 at the near plane, 0 = nothing drawn).
 class OffscreenTarget {
  public:
-  static Result<OffscreenTarget> create(int width, int height);
+  /// `samples` > 1: drawn multisampled (MSAA: edges antialiased), resolved into the plain
+  /// attachments when a renderer's draw ends; 1 to 8.
+  static Result<OffscreenTarget> create(int width, int height, int samples = 1);
+  int samples() const { return samples_; }
+  /// Multisampled targets: averages the samples into the attachments that colour(), depth(),
+  /// elevation(), depthAt() and blits read (the renderers call it at the end of each draw).
+  void resolve() const;
   int width() const { return width_; }
   int height() const { return height_; }
   void bind() const;
@@ -244,9 +254,11 @@ class OffscreenTarget {
   void blitColourToWindow(int width, int height) const;
 
  private:
-  int width_ = 0, height_ = 0;
+  int width_ = 0, height_ = 0, samples_ = 1;
   gl::Texture colour_, elevation_, depth_;
   gl::Framebuffer fbo_, colourFbo_;
+  gl::Texture msColour_, msElevation_, msDepth_;  // samples_ > 1: what is drawn into
+  gl::Framebuffer msFbo_;
 };
 
 /// A terrain renderer. draw() clears `target` and draws the scene.
@@ -304,7 +316,7 @@ class RingRenderer final : public TerrainRenderer {
 
  private:
   RingParams params_;
-  gl::Program program_;
+  gl::Program program_, sky_;
   gl::VertexArray vao_;
   gl::Buffer vertices_, indices_;
   int indexCount_ = 0;
@@ -324,7 +336,7 @@ class GridRenderer final : public TerrainRenderer {
   }
 
  private:
-  gl::Program program_;
+  gl::Program program_, sky_;
   gl::VertexArray vao_;
   gl::Buffer indices_;
   int gridW_ = 0, gridH_ = 0;

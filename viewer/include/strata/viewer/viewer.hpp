@@ -31,6 +31,7 @@ struct ViewerOptions {
   FlightParams flight;            ///< fly-through tuning
   bool showHud = true;            ///< draw the HUD (toggled with F2)
   bool scaleBar = false;          ///< draw a scale bar in the picture's bottom-left corner
+  int samples = 1;                ///< MSAA samples a pixel of the offscreen target (1 to 8)
 };
 
 /// The live simulation region: a window of the terrain simulated on the GPU.
