@@ -376,8 +376,8 @@ TEST_F(GlTest, CliRendersTheMoonsProjectedDemInPlanetaryMode) {
   }
 }
 
-// The poles (issue 17 item 4): from 75 degrees of latitude looking at the pole, the Earth's north,
-// the Moon's south and Mars's north. Before, the MIP level was chosen by a texel's north-south
+// The poles (issue 17 item 4): from 75 degrees of latitude looking at the pole, both poles of the
+// Earth, the Moon and Mars. Before, the MIP level was chosen by a texel's north-south
 // size while the columns converge at a pole (speckle radiating from it), the normals differenced
 // one column apart (a sliver of ground there: a starburst), and beyond the pole the latitude
 // formula divided 0 by 0 along the meridian opposite the viewer (a spike from the pole to the
@@ -406,15 +406,26 @@ TEST_P(PoleGolden, MatchesGoldenImage) {
 
 INSTANTIATE_TEST_SUITE_P(
     Bodies, PoleGolden,
-    ::testing::Values(PlanetView{"earth_north", "earth/etopo20.tif", gis::Body::wgs84(),
-                                 CameraPose{.lon = 0, .lat = 75, .heightM = 1.5e6, .headingDeg = 0, .pitchDeg = -50},
-                                 20.0f, Palette::Hypsometric, false},
-                      PlanetView{"moon_south", "moon/LDEM_4.LBL", gis::Body::moon(),
-                                 CameraPose{.lon = 0, .lat = -75, .heightM = 4e5, .headingDeg = 180, .pitchDeg = -50},
-                                 5.0f, Palette::Grey, false},
-                      PlanetView{"mars_north", "mars/mola_megdr_4ppd.vrt", gis::Body::mars(),
-                                 CameraPose{.lon = 0, .lat = 75, .heightM = 8e5, .headingDeg = 0, .pitchDeg = -50},
-                                 10.0f, Palette::Rust, false}),
+    ::testing::Values(
+        PlanetView{"earth_north", "earth/etopo20.tif", gis::Body::wgs84(),
+                   CameraPose{.lon = 0, .lat = 75, .heightM = 1.5e6, .headingDeg = 0, .pitchDeg = -50}, 20.0f,
+                   Palette::Hypsometric, false},
+        PlanetView{"moon_south", "moon/LDEM_4.LBL", gis::Body::moon(),
+                   CameraPose{.lon = 0, .lat = -75, .heightM = 4e5, .headingDeg = 180, .pitchDeg = -50}, 5.0f,
+                   Palette::Grey, false},
+        PlanetView{"mars_north", "mars/mola_megdr_4ppd.vrt", gis::Body::mars(),
+                   CameraPose{.lon = 0, .lat = 75, .heightM = 8e5, .headingDeg = 0, .pitchDeg = -50}, 10.0f,
+                   Palette::Rust, false},
+        // The other pole of each body, from the opposite side (lon 180 / 90 E / 120 W).
+        PlanetView{"earth_south", "earth/etopo20.tif", gis::Body::wgs84(),
+                   CameraPose{.lon = 180, .lat = -75, .heightM = 1.5e6, .headingDeg = 180, .pitchDeg = -50}, 20.0f,
+                   Palette::Hypsometric, false},
+        PlanetView{"moon_north", "moon/LDEM_4.LBL", gis::Body::moon(),
+                   CameraPose{.lon = 90, .lat = 75, .heightM = 4e5, .headingDeg = 0, .pitchDeg = -50}, 5.0f,
+                   Palette::Grey, false},
+        PlanetView{"mars_south", "mars/mola_megdr_4ppd.vrt", gis::Body::mars(),
+                   CameraPose{.lon = -120, .lat = -75, .heightM = 8e5, .headingDeg = 180, .pitchDeg = -50}, 10.0f,
+                   Palette::Rust, false}),
     [](const ::testing::TestParamInfo<PlanetView>& i) { return std::string(i.param.name); });
 
 class NoJitter : public GlTest, public ::testing::WithParamInterface<double> {};
