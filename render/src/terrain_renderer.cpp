@@ -374,6 +374,7 @@ void TerrainScene::writeHeights(int x, int y, const gis::Grid<float>& patch) {
   for (int j = 0; j < patch.height; ++j) {
     std::copy_n(&patch.data[size_t(j) * size_t(patch.width)], patch.width, &heights_.at(x, y + j));
   }
+  shadowsStale_ = shadowSun_.has_value();
 }
 
 void TerrainScene::heightsEditedOnGpu(int x, int y, int w, int h) {
@@ -382,6 +383,7 @@ void TerrainScene::heightsEditedOnGpu(int x, int y, int w, int h) {
   height_.generateMipmap();
   const auto window = height_.readRegion<float>(x, y, w, h);
   for (int j = 0; j < h; ++j) std::copy_n(&window[size_t(j) * size_t(w)], w, &heights_.at(x, y + j));
+  shadowsStale_ = shadowSun_.has_value();
 }
 
 void TerrainScene::writeLayers(int x, int y, int w, int h, const std::vector<float>& thicknessM) {
@@ -440,8 +442,13 @@ Status TerrainScene::castShadows(const SunSpec& sun, float exaggeration) {
   shadow_ = gl::Texture::create2D(gl::TextureFormat::kR32F, width(), height(), 0);
   shadow_.upload(lit.data.data());
   shadow_.generateMipmap();
+  shadowSun_ = sun;
+  shadowExaggeration_ = exaggeration;
+  shadowsStale_ = false;
   return {};
 }
+
+Status TerrainScene::recastShadows() { return shadowSun_ ? castShadows(*shadowSun_, shadowExaggeration_) : Status{}; }
 
 Status TerrainScene::enableGraticule() {
   if (streamed_) return fail("render: a graticule is drawn on whole-DEM scenes only (this one is streamed)");

@@ -270,6 +270,37 @@ TEST_F(ViewerGpu, MaterialBrushesMoveTheSurfaceWithTheLayerAndUndoBoth) {
   for (float t : editor->layers()) ASSERT_EQ(t, 0.0f);
 }
 
+TEST_F(ViewerGpu, ShadowsFollowABrushStrokeOnceItEnds) {
+  // Flat ground with shadows cast for a sun 10 degrees above the west: all lit. A raise of 60 m
+  // (radius 300 m) makes a hill; while the stroke lasts the shadows are not recast, after it
+  // the next frame casts them again and the ground east of the hill is in shadow, west of it lit.
+  ViewerOptions options;
+  options.width = 64;
+  options.height = 48;
+  options.circles = 32;
+  auto viewer = Viewer::create(planarDem(100, 100, [](int, int) { return 500.0f; }), options);
+  ASSERT_TRUE(viewer) << viewer.message();
+  auto& v = **viewer;
+  ASSERT_TRUE(
+      v.scene().castShadows({.subsolarLonLat = std::nullopt, .dirEnu = render::sunDirectionEnu(270.0, 10.0)}, 1.0f));
+  auto lit = [&] { return v.scene().shadowTexture()->read<float>(); };
+  for (float f : lit()) ASSERT_EQ(f, 1.0f);
+  auto& editor = v.editor();
+  editor.beginStroke();
+  ASSERT_TRUE(editor.dab(Brush{Tool::kRaise, 300.0 * v.scene().metresPerCrsUnit().x, 60.0}, {50.0, 50.0}));
+  EXPECT_TRUE(v.scene().shadowsStale());
+  ASSERT_TRUE(v.frame(0.0));
+  for (float f : lit()) ASSERT_EQ(f, 1.0f);  // mid-stroke: not yet
+  editor.endStroke();
+  ASSERT_TRUE(v.frame(0.0));
+  EXPECT_FALSE(v.scene().shadowsStale());
+  const auto after = lit();
+  // 8.5 cells (255 m) east of the top, 4.6 m up the hill's lee: the top 55 m higher is 12 degrees
+  // up, above the sun; as far west, on the sunward flank: lit.
+  EXPECT_LT(after[size_t(50) * 100 + 58], 0.05f);
+  EXPECT_EQ(after[size_t(50) * 100 + 41], 1.0f);
+}
+
 TEST_F(ViewerGpu, PickFindsTheGroundPointUnderThePixel) {
   // Flat ground at 500 m, 6 km square; the camera 1000 m above its centre looking north. The
   // centre pixel of an odd-sized image is the view axis: it meets the ground 1000 / tan(-pitch)

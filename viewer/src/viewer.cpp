@@ -459,6 +459,11 @@ Status Viewer::frame(double dtS) {
   auto& timer = gpuTimers_[frameIndex_ % 3];
   if (frameIndex_ >= 2) gpuFrameMs_ = gpuTimers_[(frameIndex_ + 1) % 3].milliseconds();
   timer.begin();
+  // Shadows follow edits once a stroke ends, and erosion's when the region is paused (casting
+  // them takes tens of milliseconds: not every frame of a stroke or a running simulation).
+  if (scene_.shadowsStale() && !editor_->inStroke() && !(region_ && region_->playing)) {
+    STRATA_TRY_STATUS(scene_.recastShadows());
+  }
   STRATA_TRY_STATUS(renderer_->draw(scene_, camera_->pose(), options_.shading, *target_));
   if (options_.scaleBar) hud_->drawScaleBarOver(*target_, scene_, camera_->pose(), options_.shading);
   timer.end();

@@ -123,6 +123,11 @@ class TerrainScene {
   /// CPU, a lit-fraction texture the lighting multiplies): recast them when the sun, the
   /// exaggeration or the heights change. Whole-DEM scenes only.
   Status castShadows(const SunSpec& sun, float exaggeration);
+  /// Whether heights changed (writeHeights, heightsEditedOnGpu) since the shadows were cast.
+  bool shadowsStale() const { return shadowsStale_; }
+  /// Casts the shadows again for the sun and exaggeration they were last cast with; nothing if
+  /// none were.
+  Status recastShadows();
   /// Lon/lat of every cell centre on the GPU (through the CRS's own datum for projected DEMs), so
   /// that Shading::graticuleDeg can draw lines of longitude and latitude. Whole-DEM scenes only.
   Status enableGraticule();
@@ -188,6 +193,9 @@ class TerrainScene {
   size_t voids_ = 0;
   gl::Texture height_, water_, layers_, sediment_, waterState_, voidMask_, drape_, lonLat_, shadow_;
   glm::dvec2 centreLonLat_{0.0, 0.0};
+  std::optional<SunSpec> shadowSun_;  // what the shadows were cast for
+  float shadowExaggeration_ = 1;
+  bool shadowsStale_ = false;
   std::shared_ptr<StreamedElevation> streamed_;
 };
 
