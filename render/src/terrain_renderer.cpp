@@ -77,8 +77,7 @@ glm::vec3 sunInViewerFrame(const TerrainScene& scene, const FrameGeometry& frame
 }
 
 // atmosphere.glsl's uniforms.
-void setAirUniforms(const gl::Program& p, const TerrainScene& scene, const FrameGeometry& frame, const Shading& shading,
-                    const glm::vec3& sun) {
+void setAirUniforms(const gl::Program& p, const TerrainScene& scene, const Shading& shading, const glm::vec3& sun) {
   p.set("uHasAir", shading.atmosphere ? 1 : 0);
   if (!shading.atmosphere) return;
   const Atmosphere& a = *shading.atmosphere;
@@ -92,7 +91,6 @@ void setAirUniforms(const gl::Program& p, const TerrainScene& scene, const Frame
   // Sunlight on the air at the viewer, as atmosphere.glsl's airSunAt.
   const float s = std::clamp((sun.z + 0.1f) / 0.24f, 0.0f, 1.0f);
   p.set("uAirSun", s * s * (3 - 2 * s));
-  (void)frame;
 }
 }  // namespace
 
@@ -106,7 +104,7 @@ void drawSky(const gl::Program& sky, const gl::VertexArray& vao, const TerrainSc
   sky.use();
   sky.set("uInvViewProj", toFloat(glm::inverse(viewProj)));
   sky.set("uSkyAltM", float(frame.camZ));
-  setAirUniforms(sky, scene, frame, shading, sunInViewerFrame(scene, frame, shading));
+  setAirUniforms(sky, scene, shading, sunInViewerFrame(scene, frame, shading));
   gl::setDepthTest(gl::DepthTest::kOff);
   vao.drawArrays(gl::Primitive::kTriangles, 0, 3);
   gl::setDepthTest(gl::DepthTest::kGreater, true);
@@ -175,7 +173,7 @@ Status setCommonUniforms(const gl::Program& p, const TerrainScene& scene, const 
   }
   const glm::vec3 sun = sunInViewerFrame(scene, frame, shading);
   p.set("uSunDir", sun);
-  setAirUniforms(p, scene, frame, shading, sun);
+  setAirUniforms(p, scene, shading, sun);
   p.set("uPole", glm::vec3(frame.frameRot * frame.poleAux));
   p.set("uSky", shading.sky);
   p.set("uFogM", shading.fogM);

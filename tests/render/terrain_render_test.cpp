@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <functional>
 #include <limits>
 #include <numbers>
 #include <numeric>
@@ -43,6 +44,21 @@ TEST_F(GlTest, ShadersUseTheSlotsDeclaredInCpp) {
 }
 
 Image8 colourImage(const OffscreenTarget& t) { return {t.width(), t.height(), 4, t.colour()}; }
+
+// A w x h grid of `cellM` cells in local metres on the Earth (no CRS; x east from 0, y north
+// from 0 at the bottom row), each cell's elevation height(east, north) at its centre (m).
+gis::Raster localDem(int w, int h, double cellM, const std::function<float(double, double)>& height) {
+  gis::Raster dem;
+  dem.georef.width = w;
+  dem.georef.height = h;
+  dem.georef.body = gis::Body::wgs84();
+  dem.georef.transform = gis::GeoTransform{{0, cellM, 0, h * cellM, 0, -cellM}};
+  dem.values = gis::Grid<float>(w, h);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) dem.values.at(x, y) = height((x + 0.5) * cellM, (h - y - 0.5) * cellM);
+  }
+  return dem;
+}
 
 constexpr double kPi = 3.14159265358979323846;
 
@@ -771,15 +787,7 @@ TEST_F(GlTest, ACastShadowDarkensOnlyTheGroundTheSunCannotSee) {
   // (525 m). Seen straight down: in the shadow the flat ground keeps the ambient light alone,
   // 0.25 of 0.25 + 0.75 sin(30) (0.4 of its sunlit brightness); the sunlit ground beyond and the
   // ground west of the wall do not change.
-  gis::Raster dem;
-  dem.georef.width = 200;
-  dem.georef.height = 40;
-  dem.georef.body = gis::Body::wgs84();
-  dem.georef.transform = gis::GeoTransform{{0, 10, 0, 400, 0, -10}};
-  dem.values = gis::Grid<float>(200, 40, 0.0f);
-  for (int y = 0; y < 40; ++y) {
-    for (int x = 50; x <= 52; ++x) dem.values.at(x, y) = 100.0f;
-  }
+  const auto dem = localDem(200, 40, 10, [](double east, double) { return east > 500 && east < 530 ? 100.0f : 0.0f; });
   auto scene = TerrainScene::create(dem);
   ASSERT_TRUE(scene) << scene.message();
   auto ring = RingRenderer::create({.circles = 64});
@@ -852,15 +860,9 @@ TEST_F(GlTest, AUserRampColoursEachTerraceByItsElevation) {
   // Three flat terraces (100, 550 and 1400 m) seen from above under an overhead sun (full light):
   // each terrace's pixels are the gdaldem-format ramp's colour at its elevation (2/255), the
   // 550 m one half way between the 100 and 1000 m stops.
-  gis::Raster dem;
-  dem.georef.width = 60;
-  dem.georef.height = 20;
-  dem.georef.body = gis::Body::wgs84();
-  dem.georef.transform = gis::GeoTransform{{0, 10, 0, 200, 0, -10}};
-  dem.values = gis::Grid<float>(60, 20, 100.0f);
-  for (int y = 0; y < 20; ++y) {
-    for (int x = 20; x < 60; ++x) dem.values.at(x, y) = x < 40 ? 550.0f : 1400.0f;
-  }
+  const auto dem = localDem(60, 20, 10, [](double east, double) {
+    return east < 200 ? 100.0f : east < 400 ? 550.0f : 1400.0f;
+  });
   auto scene = TerrainScene::create(dem);
   ASSERT_TRUE(scene) << scene.message();
   const auto path = test::tempDir("ramp_gl") / "ramp.txt";
@@ -898,11 +900,7 @@ TEST_F(GlTest, TheAirMakesABlueSkyAWhiteHorizonAndHazesDistantGround) {
   // than half as far from that sky colour as the ground at the image's bottom (2.4 km away);
   // no elevation in the sky. From 100 km up, the sky overhead is near black (no air above).
   // Mars's horizon is butterscotch (red above blue); the Moon has no air.
-  gis::Raster dem;
-  dem.georef.width = dem.georef.height = 300;
-  dem.georef.body = gis::Body::wgs84();
-  dem.georef.transform = gis::GeoTransform{{0, 1000, 0, 300000, 0, -1000}};
-  dem.values = gis::Grid<float>(300, 300, 0.0f);
+  auto dem = localDem(300, 300, 1000, [](double, double) { return 0.0f; });
   auto scene = TerrainScene::create(dem);
   ASSERT_TRUE(scene) << scene.message();
   auto ring = RingRenderer::create({.circles = 128});
@@ -975,17 +973,9 @@ TEST_F(GlTest, MultisamplingBlendsTheEdgesItCrosses) {
   // fragment shader discards): with 4 samples over a third of the columns' skyline pixels mix
   // sky and terrain, without it under a twentieth; away from the skyline the pictures agree;
   // elevation and depth are resolved.
-  gis::Raster dem;
-  dem.georef.width = dem.georef.height = 100;
-  dem.georef.body = gis::Body::wgs84();
-  dem.georef.transform = gis::GeoTransform{{0, 10, 0, 1000, 0, -10}};
-  dem.values = gis::Grid<float>(100, 100, 0.0f);
-  for (int y = 0; y < 100; ++y) {
-    for (int x = 0; x < 100; ++x) {
-      const double east = (x + 0.5) * 10, north = 1000 - (y + 0.5) * 10;
-      dem.values.at(x, y) = float(std::clamp(1.5 * (east - 200), 0.0, 750.0) + 0.3 * north);
-    }
-  }
+  const auto dem = localDem(100, 100, 10, [](double east, double north) {
+    return float(std::clamp(1.5 * (east - 200), 0.0, 750.0) + 0.3 * north);
+  });
   auto scene = TerrainScene::create(dem);
   ASSERT_TRUE(scene) << scene.message();
   auto ring = RingRenderer::create({.circles = 128});
