@@ -4,10 +4,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 
+#include <strata/core/process.hpp>
 #include <strata/gis/dem_io.hpp>
 #include <strata/render/colour_ramp.hpp>
 
@@ -49,8 +49,8 @@ TEST(ColourRamp, ColoursEveryCellAsGdaldemColorReliefDoes) {
   EXPECT_FLOAT_EQ(r->elevationsM[3], 2500);
   EXPECT_NEAR(r->elevationsM[4], lo + 0.9 * (hi - lo), 1e-3);
   const auto out = dir / "gdaldem.tif";
-  const std::string cmd = "gdaldem color-relief -q '" + dem + "' '" + ramp + "' '" + out.string() + "'";
-  ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+  const auto run = runProcess({"/usr/bin/gdaldem", "color-relief", "-q", dem, ramp, out.string()});
+  ASSERT_TRUE(run) << run.message();
   GDALAllRegister();
   GDALDataset* ds = GDALDataset::Open(out.string().c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY);
   ASSERT_NE(ds, nullptr);

@@ -8,9 +8,11 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <vector>
 
 #include <gtest/gtest.h>
 
+#include <strata/core/process.hpp>
 #include <strata/gis/dem_io.hpp>
 #include <strata/gis/geodesy.hpp>
 #include <strata/render/image_io.hpp>
@@ -22,9 +24,36 @@
 namespace strata {
 namespace {
 
+constexpr const char* kXvfbRun = "/usr/bin/xvfb-run";
+
+// Runs strata-view in a virtual X server with `args`, without a shell (an argument vector: no
+// path is ever parsed as a command line); writes its output to `log` for people to read and
+// returns it, or the failure with it.
+// Under the sanitizer build the viewer's leak check is off: GLX loads Mesa's X11 driver, which is
+// unloaded before LeakSanitizer runs, so its allocations show as "<unknown module>" frames no
+// library suppression (scripts/lsan.supp) can match. ASan's memory errors and UBSan still apply
+// to that process, and the viewer's code is leak-checked by the headless tests
+// (viewer_gpu_test.cpp). Outside a sanitizer build ASAN_OPTIONS is ignored; this process read
+// its own at start-up, so changing it here affects the child only.
+Result<std::string> runViewerWindow(const std::vector<std::string>& args, const std::filesystem::path& log) {
+  const char* asan = std::getenv("ASAN_OPTIONS");
+  const std::string before = asan ? asan : "";
+  ::setenv("ASAN_OPTIONS", (before + ":detect_leaks=0").c_str(), 1);
+  std::vector<std::string> argv{kXvfbRun, "-a", "-s", "-screen 0 1280x800x24", STRATA_VIEW_EXE};
+  argv.insert(argv.end(), args.begin(), args.end());
+  auto out = runProcess(argv);
+  if (asan) {
+    ::setenv("ASAN_OPTIONS", before.c_str(), 1);
+  } else {
+    ::unsetenv("ASAN_OPTIONS");
+  }
+  std::ofstream(log) << (out ? *out : out.message());
+  return out;
+}
+
 TEST(ViewerWindow, ScriptedSessionMatchesGoldensAndUndoIsExact) {
   if (std::getenv("STRATA_NO_GL")) GTEST_SKIP() << "STRATA_NO_GL set: no GL in this run";
-  ASSERT_EQ(std::system("command -v xvfb-run > /dev/null"), 0)
+  ASSERT_TRUE(std::filesystem::exists(kXvfbRun))
       << "xvfb-run is missing (scripts/setup.sh installs xvfb): strata-view needs an X server";
   const auto out = test::outputDir("viewer");
   const std::string o = out.string() + "/";
@@ -64,20 +93,10 @@ TEST(ViewerWindow, ScriptedSessionMatchesGoldensAndUndoIsExact) {
       script << line << "\n";
     }
   }
-  // Under the sanitizer build the viewer's leak check is off: GLX loads Mesa's X11 driver, which is
-  // unloaded before LeakSanitizer runs, so its allocations show as "<unknown module>" frames no
-  // library suppression (scripts/lsan.supp) can match. ASan's memory errors and UBSan still apply
-  // to this process, and the viewer's code is leak-checked by the headless tests
-  // (viewer_gpu_test.cpp). Outside a sanitizer build ASAN_OPTIONS is ignored.
-  const char* asan = std::getenv("ASAN_OPTIONS");
-  const std::string env = std::string("ASAN_OPTIONS='") + (asan ? asan : "") + ":detect_leaks=0' ";
-  const std::string cmd = env + "xvfb-run -a -s '-screen 0 1280x800x24' " + STRATA_VIEW_EXE + " " +
-                          test::dataPath("grand_canyon/grand_canyon_512.tif") +
-                          " --size 480x320 --circles 128 --script " + o + "session.txt > " + o + "session.log 2>&1";
-  const int rc = std::system(cmd.c_str());
-  std::ifstream logFile(out / "session.log");
-  const std::string log((std::istreambuf_iterator<char>(logFile)), std::istreambuf_iterator<char>());
-  ASSERT_EQ(rc, 0) << cmd << "\n" << log;
+  const auto run = runViewerWindow({test::dataPath("grand_canyon/grand_canyon_512.tif"), "--size", "480x320",
+                                    "--circles", "128", "--script", o + "session.txt"},
+                                   out / "session.log");
+  ASSERT_TRUE(run) << run.message();
 
   // Tolerances as for the renderer's goldens (terrain_render_test): one pixel of displacement,
   // then 24/255 per pixel and 3/255 on average (llvmpipe vs a GPU's rasterisation and rounding).
@@ -108,7 +127,7 @@ TEST(ViewerWindow, MapLayersFromTheCommandLineAreDrawn) {
   // and a scale bar, looking straight down at the marker from 12 km: the centre is the marker's
   // red, the graticule's white lines cross the view, the bar sits in the bottom-left corner.
   if (std::getenv("STRATA_NO_GL")) GTEST_SKIP() << "STRATA_NO_GL set: no GL in this run";
-  ASSERT_EQ(std::system("command -v xvfb-run > /dev/null"), 0) << "xvfb-run is missing (scripts/setup.sh installs it)";
+  ASSERT_TRUE(std::filesystem::exists(kXvfbRun)) << "xvfb-run is missing (scripts/setup.sh installs it)";
   const auto out = test::outputDir("viewer");
   const std::string o = out.string() + "/";
   std::filesystem::remove(out / "layers.png");
@@ -122,16 +141,12 @@ TEST(ViewerWindow, MapLayersFromTheCommandLineAreDrawn) {
     script.precision(12);
     script << "0 goto " << lon << " " << lat << " 12000\n0 look 0 -89\n2 screenshot " << o << "layers.png\n";
   }
-  const char* asan = std::getenv("ASAN_OPTIONS");  // as above: no leak check under GLX
-  const std::string env = std::string("ASAN_OPTIONS='") + (asan ? asan : "") + ":detect_leaks=0' ";
-  const std::string cmd =
-      env + "xvfb-run -a -s '-screen 0 1280x800x24' " + STRATA_VIEW_EXE + " " +
-      test::dataPath("grand_canyon/grand_canyon_512.tif") + " --size 480x320 --circles 128 --drape " + o +
-      "utm_marker.tif --graticule 0.05 --scale-bar --script " + o + "layers.txt > " + o + "layers.log 2>&1";
-  const int rc = std::system(cmd.c_str());
-  std::ifstream logFile(out / "layers.log");
-  const std::string log((std::istreambuf_iterator<char>(logFile)), std::istreambuf_iterator<char>());
-  ASSERT_EQ(rc, 0) << cmd << "\n" << log;
+  const auto run = runViewerWindow(
+      {test::dataPath("grand_canyon/grand_canyon_512.tif"), "--size", "480x320", "--circles", "128", "--drape",
+       o + "utm_marker.tif", "--graticule", "0.05", "--scale-bar", "--script", o + "layers.txt"},
+      out / "layers.log");
+  ASSERT_TRUE(run) << run.message();
+  const std::string& log = *run;
   EXPECT_NE(log.find("drape: RGB (3 Byte bands)"), std::string::npos) << log;
   auto image = render::readImage8(o + "layers.png");
   ASSERT_TRUE(image) << image.message();
