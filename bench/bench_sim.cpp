@@ -1,13 +1,15 @@
 // Simulation step cost side by side in one run: the CPU backend (sim::CpuSolver) with 1 and 2
-// OpenMP threads, and the GL backend (sim::GlSolver) on whatever GL the machine has (Mesa
-// llvmpipe without a GPU), at 256^2 to 2048^2, for the virtual-pipe model, pipes + erosion +
-// thermal weathering on four layers, and flood mode. Before the benchmarks the program measures
-// the machine's floors with the same threads and instruction set the CPU kernels use: memory
-// bandwidth (a STREAM triad, a[i] = b[i] + s c[i] on 64 MB arrays) and peak float throughput
-// (independent multiply + add chains; the kernels do not contract into FMA). Each benchmark
-// reports ms per step, cell updates per second, the bytes and flops one cell costs per step
+// OpenMP threads (and all cores, on a machine with more than two), and the GL backend
+// (sim::GlSolver) on whatever GL the machine has (Mesa llvmpipe without a GPU), at 256^2 to 4096^2
+// (4096^2 is for a GPU or a many-core machine: filter it out on a small one), for the virtual-pipe model, pipes +
+// erosion + thermal weathering on four layers, and flood mode. Before the benchmarks the program measures the machine's
+// floors with the same threads and instruction set the CPU kernels use: memory bandwidth (a STREAM triad, a[i] = b[i] +
+// s c[i] on 64 MB arrays) and peak float throughput (independent multiply + add chains; the kernels do not contract
+// into FMA). Each benchmark reports ms per step, cell updates per second, the bytes and flops one cell costs per step
 // (counted from the code, below) and its time as a multiple of the bandwidth floor
-// (bytes x cells / bandwidth) and of the compute floor (flops x cells / peak).
+// (bytes x cells / bandwidth) and of the compute floor (flops x cells / peak); the GL rows are
+// measured against the GL device's own bandwidth (a shader copy, bench_context.hpp), taken in the
+// same run.
 //   build/bench/strata_bench_sim [--benchmark_filter=...]
 // Figures go to docs/benchmarks.md.
 #include <benchmark/benchmark.h>
@@ -18,9 +20,12 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
+
+#include "bench_context.hpp"
 
 #include <strata/gl/context.hpp>
 #include <strata/gl/state.hpp>
@@ -87,9 +92,17 @@ using Vec8 = float __attribute__((vector_size(32)));
 }
 constexpr double kChainFlops = 12 * 8 * 2;  // per iteration
 
+// The thread counts the CPU rows run with: 1, 2 and, on a machine with more cores, all of them.
+std::vector<int> threadCounts() {
+  std::vector<int> t{1, 2};
+  if (omp_get_num_procs() > 2) t.push_back(omp_get_num_procs());
+  return t;
+}
+
 struct Floors {
-  double bandwidthGBs[3] = {0, 0, 0};  // by thread count (1, 2)
-  double peakGflops[3] = {0, 0, 0};
+  std::map<int, double> bandwidthGBs;  // by thread count
+  std::map<int, double> peakGflops;
+  double glCopyGBs = 0;  // the GL device's shader copy of floats in 16 x 16 groups (bench_context.hpp)
 };
 Floors gFloors;
 
@@ -106,12 +119,12 @@ double bestOf(int runs, const std::function<void()>& f) {
 void measureFloors() {
   const long n = 1L << 23;  // 64 MB per array, far beyond the caches
   std::vector<double> a(size_t(n), 0.0), b(size_t(n), 1.0), c(size_t(n), 2.0);
-  for (int threads : {1, 2}) {
+  for (int threads : threadCounts()) {
     triad(a.data(), b.data(), c.data(), 3.0, n, threads);  // first touch
     const double s = bestOf(5, [&] { triad(a.data(), b.data(), c.data(), 3.0, n, threads); });
     gFloors.bandwidthGBs[threads] = 3.0 * 8.0 * double(n) / s / 1e9;
     const long iterations = 10000000;
-    float results[2] = {0.0f, 0.0f};
+    std::vector<float> results(size_t(threads), 0.0f);
     const double t = bestOf(3, [&] {
 #pragma omp parallel num_threads(threads)
       results[omp_get_thread_num()] = chains(iterations, 0.999999f, 1e-7f);
@@ -209,12 +222,17 @@ void run(benchmark::State& state, const ts::SimParams& p, Work work, int threads
     state.SetIterationTime(t / steps);
   }
   const double cells = double(n) * n, perStep = seconds / (double(state.iterations()) * steps);
-  const int floorThreads = threads == 1 ? 1 : 2;  // llvmpipe runs on both cores
-  const double bwFloor = work.bytes * cells / (gFloors.bandwidthGBs[floorThreads] * 1e9);
-  const double flopFloor = work.flops * cells / (gFloors.peakGflops[floorThreads] * 1e9);
   state.counters["cells/s"] = benchmark::Counter(cells * double(state.iterations()), benchmark::Counter::kIsRate);
   state.counters["B/cell"] = work.bytes;
   state.counters["flop/cell"] = work.flops;
+  if (threads == 0) {
+    // GL: the floor is the device's own shader-copy bandwidth (no GPU peak-flop figure is measured).
+    if (gFloors.glCopyGBs > 0)
+      state.counters["x_bw_floor"] = perStep / (work.bytes * cells / (gFloors.glCopyGBs * 1e9));
+    return;
+  }
+  const double bwFloor = work.bytes * cells / (gFloors.bandwidthGBs[threads] * 1e9);
+  const double flopFloor = work.flops * cells / (gFloors.peakGflops[threads] * 1e9);
   state.counters["x_bw_floor"] = perStep / bwFloor;
   state.counters["x_flop_floor"] = perStep / flopFloor;
 }
@@ -254,7 +272,12 @@ void registerAll() {
     int threads;
     bool skip;
   };
-  const Variant variants[] = {{"cpu_1thread", 1, false}, {"cpu_2threads", 2, false}, {"gl", 0, false}};
+  std::vector<Variant> variants = {{"cpu_1thread", 1, false}, {"cpu_2threads", 2, false}, {"gl", 0, false}};
+  static std::string allThreads;  // outlives the registrations that point at it
+  if (const int all = omp_get_num_procs(); all > 2) {
+    allThreads = "cpu_" + std::to_string(all) + "threads";
+    variants.insert(variants.begin() + 2, Variant{allThreads.c_str(), all, false});
+  }
   for (const auto& m : models) {
     for (const auto& v : variants) {
       const std::string name = std::string(m.name) + "/" + v.name;
@@ -264,6 +287,7 @@ void registerAll() {
           ->Arg(512)
           ->Arg(1024)
           ->Arg(2048)
+          ->Arg(4096)
           ->UseManualTime()
           ->Unit(benchmark::kMillisecond);
     }
@@ -276,6 +300,7 @@ void registerAll() {
       ->Arg(512)
       ->Arg(1024)
       ->Arg(2048)
+      ->Arg(4096)
       ->UseManualTime()
       ->Unit(benchmark::kMillisecond);
   benchmark::RegisterBenchmark("gl_halo_strip", glHaloStrip)->Arg(512)->Arg(2048)->Unit(benchmark::kMillisecond);
@@ -286,22 +311,31 @@ void registerAll() {
 int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
   measureFloors();
+  std::string stream, peak;
   char text[160];
-  std::snprintf(text, sizeof text, "%.1f GB/s (1 thread), %.1f GB/s (2 threads)", gFloors.bandwidthGBs[1],
-                gFloors.bandwidthGBs[2]);
-  benchmark::AddCustomContext("stream_triad", text);
-  std::snprintf(text, sizeof text, "%.1f GFLOP/s (1 thread), %.1f GFLOP/s (2 threads)", gFloors.peakGflops[1],
-                gFloors.peakGflops[2]);
-  benchmark::AddCustomContext("peak_mul_add", text);
+  for (int threads : threadCounts()) {
+    std::snprintf(text, sizeof text, "%s%.1f GB/s (%d thread%s)", stream.empty() ? "" : ", ",
+                  gFloors.bandwidthGBs[threads], threads, threads == 1 ? "" : "s");
+    stream += text;
+    std::snprintf(text, sizeof text, "%s%.1f GFLOP/s (%d thread%s)", peak.empty() ? "" : ", ",
+                  gFloors.peakGflops[threads], threads, threads == 1 ? "" : "s");
+    peak += text;
+  }
+  benchmark::AddCustomContext("stream_triad", stream);
+  benchmark::AddCustomContext("peak_mul_add", peak);
   auto ctx = gl::HeadlessContext::create({.debugOutput = false});
   if (ctx) {
     gContext.emplace(std::move(ctx).value());
     benchmark::AddCustomContext("gl_renderer", gContext->info().renderer);
+    gFloors.glCopyGBs = bench::shaderCopyGBs(16);
+    std::snprintf(text, sizeof text, "%.1f GB/s (floats in 16 x 16 groups, read + written)", gFloors.glCopyGBs);
+    benchmark::AddCustomContext("gl_shader_copy", text);
   } else {
     benchmark::AddCustomContext("gl_renderer", "none: " + ctx.message());
   }
   registerAll();
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
+  gContext.reset();  // while the driver is loaded: NVIDIA's EGL crashed tearing it down after main
   return 0;
 }

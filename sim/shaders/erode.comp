@@ -4,7 +4,7 @@
 // E6 settling where the water is gone. Purely local: each cell reads and writes only itself.
 #include "sim.glsl"
 #include "sim_layers.glsl"
-layout(local_size_x = 16, local_size_y = 16) in;
+layout(local_size_x = SIM_GROUP_X, local_size_y = SIM_GROUP_Y) in;
 layout(std430, binding = SLOT_BED) buffer Bed { float bed[]; };
 layout(std430, binding = SLOT_STATE_IN) buffer StateIn { vec4 state[]; };
 layout(std430, binding = SLOT_TILT) readonly buffer Tilt { float tilt[]; };

@@ -3,7 +3,7 @@
 // edges (W17). Each invocation owns its cell's east and south faces, plus the west face in
 // column 0 and the north face in row 0. average = 1 (Heun corrector, W22): face = (old + new)/2.
 #include "sim.glsl"
-layout(local_size_x = 16, local_size_y = 16) in;
+layout(local_size_x = SIM_GROUP_X, local_size_y = SIM_GROUP_Y) in;
 layout(std430, binding = SLOT_BED) readonly buffer Bed { float bed[]; };
 layout(std430, binding = SLOT_STATE_IN) readonly buffer StateIn { vec4 state[]; };  // U0 or U1, bound by the host
 layout(std430, binding = SLOT_FACE_X) buffer FaceX { vec4 faceX[]; };

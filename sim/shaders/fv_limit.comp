@@ -3,7 +3,7 @@
 // outgoing mass fluxes each cell can give without going below zero (as the pipe model's W2);
 // fv_update.comp scales each face's mass flux by its upwind cell's K, so no depth is clipped.
 #include "sim.glsl"
-layout(local_size_x = 16, local_size_y = 16) in;
+layout(local_size_x = SIM_GROUP_X, local_size_y = SIM_GROUP_Y) in;
 layout(std430, binding = SLOT_STATE_IN) readonly buffer StateIn { vec4 state[]; };
 layout(std430, binding = SLOT_FACE_X) readonly buffer FaceX { vec4 faceX[]; };
 layout(std430, binding = SLOT_FACE_Y) readonly buffer FaceY { vec4 faceY[]; };

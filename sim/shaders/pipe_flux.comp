@@ -3,7 +3,7 @@
 // difference), W1a: heads equal to float32 resolution are equal, W2: scaled by K so no cell
 // gives more water than it has. Each cell writes only its own four outflows.
 #include "sim.glsl"
-layout(local_size_x = 16, local_size_y = 16) in;
+layout(local_size_x = SIM_GROUP_X, local_size_y = SIM_GROUP_Y) in;
 layout(std430, binding = SLOT_BED) readonly buffer Bed { float bed[]; };
 layout(std430, binding = SLOT_STATE_IN) readonly buffer StateIn { vec4 state[]; };
 layout(std430, binding = SLOT_FLUX) buffer Flux { vec4 flux[]; };

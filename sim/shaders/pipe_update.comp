@@ -4,7 +4,7 @@
 // E0: bed tilt. Reads stateIn and fluxes (also of neighbours), writes stateOut: no races.
 #include "sim.glsl"
 #include "sim_accum.glsl"
-layout(local_size_x = 16, local_size_y = 16) in;
+layout(local_size_x = SIM_GROUP_X, local_size_y = SIM_GROUP_Y) in;
 layout(std430, binding = SLOT_BED) readonly buffer Bed { float bed[]; };
 layout(std430, binding = SLOT_STATE_IN) readonly buffer StateIn { vec4 state[]; };
 layout(std430, binding = SLOT_STATE_OUT) writeonly buffer StateOut { vec4 stateOut[]; };

@@ -1,9 +1,8 @@
 // The water / erosion simulation as the compute kernels see it. SimParams, SimMaterial and
-// SourceEntry mirror strata::terrain::sim (terrain/include/strata/terrain/sim/sim_params.hpp,
-// sim_host.hpp); tests/render/gpu_layouts_test.cpp checks that they agree. Buffer bindings are
-// fixed here; render/src/sim/simulation.cpp binds them. Equation numbers (W.., E..) refer to
-// docs/sim-water.md and docs/sim-erosion.md; terrain/src/sim/cpu_simulation.cpp is the same
-// code in C++.
+// SourceEntry mirror sim/include/strata/sim/gl_layout.hpp; tests/gl/gpu_layouts_test.cpp checks
+// that they agree. Buffer bindings are fixed here (slots: sim/include/strata/sim/shader_slots.hpp);
+// sim/src/gl/gl_solver.cpp binds them. Equation numbers (W.., E..) refer to docs/sim-water.md and
+// docs/sim-erosion.md; sim/src/cpu_*.cpp is the same code in C++.
 struct SimParams {
   int width;
   int height;
@@ -38,6 +37,10 @@ struct SimParams {
   float pad0;
   float pad1;
 };
+
+// The work-group shape of the grid kernels (the sources, pipe, erosion, thermal and flood passes).
+#define SIM_GROUP_X 16
+#define SIM_GROUP_Y 16
 
 struct SimMaterial {
   float erodibility;

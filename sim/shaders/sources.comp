@@ -2,7 +2,7 @@
 // W11: rain (uniform + raster) and evaporation, per cell, in place (each cell only its own).
 #include "sim.glsl"
 #include "sim_accum.glsl"
-layout(local_size_x = 16, local_size_y = 16) in;
+layout(local_size_x = SIM_GROUP_X, local_size_y = SIM_GROUP_Y) in;
 layout(std430, binding = SLOT_STATE_IN) buffer StateIn { vec4 state[]; };
 layout(std430, binding = SLOT_RAIN) readonly buffer Rain { float rainMmH[]; };
 void main() {

@@ -4,7 +4,7 @@
 // from `thermal`, which this pass does not write.
 #include "sim.glsl"
 #include "sim_layers.glsl"
-layout(local_size_x = 16, local_size_y = 16) in;
+layout(local_size_x = SIM_GROUP_X, local_size_y = SIM_GROUP_Y) in;
 layout(std430, binding = SLOT_BED) writeonly buffer Bed { float bed[]; };
 layout(std430, binding = SLOT_THERMAL) readonly buffer Thermal { vec4 thermal[]; };
 void main() {

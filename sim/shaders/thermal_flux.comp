@@ -6,7 +6,7 @@
 // outflows; layers are read-only here.
 #include "sim.glsl"
 #include "sim_layers.glsl"
-layout(local_size_x = 16, local_size_y = 16) in;
+layout(local_size_x = SIM_GROUP_X, local_size_y = SIM_GROUP_Y) in;
 layout(std430, binding = SLOT_BED) readonly buffer Bed { float bed[]; };
 layout(std430, binding = SLOT_STATE_IN) readonly buffer StateIn { vec4 state[]; };
 layout(std430, binding = SLOT_THERMAL) writeonly buffer Thermal { vec4 thermal[]; };
