@@ -40,6 +40,10 @@ void GLAPIENTRY debugCallback(GLenum source, GLenum type, GLuint id, GLenum seve
   } else if (type == GL_DEBUG_TYPE_ERROR) {
     ++tErrorCount;
     log::error("gl") << msg << " (id " << id << ")";
+  } else if (type == GL_DEBUG_TYPE_PERFORMANCE) {
+    // Driver advice for developers (NVIDIA's "buffer moved to host memory", "shader recompiled
+    // based on GL state"): nothing a user can act on, and some come once per step.
+    log::debug("gl") << msg;
   } else if (severity == GL_DEBUG_SEVERITY_HIGH || severity == GL_DEBUG_SEVERITY_MEDIUM) {
     log::warn("gl") << msg;
   } else {

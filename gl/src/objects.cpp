@@ -35,8 +35,13 @@ GLuint createBuffer() {
 
 Buffer::Buffer(size_t bytes, const void* data, BufferStorage storage) : Object(createBuffer()), bytes_(bytes) {
   STRATA_CHECK(bytes > 0) << "empty buffer";
-  glNamedBufferStorage(id(), GLsizeiptr(bytes), data,
-                       storage == BufferStorage::kDynamic ? GLbitfield(GL_DYNAMIC_STORAGE_BIT) : GLbitfield(0));
+  GLbitfield flags = 0;
+  switch (storage) {
+    case BufferStorage::kDynamic: flags = GL_DYNAMIC_STORAGE_BIT; break;
+    case BufferStorage::kImmutable: break;
+    case BufferStorage::kReadback: flags = GL_DYNAMIC_STORAGE_BIT | GL_MAP_READ_BIT | GL_CLIENT_STORAGE_BIT; break;
+  }
+  glNamedBufferStorage(id(), GLsizeiptr(bytes), data, flags);
 }
 
 void Buffer::upload(size_t offset, size_t bytes, const void* data) {

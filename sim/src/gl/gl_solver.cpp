@@ -34,7 +34,8 @@ struct GlSolver::Impl {
   bool aIsCurrent = true;
   gl::Program pSources, pPointSources, pWaveSpeed, pPipeFlux, pPipeUpdate, pFvFace, pFvLimit, pFvUpdate, pErode,
       pThermalFlux, pThermalApply, pFloodStats, pLevel, pCopyRect, pBedRect;
-  gl::Buffer packed;  // copy_rect.comp's side of a rectangle moved to or from the host
+  gl::Buffer maxSpeedHost;  // maxSpeed copied to host memory, read every step (maxWaveSpeed)
+  gl::Buffer packed;        // copy_rect.comp's side of a rectangle moved to or from the host
 
   const gl::Buffer& cur() const { return aIsCurrent ? stateA : stateB; }
   const gl::Buffer& next() const { return aIsCurrent ? stateB : stateA; }
@@ -68,8 +69,11 @@ struct GlSolver::Impl {
     bindAll();
     pWaveSpeed.dispatchCovering(int(n));
     readBarrier();
+    // Through a host-memory buffer: NVIDIA moved maxSpeed itself between GPU and host memory at
+    // every step's read (and warned each time) when it was read directly.
+    maxSpeed.copyTo(maxSpeedHost, 4);
     uint32_t bits = 0;
-    maxSpeed.download(0, 4, &bits);
+    maxSpeedHost.download(0, 4, &bits);
     float v;
     std::memcpy(&v, &bits, 4);
     return double(v);
@@ -299,6 +303,7 @@ Result<GlSolver> GlSolver::create(const SimInput& input, const SimParams& params
   s.thermal.fill(0u);
   s.sourceEntries = gl::Buffer(sizeof(SourceEntry) * 16);
   s.maxSpeed = gl::Buffer(4);
+  s.maxSpeedHost = gl::Buffer(4, nullptr, gl::BufferStorage::kReadback);
   s.floodStats = gl::Buffer(16 * n);
 
   GlSolver solver(input, params, std::move(impl));

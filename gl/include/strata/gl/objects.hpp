@@ -63,6 +63,7 @@ void deleteQuery(uint32_t id);
 enum class BufferStorage {
   kDynamic,    ///< upload() allowed (GL_DYNAMIC_STORAGE_BIT)
   kImmutable,  ///< contents given at creation; GPU writes (shaders, fill, copies) still allowed
+  kReadback,   ///< read by the host often (download): kept in host memory (GL_CLIENT_STORAGE_BIT)
 };
 
 /// A buffer with immutable storage (glNamedBufferStorage).
