@@ -2,7 +2,7 @@
 // defects a renderer really produces (a crack, a hole, a lighting change) are each injected into
 // the golden and must be rejected, while the differences another driver makes (rounding noise,
 // an edge moved by a pixel) must pass. The old rule (24/255 on at most 2% of the pixels) passed
-// all three defects; each case also shows that.
+// all three defects; each case also shows that. A few lone pixels pass; two that touch do not.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -116,6 +116,34 @@ TEST(GoldenCompare, RoundingNoiseAndAOnePixelDisplacementPass) {
   report("horizon one pixel lower", m);
   EXPECT_TRUE(m.ok) << m.message;
   EXPECT_GT(m.maxDiff, 24) << "the displacement should have moved pixels by more than the cap";
+}
+
+TEST(GoldenCompare, LonePixelsPassUpToTheLimitAndTwoThatTouchFail) {
+  // Single magenta pixels far apart (another GPU's raster of a sub-pixel triangle): up to
+  // maxLonePixels pass; one more fails; two side by side (the smallest crack) fail at once.
+  const auto g = golden();
+  const test::GoldenTolerance tol;
+  auto magenta = [](render::Image8& im, int x, int y) {
+    uint8_t* p = pixel(im, x, y);
+    p[0] = 255, p[1] = 0, p[2] = 255;
+  };
+  auto lone = g;
+  for (int k = 0; k < tol.maxLonePixels; ++k) magenta(lone, 20 + 40 * k, g.height * 2 / 3);
+  const auto r = test::compareImages(g, lone, tol);
+  report("lone pixels at the limit", r);
+  EXPECT_TRUE(r.ok) << r.message;
+  EXPECT_EQ(r.lonePixels, size_t(tol.maxLonePixels));
+  magenta(lone, 20 + 40 * tol.maxLonePixels, g.height * 2 / 3);
+  const auto over = test::compareImages(g, lone, tol);
+  EXPECT_FALSE(over.ok) << over.message;
+  auto pair = g;
+  magenta(pair, g.width / 2, g.height * 2 / 3);
+  magenta(pair, g.width / 2 + 1, g.height * 2 / 3 + 1);
+  const auto touching = test::compareImages(g, pair, tol);
+  report("two touching pixels", touching);
+  EXPECT_FALSE(touching.ok) << touching.message;
+  EXPECT_EQ(touching.pixelsOverCap, 2u);
+  EXPECT_EQ(touching.lonePixels, 0u);
 }
 
 }  // namespace

@@ -20,8 +20,13 @@ struct Shared {
   bool tried = false;
 };
 
-Shared& shared() {
+Shared& state() {
   static Shared s;
+  return s;
+}
+
+Shared& shared() {
+  Shared& s = state();
   if (!s.tried) {
     s.tried = true;
     auto r = gl::HeadlessContext::create();
@@ -33,6 +38,16 @@ Shared& shared() {
   }
   return s;
 }
+
+// Destroys the shared context when the run ends, while the GL driver is still loaded: NVIDIA's EGL
+// (580, H100) crashed with SIGSEGV when the context was destroyed by a static destructor after
+// main returned, failing a run whose tests had all passed.
+class ReleaseContext : public ::testing::Environment {
+ public:
+  void TearDown() override { state().ctx.reset(); }
+};
+[[maybe_unused]] const ::testing::Environment* const kReleaseContext =
+    ::testing::AddGlobalTestEnvironment(new ReleaseContext);
 
 }  // namespace
 

@@ -47,6 +47,7 @@ GoldenResult compareImages(const render::Image8& expected, const render::Image8&
   }
   const size_t pixels = size_t(actual.width) * size_t(actual.height);
   res.diff.assign(pixels * 4, 0);
+  std::vector<uint8_t> overCap(pixels, 0);
   res.maxDiff = 0;
   res.maxDisplacedDiff = 0;
   double sum = 0;
@@ -65,6 +66,7 @@ GoldenResult compareImages(const render::Image8& expected, const render::Image8&
       res.maxDisplacedDiff = std::max(res.maxDisplacedDiff, dd);
       const bool over = dd > tol.maxPixelDiff;
       res.pixelsOverCap += over;
+      overCap[p] = over;
       const uint8_t v = uint8_t(std::min(255, d * 4));
       res.diff[p * 4 + 0] = over ? 255 : v;
       res.diff[p * 4 + 1] = over ? 0 : v;
@@ -74,11 +76,28 @@ GoldenResult compareImages(const render::Image8& expected, const render::Image8&
   }
   res.meanDiff = sum / double(pixels);
   res.plainFractionOver = double(plainOver) / double(pixels);
-  res.ok = res.pixelsOverCap == 0 && res.meanDiff <= tol.maxMeanDiff;
+  auto overAt = [&](int x, int y) {
+    return x >= 0 && y >= 0 && x < actual.width && y < actual.height &&
+           overCap[size_t(y) * size_t(actual.width) + size_t(x)] != 0;
+  };
+  for (int y = 0; y < actual.height; ++y) {
+    for (int x = 0; x < actual.width; ++x) {
+      if (!overAt(x, y)) continue;
+      bool touches = false;
+      for (int dy = -1; dy <= 1 && !touches; ++dy) {
+        for (int dx = -1; dx <= 1 && !touches; ++dx) touches = (dx != 0 || dy != 0) && overAt(x + dx, y + dy);
+      }
+      res.lonePixels += !touches;
+    }
+  }
+  const size_t touching = res.pixelsOverCap - res.lonePixels;
+  res.ok = touching == 0 && res.lonePixels <= size_t(tol.maxLonePixels) && res.meanDiff <= tol.maxMeanDiff;
   res.message = std::to_string(res.pixelsOverCap) + " pixels differ by more than " + std::to_string(tol.maxPixelDiff) +
-                " after one pixel of displacement (largest " + std::to_string(res.maxDisplacedDiff) +
-                "; allowed none), mean difference " + fmt("%.3f", res.meanDiff) + " (allowed " +
-                fmt("%.3f", tol.maxMeanDiff) + "), largest plain difference " + std::to_string(res.maxDiff);
+                " after one pixel of displacement (largest " + std::to_string(res.maxDisplacedDiff) + "; " +
+                std::to_string(touching) + " touching another, allowed none; " + std::to_string(res.lonePixels) +
+                " alone, allowed " + std::to_string(tol.maxLonePixels) + "), mean difference " +
+                fmt("%.3f", res.meanDiff) + " (allowed " + fmt("%.3f", tol.maxMeanDiff) +
+                "), largest plain difference " + std::to_string(res.maxDiff);
   return res;
 }
 

@@ -19,10 +19,14 @@ namespace strata::test {
 /// by one pixel, as another driver's rasterisation moves it, passes; a crack or a hole, which
 /// has no match nearby, does not). The mean of the plain differences over the whole image is
 /// capped by `maxMeanDiff`: a change of every pixel below the cap, such as a brightness shift,
-/// does not pass, while rounding noise of +-2 on every channel (mean 1.8) does.
+/// does not pass, while rounding noise of +-2 on every channel (mean 1.8) does. A few lone
+/// pixels over the cap (none of their 8 neighbours over it) pass: an NVIDIA H100 drew 1 or 2
+/// such pixels in 5 of the llvmpipe goldens (a sub-pixel triangle at a silhouette rasterised
+/// differently), while a crack, a seam or a hole is pixels that touch.
 struct GoldenTolerance {
   int maxPixelDiff = 24;   ///< per pixel, after one pixel of displacement (0..255)
   double maxMeanDiff = 3;  ///< mean over all pixels of the plain difference (0..255)
+  int maxLonePixels = 4;   ///< pixels over the cap with no neighbour over it
 };
 
 /// The outcome of a golden comparison, with the figures for the message and for tests.
@@ -31,6 +35,7 @@ struct GoldenResult {
   int maxDiff = 255;             ///< largest plain pixel difference
   int maxDisplacedDiff = 255;    ///< largest difference after one pixel of displacement (the cap's)
   size_t pixelsOverCap = 0;      ///< pixels whose displaced difference exceeds the cap
+  size_t lonePixels = 0;         ///< of those, pixels with none of their 8 neighbours over the cap
   double meanDiff = 255;         ///< mean plain pixel difference
   double plainFractionOver = 1;  ///< fraction of pixels whose plain difference exceeds the cap
   std::vector<uint8_t> diff;     ///< RGBA: grey = 4 x the plain difference, red where over the cap
