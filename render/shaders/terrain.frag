@@ -93,30 +93,37 @@ void main() {
   // MIP level apart.
   float lod = fs.lod;
   float d = exp2(lod);
-  // On a body the east-west difference spans as much ground as the north-south one: 1 / cos(lat)
-  // times as many columns, read at a level as much coarser (columns converge at the poles, and
-  // one column there is a sliver of ground: its differences were noise, a starburst).
-  vec2 dd = vec2(d);
-  float lodX = lod;
-  if (uPlanetary != 0) {
-    float c = max(cos(uv.y / uGeoToUv.w + uGeoToUv.z), 1e-3);
-    dd.x = d / c;
-    lodX = lod + log2(1.0 / c);
-  }
-  float hx = terrainHeight(q + vec2(dd.x, 0.0), lodX) - terrainHeight(q - vec2(dd.x, 0.0), lodX);
-  float hy = terrainHeight(q + vec2(0.0, dd.y), lod) - terrainHeight(q - vec2(0.0, dd.y), lod);
-  vec2 metresPerTexel;
+  vec2 grad;
   vec3 east = vec3(1.0, 0.0, 0.0), north = vec3(0.0, 1.0, 0.0), up = vec3(0.0, 0.0, 1.0);
   if (uPlanetary == 0) {
-    metresPerTexel = 1.0 / uTexelPerMetre;
+    float hx = terrainHeight(q + vec2(d, 0.0), lod) - terrainHeight(q - vec2(d, 0.0), lod);
+    float hy = terrainHeight(q + vec2(0.0, d), lod) - terrainHeight(q - vec2(0.0, d), lod);
+    grad = vec2(hx, hy) / (2.0 * d / uTexelPerMetre);
   } else {
-    float lat = uv.y / uGeoToUv.w + uGeoToUv.z;
-    metresPerTexel = vec2(uRadius * max(cos(lat), 1e-3), uRadius) / uTexelPerRad;
+    // On a body: the four points d texels of latitude away along the great circles east-west
+    // and north-south through the fragment, so both differences span the same ground at any
+    // latitude. (Stepping d columns along the parallel spans cos(lat) as much ground: one column
+    // near a pole is a sliver, and its differences were noise, a starburst; d / cos(lat) columns
+    // at a level as much coarser went round the globe within a few texels of the pole, where a
+    // level that coarse also averages half the polar cap: a dark dot on the pole.) The
+    // fragment's own east and north in the viewer's nadir frame, where the pole lies at
+    // (0, cos lat0, sin lat0); at the pole itself any pair does.
+    vec3 p = normalize(fs.sph);
+    vec3 pole = vec3(0.0, cos(uCamLonLat.y), sin(uCamLonLat.y));
+    vec3 e = cross(pole, p);
+    e = dot(e, e) > 1e-14 ? normalize(e) : normalize(cross(abs(p.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 1.0, 0.0), p));
+    vec3 nth = cross(p, e);
+    float a = d / uTexelPerRad.y;  // d texels of latitude, as an angle
+    float hx = terrainHeight(dtOfSphereDir(normalize(p + a * e)), lod) -
+               terrainHeight(dtOfSphereDir(normalize(p - a * e)), lod);
+    float hy = terrainHeight(dtOfSphereDir(normalize(p + a * nth)), lod) -
+               terrainHeight(dtOfSphereDir(normalize(p - a * nth)), lod);
+    grad = vec2(hx, hy) / (2.0 * a * uRadius);
     up = normalize(fs.up);
     east = normalize(cross(uPole, up));
     north = cross(up, east);
   }
-  vec2 grad = uExaggeration * vec2(hx, hy) / (2.0 * dd * metresPerTexel);
+  grad *= uExaggeration;
   vec3 nLocal = normalize(vec3(-grad, 1.0));
   vec3 n = nLocal.x * east + nLocal.y * north + nLocal.z * up;
 

@@ -11,6 +11,7 @@
 #include <numbers>
 #include <numeric>
 
+#include <strata/core/process.hpp>
 #include <strata/gis/dem_io.hpp>
 #include <strata/gis/geodesy.hpp>
 #include <strata/render/colour_ramp.hpp>
@@ -352,16 +353,29 @@ INSTANTIATE_TEST_SUITE_P(
 TEST_F(GlTest, CliRendersTheMoonsProjectedDemInPlanetaryMode) {
   const auto out = test::outputDir("render") / "cli_moon_planetary.png";
   std::filesystem::remove(out);
-  const std::string cmd = std::string(STRATA_CLI) + " render '" + test::dataPath("moon/LDEM_4.LBL") +
-                          "' --planetary --lon 0 --lat 0 --height 4e6 --pitch -90 --exaggeration 3 --palette grey "
-                          "--circles 128 --size 192x192 -o '" +
-                          out.string() + "' 2>&1";
-  std::string log;
-  FILE* p = popen(cmd.c_str(), "r");
-  ASSERT_NE(p, nullptr);
-  char buf[512];
-  while (fgets(buf, sizeof buf, p)) log += buf;
-  ASSERT_EQ(pclose(p), 0) << cmd << "\n" << log;
+  const auto run = runProcess({STRATA_CLI,
+                               "render",
+                               test::dataPath("moon/LDEM_4.LBL"),
+                               "--planetary",
+                               "--lon",
+                               "0",
+                               "--lat",
+                               "0",
+                               "--height",
+                               "4e6",
+                               "--pitch",
+                               "-90",
+                               "--exaggeration",
+                               "3",
+                               "--palette",
+                               "grey",
+                               "--circles",
+                               "128",
+                               "--size",
+                               "192x192",
+                               "-o",
+                               out.string()});
+  ASSERT_TRUE(run) << run.message();
   auto img = render::readImage8(out.string());
   ASSERT_TRUE(img) << img.message();
   ASSERT_EQ(img->width, 192);
@@ -379,7 +393,7 @@ TEST_F(GlTest, CliRendersTheMoonsProjectedDemInPlanetaryMode) {
       cy += y + 0.5;
     }
   }
-  ASSERT_GT(covered, 0) << log;
+  ASSERT_GT(covered, 0) << *run;
   const double fraction = double(covered) / (192.0 * 192.0);
   std::printf("CLI Moon: disc covers %.3f of the image, centred at (%.1f, %.1f)\n", fraction, cx / covered,
               cy / covered);
@@ -1135,11 +1149,15 @@ TEST_F(GlTest, DistantReliefStaysWithinItsErrorBound) {
       return e;
     };
     // The metric's floor: the grid against itself (bands of a few silhouette pixels aside), at
-    // one height per site (its 2.9 million triangles are the slow part of this test).
+    // one height per site (its 2.9 million triangles are the slow part of this test). A GPU
+    // snaps vertices to 1/256 of a pixel (GL_SUBPIXEL_BITS 8), which may move a surface seen at
+    // distance d by d x (pixel angle) / 256: llvmpipe stays under 2 cm in every band, an NVIDIA
+    // H100 gave p95 3.5 cm at 5-15 km and 11 cm at 40-80 km (bounds 23 cm and 1.2 m here).
     if (v.agl == 50) {
+      const double snapRad = cam.fovYDeg * std::numbers::pi / 180.0 / h / 256.0;
       for (const auto& b : row("grid", **grid)) {
         if (b.pixels >= 200) {
-          EXPECT_LT(b.p95M, 0.02) << v.site << " " << v.agl << " m, " << b.fromM << " m";
+          EXPECT_LT(b.p95M, std::max(0.02, b.toM * snapRad)) << v.site << " " << v.agl << " m, " << b.fromM << " m";
         }
       }
     }
