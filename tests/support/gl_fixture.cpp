@@ -7,12 +7,12 @@
 #include <string>
 
 namespace strata::test {
-namespace {
-
 bool noGlRequested() {
   const char* v = std::getenv("STRATA_NO_GL");
   return v && std::string(v) == "1";
 }
+
+namespace {
 
 struct Shared {
   std::optional<gl::HeadlessContext> ctx;

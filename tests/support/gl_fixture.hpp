@@ -16,6 +16,10 @@
 
 namespace strata::test {
 
+/// The run says it has no GL (STRATA_NO_GL=1): GL tests skip, and say so, instead of failing.
+/// Tests that reach GL through another program (strata-view under Xvfb) ask this too.
+bool noGlRequested();
+
 class GlTest : public ::testing::Test {
  protected:
   void SetUp() override;

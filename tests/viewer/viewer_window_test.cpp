@@ -18,6 +18,7 @@
 #include <strata/render/image_io.hpp>
 
 #include "../render/drape_raster.hpp"
+#include "gl_fixture.hpp"
 #include "strata_test.hpp"
 #include "terrain_fixture.hpp"
 
@@ -52,7 +53,7 @@ Result<std::string> runViewerWindow(const std::vector<std::string>& args, const 
 }
 
 TEST(ViewerWindow, ScriptedSessionMatchesGoldensAndUndoIsExact) {
-  if (std::getenv("STRATA_NO_GL")) GTEST_SKIP() << "STRATA_NO_GL set: no GL in this run";
+  if (test::noGlRequested()) GTEST_SKIP() << "STRATA_NO_GL=1: this run has no GL context";
   ASSERT_TRUE(std::filesystem::exists(kXvfbRun))
       << "xvfb-run is missing (scripts/setup.sh installs xvfb): strata-view needs an X server";
   const auto out = test::outputDir("viewer");
@@ -126,7 +127,7 @@ TEST(ViewerWindow, MapLayersFromTheCommandLineAreDrawn) {
   // strata-view with the UTM marker raster draped over the Grand Canyon, a 0.05 degree graticule
   // and a scale bar, looking straight down at the marker from 12 km: the centre is the marker's
   // red, the graticule's white lines cross the view, the bar sits in the bottom-left corner.
-  if (std::getenv("STRATA_NO_GL")) GTEST_SKIP() << "STRATA_NO_GL set: no GL in this run";
+  if (test::noGlRequested()) GTEST_SKIP() << "STRATA_NO_GL=1: this run has no GL context";
   ASSERT_TRUE(std::filesystem::exists(kXvfbRun)) << "xvfb-run is missing (scripts/setup.sh installs it)";
   const auto out = test::outputDir("viewer");
   const std::string o = out.string() + "/";
