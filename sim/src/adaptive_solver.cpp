@@ -129,6 +129,14 @@ std::string AdaptiveSolver::backendName() const {
 
 int AdaptiveSolver::ownerOf(int bx, int by) const { return (by / o_.tileSize) * tilesX_ + bx / o_.tileSize; }
 
+void AdaptiveSolver::onClockStarted() {
+  for (auto& t : tiles_) {
+    for (auto& sim : t.sims) {
+      if (sim) sim->startClockAt(timeS());
+    }
+  }
+}
+
 Status AdaptiveSolver::onSourceAdded(const Source& source) {
   if (started_) return fail("adaptive tiles: add sources before the first step");
   for (auto [x, y] : source.cells) tiles_[size_t(ownerOf(x, y))].pinned = true;
@@ -165,6 +173,8 @@ Status AdaptiveSolver::ensureSim(Tile& t, int L) {
       STRATA_TRY_STATUS((*sim)->addSource(one));
     }
   }
+  // Its clock is the run's (a sim made mid-run or during a spin-up feeds its sources at that time).
+  (*sim)->startClockAt(timeS());
   t.sims[size_t(L)] = std::move(sim).value();
   return {};
 }

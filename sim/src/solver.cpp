@@ -227,6 +227,7 @@ FloodStats floodStatsFromCells(const std::vector<float>& v, int width, int heigh
 void Solver::startClockAt(double timeS) {
   STRATA_CHECK(c_.steps == 0 && std::isfinite(timeS)) << "the clock is set before the first step";
   c_.timeS = timeS;
+  onClockStarted();
 }
 
 void Solver::restartBudgets() {

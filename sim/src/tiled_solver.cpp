@@ -54,6 +54,10 @@ std::string TiledSolver::backendName() const {
 
 int TiledSolver::ownerOf(int x, int y) const { return (y / options_.tileHeight) * tilesX_ + x / options_.tileWidth; }
 
+void TiledSolver::onClockStarted() {
+  for (auto& tile : tiles_) tile.solver->startClockAt(timeS());
+}
+
 Status TiledSolver::onSourceAdded(const Source& source) {
   // Each cell becomes its own source carrying its share, so a tile that sees only some of the
   // cells still feeds each the right amount.

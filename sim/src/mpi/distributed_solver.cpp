@@ -105,8 +105,11 @@ class Timer {
   double t0_;
 };
 
-// The lowest failing rank's message on every rank, or success everywhere.
-Status collective(const Status& local, int rank, MPI_Comm comm) {
+}  // namespace
+
+Status collectiveStatus(const Status& local, MPI_Comm comm) {
+  int rank = 0;
+  MPI_Comm_rank(comm, &rank);
   int failing = local.ok() ? INT_MAX : rank, first = INT_MAX;
   MPI_Allreduce(&failing, &first, 1, MPI_INT, MPI_MIN, comm);
   if (first == INT_MAX) return {};
@@ -115,10 +118,8 @@ Status collective(const Status& local, int rank, MPI_Comm comm) {
   MPI_Bcast(&len, 1, MPI_INT, first, comm);
   msg.resize(size_t(len));
   MPI_Bcast(msg.data(), len, MPI_CHAR, first, comm);
-  return fail("rank " + std::to_string(first) + ": " + msg);
+  return fail(first == 0 ? msg : "rank " + std::to_string(first) + ": " + msg);
 }
-
-}  // namespace
 
 namespace detail {
 
@@ -279,7 +280,7 @@ struct DistributedSolver::Impl {
     for (size_t k = 0; k < blocks.size(); ++k) localIndex[size_t(blocks[k].id)] = int(k);
     if (blockBackend.empty() && !blocks.empty()) blockBackend = blocks[0].solver->backendName();
     plan(params);
-    return collective(status, rank, comm);
+    return collectiveStatus(status, comm);
   }
 
   // Who sends what to whom each step, from `owner`.
@@ -617,6 +618,10 @@ CellBlock DistributedSolver::readLocalBlock(const CellRect& rect, unsigned parts
   return {};
 }
 
+void DistributedSolver::onClockStarted() {
+  for (auto& b : impl_->blocks) b.solver->startClockAt(timeS());
+}
+
 Status DistributedSolver::onSourceAdded(const Source& source) {
   for (auto& b : impl_->blocks) STRATA_TRY_STATUS(Impl::addSource(b, source));
   return {};
@@ -781,7 +786,7 @@ Result<RebalanceReport> DistributedSolver::rebalance() {
     arrived.push_back(std::move(b).value());
   }
   MPI_Waitall(int(requests.size()), requests.data(), MPI_STATUSES_IGNORE);
-  status = collective(status, m.rank, m.comm);
+  status = collectiveStatus(status, m.comm);
   if (!status) return status.error();
   // Blocks that stay keep their idle state; those that arrive start active (always exact).
   m.owner = next;
@@ -1003,7 +1008,7 @@ Status DistributedSolver::restoreCells(const SolverState& in) {
     status = fail("distributed: the saved state's blocks do not match its block grid (rank " + std::to_string(m.rank) +
                   " has " + std::to_string(in.parts.size()) + " parts)");
   }
-  STRATA_TRY_STATUS(collective(status, m.rank, m.comm));
+  STRATA_TRY_STATUS(collectiveStatus(status, m.comm));
   if (owner != m.owner) {
     m.owner = owner;
     STRATA_TRY_STATUS(m.adoptOwners(params(), sources(), levels(), floodThresholdM(), {}));
@@ -1017,7 +1022,7 @@ Status DistributedSolver::restoreCells(const SolverState& in) {
     }
   }
   m.invalidate();
-  return collective(status, m.rank, m.comm);
+  return collectiveStatus(status, m.comm);
 }
 
 // -------------------------------------------------------------------------------------------------

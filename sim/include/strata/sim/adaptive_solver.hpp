@@ -91,6 +91,7 @@ class AdaptiveSolver final : public Solver {
                  const SolverFactory& makeTile);
   void runStep(const StepInputs& step) override;
   Status onSourceAdded(const Source& source) override;
+  void onClockStarted() override;
   Status onLevelAdded(const LevelBoundary& level) override;
   void saveCells(SolverState& out) const override;
   Status restoreCells(const SolverState& in) override;

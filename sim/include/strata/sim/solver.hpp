@@ -244,6 +244,9 @@ class Solver {
   void updateRainTotals();
   /// A source or level was added (runners hand them on to the solvers they hold).
   virtual Status onSourceAdded(const Source& /*source*/) { return {}; }
+  /// startClockAt() set the clock (runners set their parts' clocks: a part's sources and levels
+  /// follow its own clock).
+  virtual void onClockStarted() {}
   virtual Status onLevelAdded(const LevelBoundary& /*level*/) { return {}; }
 
   /// Per-cell sums for stats(): the cells' depth, suspended load and layers, and the totals of
