@@ -1,11 +1,13 @@
 // strata flood SCENARIO / strata erode SCENARIO: run a what-if scenario and write its
-// run folder (maps, series, plots, report). Ctrl-C stops cleanly; --resume continues.
+// run folder (maps, series, plots, report). Ctrl-C stops cleanly; --resume continues. Under
+// mpirun the run is spread over the ranks (docs/distributed.md); rank 0 prints for all.
 #include <algorithm>
 #include <cstdio>
 #include <memory>
 
 #include <strata/scenario/run.hpp>
 #include <strata/scenario/scenario.hpp>
+#include <strata/sim/distributed_solver.hpp>
 
 #include "commands.hpp"
 
@@ -31,11 +33,16 @@ void addRunCommand(CLI::App& app, const char* name, const char* help, bool erosi
   cmd->add_flag("--no-pictures", args->noPictures, "Do not render pictures");
   cmd->add_flag("--no-plots", args->noPlots, "Do not draw plots");
   cmd->callback([args, name, erosion] {
+    const auto& mpi = mpiLaunch();
+    // One line per failure, from rank 0 only (every rank fails alike).
+    auto failWith = [&](const std::string& what, int code) {
+      if (mpi.rank == 0) std::fprintf(stderr, "strata %s: %s\n", name, what.c_str());
+      throw CLI::RuntimeError(code);
+    };
     auto scenario = scenario::loadScenario(args->scenario);
-    if (!scenario) {
-      std::fprintf(stderr, "strata %s: %s\n", name, scenario.message().c_str());
-      throw CLI::RuntimeError(1);
-    }
+    // Every rank reads the scenario; a rank that cannot fails the run on every rank.
+    const Status loaded = mpi.active ? sim::collectiveStatus(statusOf(scenario), MPI_COMM_WORLD) : statusOf(scenario);
+    if (!loaded) failWith(loaded.message(), 1);
     if (erosion && !scenario->erosion.enabled) {
       scenario->erosion.enabled = true;
       for (const auto& m : scenario::erosionOutputMaps()) {
@@ -47,10 +54,7 @@ void addRunCommand(CLI::App& app, const char* name, const char* help, bool erosi
     opt.command = name;
     if (!args->backend.empty()) {
       auto backend = scenario::parseBackend(args->backend);
-      if (!backend) {
-        std::fprintf(stderr, "strata %s: --backend: %s\n", name, backend.message().c_str());
-        throw CLI::RuntimeError(2);
-      }
+      if (!backend) failWith("--backend: " + backend.message(), 2);
       opt.backend = *backend;
     }
     opt.outDir = args->outDir.empty() ? std::filesystem::path("runs") / scenario->file.stem()
@@ -59,12 +63,12 @@ void addRunCommand(CLI::App& app, const char* name, const char* help, bool erosi
     opt.overwrite = args->overwrite;
     opt.pictures = !args->noPictures && scenario->outputs.pictures;
     opt.plots = !args->noPlots && scenario->outputs.plots;
+    opt.distributed = mpi.active;
     auto run = scenario::runScenario(*scenario, opt);
-    if (!run) {
-      std::fprintf(stderr, "strata %s: %s\n", name, run.message().c_str());
-      throw CLI::RuntimeError(1);
+    if (!run) failWith(run.message(), 1);
+    if (mpi.rank == 0) {
+      std::printf("%s: %s\n", run->completed ? "finished" : "stopped", (opt.outDir / "report.md").c_str());
     }
-    std::printf("%s: %s\n", run->completed ? "finished" : "stopped", (opt.outDir / "report.md").c_str());
     if (!run->completed) throw CLI::RuntimeError(130);
   });
 }

@@ -14,4 +14,12 @@ void addCheckCommand(CLI::App& app);
 void addIngestCommand(CLI::App& app);
 void addExportCommand(CLI::App& app);
 
+/// Whether strata runs as one rank of an MPI job (launched by mpirun or mpiexec: main initialises
+/// MPI then), this process's rank and the number of ranks; else false, 0, 1.
+struct MpiLaunch {
+  bool active = false;
+  int rank = 0, size = 1;
+};
+const MpiLaunch& mpiLaunch();
+
 }  // namespace strata::app

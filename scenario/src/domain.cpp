@@ -326,13 +326,16 @@ Result<RegionFrame> regionWindow(const Scenario& s, const TerrainSource& source,
 // thermal flows, flood statistics; 8 accumulators; base, bed, tilt, outflow limit, rain; a float
 // per layer), the domain (bed, mask, area in double, base, layers, water, rain), what the run
 // reads back at each interval (depth, flood statistics, layers, terrain change), and the
-// checkpoint (the saved state, and its encoding beside it).
-double bytesPerCell(int layers) {
+// checkpoint (the saved state, and its encoding beside it). Over `ranks` MPI ranks the lead (the
+// heaviest) holds the whole domain and the gathered read-backs, and a 1/ranks share of the solver
+// and checkpoint (its blocks' halos add ~10% at the default block sizes).
+double bytesPerCell(int layers, int ranks) {
   const double solver = 4.0 * (9 * 4 + 8 + 5 + layers);
   const double domain = 4 + 1 + 8 + 4 + 4.0 * layers + 4 + 4;
   const double readBack = 4 + 16 + 4.0 * layers + 8;
   const double checkpoint = 2 * 4.0 * (4 + 4 + 4 + 8 + 4 + layers);
-  return solver + domain + readBack + checkpoint;
+  const double share = ranks > 1 ? 1.1 / ranks : 1.0;
+  return (solver + checkpoint) * share + domain + readBack;
 }
 
 // The key a message about the region's size names: cell_size when given, else the region, else
@@ -355,8 +358,9 @@ gis::Georef windowGeoref(const gis::Georef& full, const gis::CellRect& w) {
 
 // Step 2: the grid, planned before anything is read: the window at region.cell_size (sizes in
 // double, so no count overflows), at least 4 x 4 cells, and a run on it must fit in the memory
-// this process can have (`budget` bytes; 0: what the machine has available).
-Status planGrid(const Scenario& s, const TerrainSource& source, RegionFrame& frame, uint64_t budget) {
+// this process can have (`budget` bytes; 0: what the machine has available), its share of a run
+// over `ranks` MPI ranks.
+Status planGrid(const Scenario& s, const TerrainSource& source, RegionFrame& frame, uint64_t budget, int ranks) {
   const gis::Georef g0 = windowGeoref(source.georef(), frame.window);
   double width = g0.width, height = g0.height;
   if (s.region.cellSizeM > 0) {
@@ -386,7 +390,7 @@ Status planGrid(const Scenario& s, const TerrainSource& source, RegionFrame& fra
   const int layers = std::max<int>(1, source.layerCount() + int(s.terrain.layers.size()));
   const double cells = width * height, nativeCells = double(g0.width) * g0.height;
   // The window as read (and GDAL's copy while it resamples) comes on top.
-  const double bytes = cells * bytesPerCell(layers) + (s.region.cellSizeM > 0 ? 8 * nativeCells : 0);
+  const double bytes = cells * bytesPerCell(layers, ranks) + (s.region.cellSizeM > 0 ? 8 * nativeCells : 0);
   const double available = budget > 0 ? double(budget) : double(availableMemoryBytes());
   const bool tooWide = width > std::numeric_limits<int>::max() / 2 || height > std::numeric_limits<int>::max() / 2;
   if (tooWide || (available > 0 && bytes > available)) {
@@ -955,11 +959,11 @@ sim::SimParams modelParams(const Scenario& s) {
   return p;
 }
 
-Result<ScenarioDomain> buildDomain(const Scenario& s, uint64_t memoryBudgetBytes) {
+Result<ScenarioDomain> buildDomain(const Scenario& s, uint64_t memoryBudgetBytes, int ranks) {
   STRATA_TRY(auto source, TerrainSource::open(s));
   STRATA_TRY(auto mapper, PixelMapper::create(source.georef()));
   STRATA_TRY(auto frame, regionWindow(s, source, mapper));
-  STRATA_TRY_STATUS(planGrid(s, source, frame, memoryBudgetBytes));
+  STRATA_TRY_STATUS(planGrid(s, source, frame, memoryBudgetBytes, ranks));
   ScenarioDomain d;
   std::vector<StoredLayer> storeLayers;
   STRATA_TRY_STATUS(readBed(s, source, frame, d, storeLayers));

@@ -21,12 +21,15 @@
 #include <strata/scenario/domain.hpp>
 #include <strata/scenario/report.hpp>
 #include <strata/sim/cpu_solver.hpp>
+#include <strata/sim/distributed_solver.hpp>
 #include <strata/sim/gl_solver.hpp>
 
 #include "checkpoint.hpp"
+#include "distributed.hpp"
 
 namespace strata::scenario {
 namespace fs = std::filesystem;
+using detail::Ranks;
 namespace {
 
 std::string slurp(const fs::path& p) {
@@ -36,8 +39,10 @@ std::string slurp(const fs::path& p) {
   return s.str();
 }
 
-// Total material thickness per cell (m), for terrain change.
+// Total material thickness per cell (m), for terrain change (empty without layers: a rank other
+// than the lead reads no grids).
 gis::Grid<float> materialThickness(const std::vector<gis::Grid<float>>& layers) {
+  if (layers.empty() || layers.front().size() == 0) return {};
   gis::Grid<float> t(layers.front().width, layers.front().height, 0.0f);
   for (const auto& l : layers) {
     for (size_t i = 0; i < t.size(); ++i) t.data[i] += l.data[i];
@@ -61,6 +66,7 @@ std::vector<std::string> runFolderFiles() {
   for (int k = 1; k <= kMaxLayerMaps; ++k) files.push_back(layerMapFile(k));
   for (const char* p : {"water", "area", "balance", "sediment"}) files.push_back("plots/" + std::string(p) + ".png");
   for (const char* p : {"before", "peak", "after", "max_depth"}) files.push_back("pictures/" + std::string(p) + ".png");
+  for (const auto& f : detail::modelInputFiles(detail::kMaxInputLayers)) files.push_back(f);
   return files;
 }
 
@@ -120,27 +126,43 @@ Result<FileLock> takeRunFolder(const RunOptions& opt) {
 
 // What runs the simulation: a GL context when the GL backend or the pictures need one, and the
 // solver. `auto` takes the GL backend on a hardware GPU and the CPU backend when the only GL is
-// a software rasteriser (llvmpipe is slower than the CPU backend) or there is none.
+// a software rasteriser (llvmpipe is slower than the CPU backend) or there is none. Over MPI
+// ranks: every rank's blocks run on its own GPU (one per local rank) for GL, `auto` takes GL only
+// when every rank has a hardware GPU, and only the lead needs a context for pictures.
 struct Engine {
   std::optional<gl::HeadlessContext> context;
   std::unique_ptr<sim::Solver> solver;
+  sim::DistributedSolver* distributed = nullptr;  ///< the solver, when it runs over MPI ranks
 };
 
-Result<Engine> startEngine(Backend backend, const ScenarioDomain& d, bool pictures) {
+Result<Engine> startEngine(Backend backend, const ScenarioDomain& d, bool pictures, const Ranks& ranks,
+                           const fs::path& runDir) {
   Engine e;
-  if (backend != Backend::kCpu || pictures) {
-    auto ctx = gl::HeadlessContext::create();
+  Status contextStatus;
+  if (backend != Backend::kCpu || (pictures && ranks.lead())) {
+    gl::HeadlessOptions o;
+    if (ranks.distributed()) o.device = sim::rankEglDevice(MPI_COMM_WORLD);
+    auto ctx = gl::HeadlessContext::create(o);
     if (ctx) {
       e.context.emplace(std::move(ctx).value());
     } else if (backend == Backend::kGpu) {
-      return fail("the GPU backend needs a GL 4.5 context: " + ctx.message());
-    } else if (pictures) {
-      return fail("pictures need a GL 4.5 context (run with --no-pictures without one): " + ctx.message());
+      contextStatus = fail("the GPU backend needs a GL 4.5 context: " + ctx.message());
+    } else if (pictures && ranks.lead()) {
+      contextStatus = fail("pictures need a GL 4.5 context (run with --no-pictures without one): " + ctx.message());
     }
   }
-  const bool gpu =
-      backend == Backend::kGpu || (backend == Backend::kAuto && e.context && !e.context->info().isSoftware());
-  if (gpu) {
+  STRATA_TRY_STATUS(ranks.agree(contextStatus));
+  const bool hardware = e.context && !e.context->info().isSoftware();
+  const bool gpu = backend == Backend::kGpu || (backend == Backend::kAuto && ranks.all(hardware));
+  if (ranks.distributed()) {
+    sim::DistributedOptions o;
+    o.comm = MPI_COMM_WORLD;
+    STRATA_TRY(auto s, sim::DistributedSolver::create(detail::modelInputSource(runDir, d), d.params, o,
+                                                      gpu ? sim::glSolverFactory() : sim::cpuSolverFactory()));
+    auto solver = std::make_unique<sim::DistributedSolver>(std::move(s));
+    e.distributed = solver.get();
+    e.solver = std::move(solver);
+  } else if (gpu) {
     STRATA_TRY(auto s, sim::GlSolver::create(d.input, d.params));
     e.solver = std::make_unique<sim::GlSolver>(std::move(s));
   } else {
@@ -151,6 +173,13 @@ Result<Engine> startEngine(Backend backend, const ScenarioDomain& d, bool pictur
   for (const auto& level : d.levels) STRATA_TRY_STATUS(e.solver->addLevel(level));
   return e;
 }
+
+// What a picture shows of the solver's state: read on every rank (the reads are collective over
+// MPI ranks), drawn by the lead. `surfaceM` and `layers` (the top four) only in erosion runs.
+struct PictureState {
+  gis::Grid<float> depthM, surfaceM;
+  std::vector<gis::Grid<float>> layers;
+};
 
 // Oblique pictures of the region with its water, drawn by the concentric-ring renderer: from a
 // little behind the first inflow (or the region's centre), looking across the region towards its
@@ -196,19 +225,16 @@ class Pictures {
     return p;
   }
 
-  /// Draws the terrain with the solver's water (`depthM`, read already) and writes `file` (PNG).
-  Status draw(const sim::Solver& sv, gis::Grid<float> depthM, const fs::path& file) {
-    for (float& h : depthM.data) h = h > wetThresholdM_ ? h : 0.0f;  // no rain film painted as water
+  /// Draws the terrain with the solver's state and writes `file` (PNG).
+  Status draw(PictureState state, const fs::path& file) {
+    for (float& h : state.depthM.data) h = h > wetThresholdM_ ? h : 0.0f;  // no rain film painted as water
     if (erosion_) {
       // The surface as it is now (bed above the datum, layers included) and the top four layers.
-      gis::Grid<float> surface = sv.readBed();
-      for (float& z : surface.data) z = float(double(z) + datumM_);
-      scene_.writeHeights(0, 0, surface);
-      auto layers = sv.readLayers();
-      if (layers.size() > 4) layers.erase(layers.begin(), layers.end() - 4);
-      STRATA_TRY_STATUS(scene_.setMaterialLayers(layers));
+      for (float& z : state.surfaceM.data) z = float(double(z) + datumM_);
+      scene_.writeHeights(0, 0, state.surfaceM);
+      STRATA_TRY_STATUS(scene_.setMaterialLayers(state.layers));
     }
-    STRATA_TRY_STATUS(scene_.setWaterDepth(depthM));
+    STRATA_TRY_STATUS(scene_.setWaterDepth(state.depthM));
     return write(file);
   }
 
@@ -274,16 +300,34 @@ int exposedLayer(int layers, Thickness&& thickness) {
 }
 
 // The run in progress: the scenario, its domain, the solver and what has been written so far.
+// Over MPI ranks every rank holds one and calls the same methods in the same order (the solver's
+// reads are collective); only the lead holds the domain's grids and gets the grids read, and only
+// it writes files.
 class Run {
  public:
-  Run(const Scenario& s, const RunOptions& opt, ScenarioDomain d, Engine e)
+  Run(const Scenario& s, const RunOptions& opt, const Ranks& ranks, ScenarioDomain d, Engine e)
       : s_(s),
         opt_(opt),
+        ranks_(ranks),
         d_(std::move(d)),
         e_(std::move(e)),
         initialMaterial_(materialThickness(solver().readLayers())) {}
 
   sim::Solver& solver() { return *e_.solver; }
+  /// The solver when it runs over MPI ranks (else null).
+  sim::DistributedSolver* distributed() { return e_.distributed; }
+
+  /// The state a picture shows (collective).
+  PictureState pictureState(gis::Grid<float> depthM) {
+    PictureState p;
+    p.depthM = std::move(depthM);
+    if (s_.erosion.enabled) {
+      p.surfaceM = solver().readBed();
+      p.layers = solver().readLayers();
+      if (p.layers.size() > 4) p.layers.erase(p.layers.begin(), p.layers.end() - 4);
+    }
+    return p;
+  }
 
   // Uniform rain while it falls, [start, end).
   double rainAt(double t) const { return t >= d_.rainStartS && t < d_.rainEndS ? d_.rainMmPerHour : 0.0; }
@@ -315,7 +359,7 @@ class Run {
         chosenDtS_ = sv.nextDt();
         minChosenDtS_ = std::min(minChosenDtS_, chosenDtS_);
         sv.stepWithDt(std::min(chosenDtS_, next - sv.timeS()));
-        if (interrupted()) return false;
+        if (ranks_.anyInterrupted()) return false;
       }
     }
     return true;
@@ -397,8 +441,16 @@ class Run {
   }
 
   // The maps the scenario asks for, as GeoTIFFs in the region's CRS.
+  // Collective: every rank reads, the lead writes.
   Status writeMaps(const gis::Grid<float>& depth) {
     const auto flood = solver().readFloodStats();
+    std::vector<gis::Grid<float>> layers;
+    gis::Grid<float> suspended;
+    if (s_.erosion.enabled) {
+      layers = solver().readLayers();
+      suspended = solver().readSuspended();
+    }
+    if (!ranks_.lead()) return {};
     auto writeMap = [&](const std::string& name, const gis::Grid<float>& values, bool wetOnly,
                         const std::vector<std::pair<std::string, std::string>>& metadata = {}) -> Status {
       if (std::find(s_.outputs.maps.begin(), s_.outputs.maps.end(), name) == s_.outputs.maps.end()) return {};
@@ -417,7 +469,7 @@ class Run {
     STRATA_TRY_STATUS(writeMap("arrival_time", flood.arrivalS, true));
     STRATA_TRY_STATUS(writeMap("inundation_duration", flood.wetDurationS, false));
     STRATA_TRY_STATUS(writeMap("final_depth", depth, false));
-    if (s_.erosion.enabled) STRATA_TRY_STATUS(writeErosionMaps(writeMap));
+    if (s_.erosion.enabled) STRATA_TRY_STATUS(writeErosionMaps(writeMap, layers, suspended));
     return {};
   }
 
@@ -425,9 +477,9 @@ class Run {
   // data), suspended_sediment (m of material in the water) and
   // layer_thickness (maps/layer_K.tif, K = 1 the bottom layer, each naming its material).
   template <class WriteMap>
-  Status writeErosionMaps(WriteMap&& writeMap) {
+  Status writeErosionMaps(WriteMap&& writeMap, const std::vector<gis::Grid<float>>& layers,
+                          const gis::Grid<float>& suspended) {
     STRATA_TRY_STATUS(writeMap("terrain_change", change_, false));
-    const auto layers = solver().readLayers();
     const int L = int(layers.size());
     gis::Grid<float> top(layers.front().width, layers.front().height, gis::kNoData);
     for (size_t i = 0; i < top.size(); ++i) {
@@ -445,7 +497,7 @@ class Run {
       legend.push_back({"STRATA_COLOUR_" + std::to_string(l), rgb});
     }
     STRATA_TRY_STATUS(writeMap("exposed_material", top, false, legend));
-    STRATA_TRY_STATUS(writeMap("suspended_sediment", solver().readSuspended(), false));
+    STRATA_TRY_STATUS(writeMap("suspended_sediment", suspended, false));
     if (std::find(s_.outputs.maps.begin(), s_.outputs.maps.end(), "layer_thickness") == s_.outputs.maps.end()) {
       return {};
     }
@@ -463,11 +515,13 @@ class Run {
     return {};
   }
 
-  // Where the material went (the report's balance): per layer, and the solver's totals.
+  // Where the material went (the report's balance): per layer, and the solver's totals
+  // (collective; computed on the lead).
   MaterialBudget materialBudget() {
     MaterialBudget b;
     const auto layers = solver().readLayers();
     const auto st = solver().stats();
+    if (!ranks_.lead()) return b;
     const int w = layers.front().width, h = layers.front().height;
     for (size_t l = 0; l < layers.size(); ++l) {
       b.layers.push_back(d_.input.materials[l].name);
@@ -514,6 +568,7 @@ class Run {
  private:
   const Scenario& s_;
   const RunOptions& opt_;
+  const Ranks& ranks_;
   ScenarioDomain d_;
   Engine e_;
   gis::Grid<float> initialMaterial_, change_;
@@ -527,20 +582,33 @@ std::vector<std::string> runFolderOutputs(const fs::path& runDir) {
   for (const auto& f : runFolderFiles()) {
     if (fs::exists(runDir / f)) out.push_back(f);
   }
+  // The ranks' checkpoint parts of a run over MPI (checkpoint.R-of-N.bin).
+  std::error_code ec;
+  std::vector<std::string> parts;
+  for (const auto& e : fs::directory_iterator(runDir, ec)) {
+    const std::string name = e.path().filename().string();
+    if (detail::isRankCheckpointFile(name)) parts.push_back(name);
+  }
+  std::sort(parts.begin(), parts.end());
+  out.insert(out.end(), parts.begin(), parts.end());
   return out;
 }
 
 std::vector<std::string> runFolderTemporaries(const fs::path& runDir) {
   std::vector<std::string> out;
   const auto files = runFolderFiles();
-  for (const char* sub : {"", "maps", "plots", "pictures"}) {
+  for (const char* sub : {"", "maps", "plots", "pictures", "input"}) {
     std::error_code ec;
     for (const auto& e : fs::directory_iterator(runDir / sub, ec)) {
       const std::string name = e.path().filename().string();
       const std::string rel = std::string(sub) + (*sub ? "/" : "");
-      const bool ours = std::any_of(files.begin(), files.end(), [&](const std::string& f) {
-        return fs::path(f).parent_path().string() == sub && isTemporaryOf(name, fs::path(f).filename().string());
-      });
+      const auto tmp = name.find(".tmp");
+      const bool rankPart = !*sub && tmp != std::string::npos && detail::isRankCheckpointFile(name.substr(0, tmp)) &&
+                            isTemporaryOf(name, name.substr(0, tmp));
+      const bool ours =
+          rankPart || std::any_of(files.begin(), files.end(), [&](const std::string& f) {
+            return fs::path(f).parent_path().string() == sub && isTemporaryOf(name, fs::path(f).filename().string());
+          });
       if (ours && e.is_regular_file(ec)) out.push_back(rel + name);
     }
   }
@@ -562,8 +630,30 @@ std::string seriesCsv(const std::vector<SeriesRow>& rows) {
   return out;
 }
 
+namespace {
+
+// Why a checkpoint to resume from is missing, when the folder says: a run checkpointed on another
+// number of ranks (or by one process).
+std::string checkpointHint(const fs::path& dir, const Ranks& ranks) {
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(dir, ec)) {
+    int n = 0;
+    if (detail::isRankCheckpointFile(e.path().filename().string(), &n) && n != ranks.size()) {
+      return " (the run was checkpointed on " + std::to_string(n) + " MPI ranks: resume it with mpirun -np " +
+             std::to_string(n) + ")";
+    }
+  }
+  if (ranks.distributed() && fs::exists(dir / "checkpoint.bin")) {
+    return " (the run was checkpointed by one process: resume it without mpirun)";
+  }
+  return "";
+}
+
+}  // namespace
+
 Result<RunSummary> runScenario(const Scenario& s, const RunOptions& opt) {
   const auto wallStart = std::chrono::steady_clock::now();
+  const Ranks ranks = opt.distributed ? Ranks::world() : Ranks::single();
   // Derived sizes first: the interval count (64-bit, bounded; the parser checked it for files,
   // a scenario built in code is checked here) and, in buildDomain, the grid against memory.
   const double intervalCount = std::ceil(s.durationS / s.outputIntervalS - 1e-9);
@@ -574,24 +664,54 @@ Result<RunSummary> runScenario(const Scenario& s, const RunOptions& opt) {
     return fail(s.at("time.output_interval") + msg);
   }
   const int intervals = int(intervalCount);
-  STRATA_TRY(auto domain, buildDomain(s, opt.memoryBudgetBytes));
-  const auto& g = domain.bed.georef;
+  // The domain: built by the lead (the only rank that holds its grids), the shape sent to the
+  // others once the run folder is taken and the model input written for them to read.
+  ScenarioDomain domain;
+  Status status;
+  if (ranks.lead()) {
+    auto built = buildDomain(s, opt.memoryBudgetBytes, ranks.size());
+    if (built) domain = std::move(built).value();
+    status = statusOf(built);
+  }
+  STRATA_TRY_STATUS(ranks.agree(status));
   const std::string name = displayName(s.name);
-  log::info(opt.command) << name << ": " << g.width << " x " << g.height << " cells, " << domain.totalAreaM2 / 1e6
-                         << " km^2, " << domain.sources.size() << " inflow(s), " << domain.levels.size()
-                         << " fixed level(s), " << formatDuration(s.durationS) << " simulated";
+  if (ranks.lead()) {
+    const auto& g = domain.bed.georef;
+    log::info(opt.command) << name << ": " << g.width << " x " << g.height << " cells, " << domain.totalAreaM2 / 1e6
+                           << " km^2, " << domain.sources.size() << " inflow(s), " << domain.levels.size()
+                           << " fixed level(s), " << formatDuration(s.durationS) << " simulated";
+  }
 
-  STRATA_TRY(const FileLock lock, takeRunFolder(opt));
-  std::error_code ec;
-  fs::create_directories(opt.outDir / "maps", ec);
-  if (ec) return fail(opt.outDir.string() + ": cannot create the run folder: " + ec.message());
-  const std::string scenarioText = slurp(s.file);
+  std::optional<FileLock> lock;  // held by the lead for the whole run
+  if (ranks.lead()) {
+    auto taken = takeRunFolder(opt);
+    status = statusOf(taken);
+    if (taken) {
+      lock.emplace(std::move(taken).value());
+      std::error_code ec;
+      fs::create_directories(opt.outDir / "maps", ec);
+      if (ec) status = fail(opt.outDir.string() + ": cannot create the run folder: " + ec.message());
+    }
+    if (status.ok() && ranks.distributed()) status = detail::writeModelInput(opt.outDir, domain);
+  }
+  STRATA_TRY_STATUS(ranks.agree(status));
+  const std::string scenarioText = ranks.fromLead(ranks.lead() ? slurp(s.file) : std::string());
+  if (ranks.distributed()) {
+    const std::string shape = ranks.fromLead(ranks.lead() ? detail::encodeDomainShape(domain) : std::string());
+    if (!ranks.lead()) {
+      auto decoded = detail::decodeDomainShape(shape);
+      if (decoded) domain = std::move(decoded).value();
+      status = statusOf(decoded);
+    }
+    STRATA_TRY_STATUS(ranks.agree(status));
+  }
   const CheckpointOwner owner{opt.command, fnv1a(scenarioText)};
-  const fs::path checkpointPath = opt.outDir / "checkpoint.bin";
+  const fs::path checkpointPath =
+      opt.outDir / (ranks.distributed() ? detail::rankCheckpointFile(ranks.rank(), ranks.size()) : "checkpoint.bin");
 
-  STRATA_TRY(auto engine, startEngine(opt.backend.value_or(s.model.backend), domain, opt.pictures));
+  STRATA_TRY(auto engine, startEngine(opt.backend.value_or(s.model.backend), domain, opt.pictures, ranks, opt.outDir));
   engine.solver->enableFloodStats(float(s.outputs.wetThresholdM));
-  Run run(s, opt, std::move(domain), std::move(engine));
+  Run run(s, opt, ranks, std::move(domain), std::move(engine));
   log::info(opt.command) << "running on " << run.backendName();
 
   installInterruptHandler();
@@ -600,23 +720,46 @@ Result<RunSummary> runScenario(const Scenario& s, const RunOptions& opt) {
     STRATA_TRY(spinUp, run.spinUp(s.spinUpS, name));
   }
 
+  // Pictures: the state read on every rank, drawn by the lead.
   std::optional<Pictures> pictures;
+  auto drawPicture = [&](gis::Grid<float> depth, const char* file) -> Status {
+    auto state = run.pictureState(std::move(depth));
+    return ranks.agree(pictures ? pictures->draw(std::move(state), opt.outDir / "pictures" / file) : Status{});
+  };
   if (opt.pictures) {
-    fs::create_directories(opt.outDir / "pictures", ec);
-    STRATA_TRY(auto p, Pictures::create(run.domain(), s.erosion.enabled, s.outputs.wetThresholdM));
-    pictures.emplace(std::move(p));
-    if (!opt.resume)
-      STRATA_TRY_STATUS(
-          pictures->draw(run.solver(), run.solver().readWaterDepth(), opt.outDir / "pictures" / "before.png"));
+    if (ranks.lead()) {
+      std::error_code ec;
+      fs::create_directories(opt.outDir / "pictures", ec);
+      auto p = Pictures::create(run.domain(), s.erosion.enabled, s.outputs.wetThresholdM);
+      if (p) pictures.emplace(std::move(p).value());
+      status = statusOf(p);
+    }
+    STRATA_TRY_STATUS(ranks.agree(status));
+    if (!opt.resume) STRATA_TRY_STATUS(drawPicture(run.solver().readWaterDepth(), "before.png"));
   }
 
   RunSummary summary;
   summary.backend = run.backendName();
+  summary.ranks = ranks.size();
   int interval = 0;
   double earlierWallS = 0;  // of the sessions before a resume
   if (opt.resume) {
-    if (!fs::exists(checkpointPath)) return fail(checkpointPath.string() + ": no checkpoint to resume from");
-    STRATA_TRY(auto c, decodeCheckpoint(checkpointPath, owner));
+    // Each rank its own part; all of the same interval.
+    Checkpoint c;
+    status = {};
+    if (!fs::exists(checkpointPath)) {
+      status = fail(checkpointPath.string() + ": no checkpoint to resume from" + checkpointHint(opt.outDir, ranks));
+    } else {
+      auto decoded = decodeCheckpoint(checkpointPath, owner);
+      if (decoded) c = std::move(decoded).value();
+      status = statusOf(decoded);
+    }
+    STRATA_TRY_STATUS(ranks.agree(status));
+    const auto [first, last] = ranks.minMax(c.interval);
+    if (first != last) {
+      return fail(opt.outDir.string() + ": the ranks' checkpoint parts are of different intervals (" +
+                  std::to_string(first) + " to " + std::to_string(last) + "): the run was stopped while writing them");
+    }
     if (c.interval > intervals) return fail(checkpointPath.string() + ": more intervals than the scenario has");
     STRATA_TRY_STATUS(run.solver().restoreState(c.state));
     STRATA_TRY_STATUS(run.setRain(c.state.counters.timeS));
@@ -627,7 +770,8 @@ Result<RunSummary> runScenario(const Scenario& s, const RunOptions& opt) {
     log::info(opt.command) << "resuming at " << formatDuration(run.solver().timeS()) << " (interval " << interval
                            << ")";
   } else {
-    STRATA_TRY_STATUS(writeFileAtomic(opt.outDir / "scenario.toml", scenarioText));
+    STRATA_TRY_STATUS(
+        ranks.agree(ranks.lead() ? writeFileAtomic(opt.outDir / "scenario.toml", scenarioText) : Status{}));
   }
   summary.spinUp = spinUp;
 
@@ -652,26 +796,39 @@ Result<RunSummary> runScenario(const Scenario& s, const RunOptions& opt) {
     }
     if (stopped) break;
 
-    // The interval is complete: its row, maps, pictures and checkpoint.
+    // The interval is complete: its row, maps, pictures and checkpoint. The stored water, and so
+    // which interval is the peak, is the same exact sum on every rank.
     const auto depth = run.solver().readWaterDepth();
     const SeriesRow row = run.row(depth);
     summary.series.push_back(row);
     ++interval;
-    if (pictures) {
+    if (opt.pictures) {
       // The peak picture is redrawn whenever the stored water reaches a new high at an interval.
       const bool peak = std::all_of(summary.series.begin(), summary.series.end(),
                                     [&](const SeriesRow& r) { return r.waterM3 <= row.waterM3; });
-      if (peak) STRATA_TRY_STATUS(pictures->draw(run.solver(), depth, opt.outDir / "pictures" / "peak.png"));
+      if (peak) STRATA_TRY_STATUS(drawPicture(depth, "peak.png"));
       if (interval == intervals) {
-        STRATA_TRY_STATUS(pictures->draw(run.solver(), depth, opt.outDir / "pictures" / "after.png"));
-        STRATA_TRY_STATUS(pictures->drawMaxDepth(run.solver().readFloodStats().maxDepthM, run.domain().bed.georef,
-                                                 opt.outDir / "pictures" / "max_depth.png"));
+        STRATA_TRY_STATUS(drawPicture(depth, "after.png"));
+        const auto maxDepth = run.solver().readFloodStats().maxDepthM;
+        STRATA_TRY_STATUS(ranks.agree(pictures ? pictures->drawMaxDepth(maxDepth, run.domain().bed.georef,
+                                                                        opt.outDir / "pictures" / "max_depth.png")
+                                               : Status{}));
       }
     }
-    STRATA_TRY_STATUS(writeFileAtomic(opt.outDir / "series.csv", seriesCsv(summary.series)));
-    STRATA_TRY_STATUS(run.writeMaps(depth));
+    status = run.writeMaps(depth);
+    if (status.ok() && ranks.lead()) status = writeFileAtomic(opt.outDir / "series.csv", seriesCsv(summary.series));
+    STRATA_TRY_STATUS(ranks.agree(status));
+    // Over MPI ranks the blocks are dealt again by their work before each checkpoint.
+    if (auto* d = run.distributed()) {
+      STRATA_TRY(const auto moved, d->rebalance());
+      if (moved.blocksMoved > 0) {
+        log::info(opt.command) << "re-balanced: " << moved.blocksMoved << " blocks moved, busiest rank "
+                               << moved.imbalanceBefore << " -> " << moved.imbalanceAfter << " x the mean, "
+                               << moved.seconds << " s";
+      }
+    }
     const Checkpoint c{interval, wallSoFar(), summary.series, spinUp, run.solver().saveState()};
-    STRATA_TRY_STATUS(writeFileAtomic(checkpointPath, encodeCheckpoint(owner, c)));
+    STRATA_TRY_STATUS(ranks.agree(writeFileAtomic(checkpointPath, encodeCheckpoint(owner, c))));
     if (opt.stopAfterIntervals >= 0 && interval >= opt.stopAfterIntervals && interval < intervals) break;
   }
   const auto st = run.solver().stats();
@@ -685,7 +842,15 @@ Result<RunSummary> runScenario(const Scenario& s, const RunOptions& opt) {
     log::warn(opt.command) << "stopped at " << formatDuration(summary.series.empty() ? 0 : summary.series.back().timeS)
                            << "; outputs are those of that interval; continue with --resume";
   }
-  summary.files = {"scenario.toml", "series.csv", "checkpoint.bin"};
+  summary.files = {"scenario.toml", "series.csv"};
+  if (ranks.distributed()) {
+    for (int r = 0; r < ranks.size(); ++r) summary.files.push_back(detail::rankCheckpointFile(r, ranks.size()));
+    for (const auto& f : detail::modelInputFiles(int(run.domain().input.materials.size()))) {
+      if (fs::exists(opt.outDir / f)) summary.files.push_back(f);
+    }
+  } else {
+    summary.files.push_back("checkpoint.bin");
+  }
   const auto maps = run.mapFiles();
   summary.files.insert(summary.files.end(), maps.begin(), maps.end());
   std::string maxDepthLegend;
@@ -709,12 +874,14 @@ Result<RunSummary> runScenario(const Scenario& s, const RunOptions& opt) {
       if (fs::exists(opt.outDir / layerMapFile(k))) summary.files.push_back(layerMapFile(k));
     }
   }
+  const auto floodStats = run.solver().readFloodStats();
+  if (!ranks.lead()) return summary;  // the lead writes the plots and the report
   if (opt.plots) {
     STRATA_TRY(auto plots, writePlots(opt.outDir, run.domain().bed, summary.completed));
     summary.files.insert(summary.files.end(), plots.begin(), plots.end());
   }
-  STRATA_TRY_STATUS(writeReport(opt.outDir, ReportInput{s, run.domain(), summary, run.solver().readFloodStats(),
-                                                        run.backendName(), pictureFiles, maxDepthLegend}));
+  STRATA_TRY_STATUS(writeReport(
+      opt.outDir, ReportInput{s, run.domain(), summary, floodStats, run.backendName(), pictureFiles, maxDepthLegend}));
   summary.files.push_back("report.md");
   return summary;
 }

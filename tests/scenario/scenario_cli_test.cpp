@@ -11,6 +11,7 @@
 
 #include <chrono>
 #include <csignal>
+#include <cstring>
 #include <fstream>
 #include <functional>
 #include <sstream>
@@ -89,6 +90,59 @@ void writeCpuScenario(const fs::path& dir) {
   std::string text = scenarioText();
   text.replace(text.find("kind = \"flood\""), 14, "kind = \"flood\"\nbackend = \"cpu\"");
   std::ofstream(dir / "flood.toml") << text;
+}
+
+// mpirun and its flags, running `np` ranks (what STRATA_MPIEXEC_FLAGS holds, ';'-separated).
+std::vector<std::string> mpirun(int np) {
+  std::vector<std::string> w{STRATA_MPIEXEC, "-np", std::to_string(np)};
+  std::stringstream flags(STRATA_MPIEXEC_FLAGS);
+  for (std::string f; std::getline(flags, f, ';');) {
+    if (!f.empty()) w.push_back(f);
+  }
+  return w;
+}
+// Open MPI as root (containers, CI) needs these; harmless otherwise.
+const std::vector<std::string> kMpiEnv{"OMPI_ALLOW_RUN_AS_ROOT=1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1",
+                                       "OMPI_MCA_mpi_yield_when_idle=1", "OMP_NUM_THREADS=1"};
+
+// `mpirun -np 2 strata flood` as a user types it: the same scenario file, the same maps as one
+// process, bit for bit; one progress and one "finished" line; the ranks' checkpoint parts; a
+// resume without mpirun is refused saying how to resume; other commands are refused over ranks.
+TEST(StrataCli, AFloodRunsOverMpiRanks) {
+  const auto dir = strata::test::tempDir("cli-mpi");
+  writeCpuScenario(dir);
+  std::string out;
+  ASSERT_EQ(strata({"flood", "flood.toml", "-o", "one", "--no-pictures", "--no-plots"}, dir, out), 0) << out;
+  ASSERT_EQ(
+      strata({"flood", "flood.toml", "-o", "two", "--no-pictures", "--no-plots"}, dir, out, 0, kMpiEnv, mpirun(2)), 0)
+      << out;
+  auto count = [&](const std::string& what) {
+    size_t n = 0;
+    for (size_t at = out.find(what); at != std::string::npos; at = out.find(what, at + 1)) ++n;
+    return n;
+  };
+  EXPECT_EQ(count("finished: two/report.md"), 1u) << out;
+  EXPECT_EQ(count("running on 2 MPI ranks"), 1u) << out;
+  for (const char* f : {"checkpoint.0-of-2.bin", "checkpoint.1-of-2.bin", "input/base.tif", "report.md"}) {
+    EXPECT_TRUE(fs::exists(dir / "two" / f)) << f;
+  }
+  for (const char* m : {"max_depth", "arrival_time", "final_depth"}) {
+    auto a = gis::readDem((dir / "one" / "maps" / (std::string(m) + ".tif")).string(), allowEmpty());
+    auto b = gis::readDem((dir / "two" / "maps" / (std::string(m) + ".tif")).string(), allowEmpty());
+    ASSERT_TRUE(a && b);
+    ASSERT_EQ(a->values.size(), b->values.size());
+    EXPECT_EQ(std::memcmp(a->values.data.data(), b->values.data.data(), a->values.size() * sizeof(float)), 0) << m;
+  }
+  EXPECT_NE(slurp(dir / "two" / "report.md").find("on 2 MPI ranks"), std::string::npos);
+  // Resumed by one process: refused, saying how.
+  EXPECT_EQ(strata({"flood", "flood.toml", "-o", "two", "--resume", "--no-pictures", "--no-plots"}, dir, out), 1);
+  EXPECT_NE(out.find("checkpoint.bin: no checkpoint to resume from (the run was checkpointed on 2 MPI ranks: "
+                     "resume it with mpirun -np 2)"),
+            std::string::npos)
+      << out;
+  // Only the run commands spread over ranks; the message comes once.
+  EXPECT_EQ(strata({"info", "flood.toml"}, dir, out, 0, kMpiEnv, mpirun(2)), 2) << out;
+  EXPECT_EQ(count("strata: only `strata flood` and `strata erode` run over MPI ranks (2 ranks given)"), 1u) << out;
 }
 
 TEST(StrataCli, TwoFloodsIntoOneFolderOneIsRefused) {

@@ -77,6 +77,12 @@ class [[nodiscard]] Result<void> {
 
 using Status = Result<void>;
 
+/// The outcome of `r` without its value (to hand a failure on, e.g. to the other MPI ranks).
+template <class T>
+Status statusOf(const Result<T>& r) {
+  return r ? Status{} : Status{r.error()};
+}
+
 }  // namespace strata
 
 /// Propagates an error: `STRATA_TRY(auto dem, readDem(path));` or `STRATA_TRY(existing, expr);`.

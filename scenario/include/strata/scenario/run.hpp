@@ -35,6 +35,13 @@ struct RunOptions {
   bool plots = true;     ///< PNG plots of the time series (matplotlib)
   /// Stop after this many output intervals (tests of interrupt-and-resume); -1 = run to the end.
   int stopAfterIntervals = -1;
+  /// Run over the ranks of MPI_COMM_WORLD (`mpirun -np N strata flood`; docs/distributed.md,
+  /// "Scenario runs"): MPI is initialised by the caller, and every rank calls runScenario with the
+  /// same scenario and options. Rank 0 builds the domain and writes the shared files (the model
+  /// input in input/, maps, series, pictures, report); each rank reads its blocks' windows of the
+  /// input and writes its own part of each checkpoint (checkpoint.R-of-N.bin); a run is resumed
+  /// on the same number of ranks. Failures are the same on every rank.
+  bool distributed = false;
 };
 
 /// One row of the time series (series.csv).
@@ -82,6 +89,7 @@ struct SpinUpSummary {
 struct RunSummary {
   bool completed = false;  ///< false: stopped by Ctrl-C or stopAfterIntervals
   std::string backend;     ///< what ran it (Solver::backendName)
+  int ranks = 1;           ///< MPI ranks it ran on (1: one process)
   double simulatedS = 0, wallS = 0;
   long long steps = 0;
   std::vector<SeriesRow> series;

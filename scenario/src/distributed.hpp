@@ -1,0 +1,77 @@
+#pragma once
+// A scenario run spread over the ranks of MPI_COMM_WORLD (`mpirun -np N strata flood SCENARIO`,
+// docs/distributed.md, "Scenario runs"). The lead rank (0) builds the domain (the conditioning,
+// fill_depressions and breach_inflows, needs the whole region), writes the model's input as
+// GeoTIFFs into the run folder (input/) and sends every rank what it needs besides cells (the
+// shape, the model, the sources and levels); each rank then reads only its blocks' windows (plus
+// halo) of those files. Every rank runs the same loop; only the lead touches shared files,
+// except each rank's own checkpoint part.
+
+#include <filesystem>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include <strata/core/result.hpp>
+#include <strata/scenario/domain.hpp>
+#include <strata/sim/region.hpp>
+
+namespace strata::scenario::detail {
+
+/// The ranks a run's loop runs on. A single-process run is one lead rank: nothing is exchanged
+/// and MPI is never called.
+class Ranks {
+ public:
+  static Ranks single() { return {}; }
+  /// The ranks of MPI_COMM_WORLD (MPI must be initialised: `strata` does it under mpirun).
+  static Ranks world();
+
+  bool distributed() const { return distributed_; }
+  bool lead() const { return rank_ == 0; }
+  int rank() const { return rank_; }
+  int size() const { return size_; }
+
+  /// Collective: success on every rank, or the lowest failing rank's failure on every rank.
+  Status agree(const Status& local) const;
+  /// Collective: whether any rank has been asked to stop (Ctrl-C, SIGTERM).
+  bool anyInterrupted() const;
+  /// Collective: the lead's `bytes` on every rank.
+  std::string fromLead(std::string bytes) const;
+  /// Collective: the smallest and largest of `value` over the ranks.
+  std::pair<long long, long long> minMax(long long value) const;
+  /// Collective: whether `value` holds on every rank.
+  bool all(bool value) const;
+
+ private:
+  bool distributed_ = false;
+  int rank_ = 0, size_ = 1;
+};
+
+/// What every rank needs of the domain besides its cells: the region's size (bed.georef's width
+/// and height), the model, inflows, levels, rain, materials, cell sizes and datum.
+std::string encodeDomainShape(const ScenarioDomain& d);
+/// The domain with no cells from encodeDomainShape's bytes: every grid empty but waterDepthM and
+/// rainMmPerHour, which are 1 x 1 where the lead's domain has them (modelInputSource reads them).
+Result<ScenarioDomain> decodeDomainShape(std::string_view bytes);
+
+/// The run folder's model input files for `layers` layers (relative paths): input/base.tif,
+/// input/layer_K.tif (K = 1 the bottom layer), input/water.tif, input/rain.tif.
+std::vector<std::string> modelInputFiles(int layers);
+/// Layers a distributed run can have (one model input file each).
+inline constexpr int kMaxInputLayers = 64;
+
+/// Writes the domain's model input (base, layers, initial water and rain raster when present) as
+/// float32 GeoTIFFs in the region's CRS into `runDir`/input (the lead, before the ranks read).
+Status writeModelInput(const std::filesystem::path& runDir, const ScenarioDomain& d);
+
+/// The region read window by window from those files (`shape` from decodeDomainShape or the
+/// lead's domain): what each rank builds its blocks from.
+sim::RegionSource modelInputSource(const std::filesystem::path& runDir, const ScenarioDomain& shape);
+
+/// checkpoint.R-of-N.bin: rank R's part of a run checkpointed on N ranks.
+std::string rankCheckpointFile(int rank, int ranks);
+/// Whether `name` is such a file (any R and N); sets `ranks` to its N.
+bool isRankCheckpointFile(std::string_view name, int* ranks = nullptr);
+
+}  // namespace strata::scenario::detail

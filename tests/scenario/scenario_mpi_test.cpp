@@ -1,0 +1,237 @@
+// A scenario run over MPI ranks (RunOptions::distributed, what `mpirun -np N strata flood` does;
+// docs/distributed.md, "Scenario runs") under mpirun on 1, 2 and 4 ranks
+// (tests/scenario/CMakeLists.txt registers each). Rank 0 also runs the same scenario in one
+// process; the run over the ranks must write the same maps bit for bit and the same series, for a
+// flood with a spin-up, rain, conditioning (breach_inflows, fill_depressions) and open edges, and
+// for an erosion run; a run stopped at a checkpoint and resumed must equal the uninterrupted one.
+#include <gtest/gtest.h>
+#include <mpi.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <strata/gis/dem_io.hpp>
+#include <strata/scenario/run.hpp>
+#include <strata/scenario/scenario.hpp>
+
+#include "scenario_fixture.hpp"
+
+// This binary has its own main (MPI around GoogleTest), not the test support library's: the one
+// helper of it the fixture uses.
+namespace strata::test {
+std::string dataPath(const std::string& relative) { return std::string(STRATA_DATA_DIR) + "/" + relative; }
+}  // namespace strata::test
+
+namespace strata::scenario {
+namespace {
+
+namespace fs = std::filesystem;
+using namespace test_support;
+
+int worldRank() {
+  int r = 0;
+  MPI_Comm_rank(MPI_COMM_WORLD, &r);
+  return r;
+}
+int worldSize() {
+  int n = 0;
+  MPI_Comm_size(MPI_COMM_WORLD, &n);
+  return n;
+}
+
+// A folder every rank sees: made by rank 0, its name sent to the others.
+fs::path sharedDir(const std::string& name) {
+  std::string path;
+  if (worldRank() == 0) {
+    path = (fs::temp_directory_path() /
+            ("strata-scenario-mpi-" + name + "-" + std::to_string(worldSize()) + "-" + std::to_string(::getpid())))
+               .string();
+    fs::remove_all(path);
+    fs::create_directories(path);
+  }
+  int len = int(path.size());
+  MPI_Bcast(&len, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  path.resize(size_t(len));
+  MPI_Bcast(path.data(), len, MPI_CHAR, 0, MPI_COMM_WORLD);
+  return path;
+}
+
+// The shared fixture flood (a 20,000 m3/s river in a piece of the canyon at 600 m cells) with a
+// spin-up of its first flow, rain over the whole run, the DEM conditioned, three open edges.
+std::string floodText() {
+  std::string text = scenarioText();
+  text.replace(text.find("[region]"), 8, "breach_inflows = true\nfill_depressions = true\n[region]");
+  text.replace(text.find("hydrograph = [[0, 0]"), 20, "hydrograph = [[0, 400]");
+  text.replace(text.find("output_interval = \"5 min\""), 25, "output_interval = \"5 min\"\nspin_up = \"10 min\"");
+  text += "[water.rain]\nrate = \"30 mm/h\"\nstart = \"0 min\"\nend = \"20 min\"\n";
+  return text;
+}
+
+std::string erosionText() {
+  return scenarioText() +
+         "[[terrain.layer]]\nmaterial = \"rock\"\nthickness = \"20 m\"\n"
+         "[[terrain.layer]]\nmaterial = \"sand\"\nthickness = \"1 m\"\n"
+         "[erosion]\nenabled = true\n";
+}
+
+Scenario load(const fs::path& dir, const std::string& name, const std::string& text) {
+  if (worldRank() == 0) std::ofstream(dir / name) << text;
+  MPI_Barrier(MPI_COMM_WORLD);
+  auto s = loadScenario(dir / name);
+  EXPECT_TRUE(s) << s.message();
+  return s ? *s : Scenario{};
+}
+
+RunOptions options(const fs::path& out, const std::string& command) {
+  RunOptions o;
+  o.outDir = out;
+  o.command = command;
+  o.backend = Backend::kCpu;
+  o.pictures = false;
+  o.plots = false;
+  return o;
+}
+
+// Every map of `b` equals `a`'s bit for bit, and the series agree (their balances are exact sums
+// over the ranks and double row sums in one process: equal to 1e-9).
+void expectSameRun(const fs::path& a, const fs::path& b, const std::vector<std::string>& maps,
+                   const std::string& what) {
+  for (const auto& m : maps) {
+    auto ra = gis::readDem((a / "maps" / (m + ".tif")).string(), allowEmpty());
+    auto rb = gis::readDem((b / "maps" / (m + ".tif")).string(), allowEmpty());
+    ASSERT_TRUE(ra) << ra.message();
+    ASSERT_TRUE(rb) << rb.message();
+    ASSERT_EQ(ra->values.size(), rb->values.size()) << what << ": " << m;
+    size_t differ = 0;
+    for (size_t i = 0; i < ra->values.size(); ++i) {
+      const float x = ra->values.data[i], y = rb->values.data[i];
+      differ += (x == y || (std::isnan(x) && std::isnan(y))) ? 0 : 1;
+    }
+    EXPECT_EQ(differ, 0u) << what << ": " << m << " differs in " << differ << " cells";
+  }
+  const auto sa = readCsv(a / "series.csv"), sb = readCsv(b / "series.csv");
+  ASSERT_EQ(sa.size(), sb.size()) << what;
+  for (size_t r = 0; r < sa.size(); ++r) {
+    ASSERT_EQ(sa[r].size(), sb[r].size());
+    for (size_t c = 0; c < sa[r].size(); ++c) {
+      EXPECT_NEAR(sa[r][c], sb[r][c], 1e-9 * std::max(1.0, std::abs(sa[r][c])))
+          << what << ": series row " << r << " column " << c;
+    }
+  }
+}
+
+TEST(ScenarioMpi, AFloodOverTheRanksEqualsOneProcess) {
+  const auto dir = sharedDir("flood");
+  const Scenario s = load(dir, "flood.toml", floodText());
+  if (worldRank() == 0) {
+    auto one = runScenario(s, options(dir / "one", "flood"));
+    ASSERT_TRUE(one) << one.message();
+    EXPECT_GT(one->spinUp.storedM3, 0.0);
+  }
+  auto o = options(dir / "ranks", "flood");
+  o.distributed = true;
+  auto run = runScenario(s, o);
+  ASSERT_TRUE(run) << run.message();
+  EXPECT_TRUE(run->completed);
+  EXPECT_EQ(run->ranks, worldSize());
+  EXPECT_NE(run->backend.find(std::to_string(worldSize()) + " MPI ranks"), std::string::npos) << run->backend;
+  // Each rank wrote its own checkpoint part; the model input is in the run folder.
+  EXPECT_TRUE(fs::exists(
+      dir / "ranks" / ("checkpoint." + std::to_string(worldRank()) + "-of-" + std::to_string(worldSize()) + ".bin")));
+  MPI_Barrier(MPI_COMM_WORLD);
+  if (worldRank() != 0) return;
+  EXPECT_TRUE(fs::exists(dir / "ranks" / "input" / "base.tif"));
+  EXPECT_FALSE(fs::exists(dir / "ranks" / "checkpoint.bin"));
+  expectSameRun(dir / "one", dir / "ranks",
+                {"max_depth", "max_speed", "arrival_time", "inundation_duration", "final_depth"},
+                "flood on " + std::to_string(worldSize()) + " ranks");
+  // The report says what ran it.
+  std::ifstream report(dir / "ranks" / "report.md");
+  const std::string text((std::istreambuf_iterator<char>(report)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find(std::to_string(worldSize()) + " MPI ranks"), std::string::npos);
+  fs::remove_all(dir);
+}
+
+TEST(ScenarioMpi, AnErosionRunOverTheRanksEqualsOneProcess) {
+  const auto dir = sharedDir("erosion");
+  const Scenario s = load(dir, "erode.toml", erosionText());
+  MaterialBudget reference;
+  if (worldRank() == 0) {
+    auto one = runScenario(s, options(dir / "one", "erode"));
+    ASSERT_TRUE(one) << one.message();
+    reference = *one->material;
+  }
+  auto o = options(dir / "ranks", "erode");
+  o.distributed = true;
+  auto run = runScenario(s, o);
+  ASSERT_TRUE(run) << run.message();
+  ASSERT_TRUE(run->material);
+  if (worldRank() != 0) return;
+  const auto& b = *run->material;
+  std::printf("erosion on %d ranks: eroded %.6g m3 (one process %.6g), balance %.3g m3\n", worldSize(), b.erodedM3,
+              reference.erodedM3, b.balanceM3());
+  EXPECT_GT(b.erodedM3, 1e3);
+  EXPECT_DOUBLE_EQ(b.erodedM3, reference.erodedM3);
+  EXPECT_DOUBLE_EQ(b.depositedM3, reference.depositedM3);
+  EXPECT_NEAR(b.suspendedM3, reference.suspendedM3, 1e-9 * std::max(1.0, reference.suspendedM3));
+  EXPECT_LT(std::abs(b.balanceM3()), 1e-6 * b.initialM3Total);
+  expectSameRun(dir / "one", dir / "ranks",
+                {"max_depth", "final_depth", "terrain_change", "exposed_material", "suspended_sediment"},
+                "erosion on " + std::to_string(worldSize()) + " ranks");
+  fs::remove_all(dir);
+}
+
+// Stopped after the first output interval (as Ctrl-C after a checkpoint leaves it), then resumed
+// on the same ranks: the same as the run that was never stopped.
+TEST(ScenarioMpi, AStoppedRunResumesOnItsRanks) {
+  const auto dir = sharedDir("resume");
+  const Scenario s = load(dir, "flood.toml", floodText());
+  auto o = options(dir / "whole", "flood");
+  o.distributed = true;
+  ASSERT_TRUE(runScenario(s, o));
+  o.outDir = dir / "stopped";
+  o.stopAfterIntervals = 1;
+  auto first = runScenario(s, o);
+  ASSERT_TRUE(first) << first.message();
+  EXPECT_FALSE(first->completed);
+  o.stopAfterIntervals = -1;
+  o.resume = true;
+  auto second = runScenario(s, o);
+  ASSERT_TRUE(second) << second.message();
+  EXPECT_TRUE(second->completed);
+  MPI_Barrier(MPI_COMM_WORLD);
+  if (worldRank() == 0) {
+    expectSameRun(dir / "whole", dir / "stopped",
+                  {"max_depth", "max_speed", "arrival_time", "inundation_duration", "final_depth"},
+                  "resumed on " + std::to_string(worldSize()) + " ranks");
+  }
+  // A folder checkpointed on another number of ranks is refused on every rank, saying how many.
+  if (worldRank() == 0) {
+    fs::create_directories(dir / "other");
+    fs::copy(dir / "stopped", dir / "other", fs::copy_options::recursive | fs::copy_options::overwrite_existing);
+    for (int r = 0; r < worldSize(); ++r) {
+      fs::rename(
+          dir / "other" / ("checkpoint." + std::to_string(r) + "-of-" + std::to_string(worldSize()) + ".bin"),
+          dir / "other" / ("checkpoint." + std::to_string(r) + "-of-" + std::to_string(worldSize() + 1) + ".bin"));
+    }
+  }
+  MPI_Barrier(MPI_COMM_WORLD);
+  o.outDir = dir / "other";
+  auto refused = runScenario(s, o);
+  ASSERT_FALSE(refused);
+  const std::string n = std::to_string(worldSize() + 1);
+  EXPECT_NE(refused.message().find("no checkpoint to resume from (the run was checkpointed on " + n +
+                                   " MPI ranks: resume it with mpirun -np " + n + ")"),
+            std::string::npos)
+      << refused.message();
+  MPI_Barrier(MPI_COMM_WORLD);
+  if (worldRank() == 0) fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace strata::scenario
