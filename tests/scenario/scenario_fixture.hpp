@@ -3,8 +3,6 @@
 // Canyon DEM with a river inflow) and helpers to read what a run writes.
 #include <gtest/gtest.h>
 
-#include <array>
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -39,16 +37,6 @@ inline scenario::Scenario writeScenario(const std::filesystem::path& dir) {
   auto s = strata::scenario::loadScenario(file);
   EXPECT_TRUE(s) << s.message();
   return *s;
-}
-
-inline std::string run(const std::string& cmd) {
-  std::string out;
-  FILE* p = popen((cmd + " 2>&1").c_str(), "r");
-  std::array<char, 4096> buf{};
-  size_t n = 0;
-  while ((n = fread(buf.data(), 1, buf.size(), p)) > 0) out.append(buf.data(), n);
-  pclose(p);
-  return out;
 }
 
 inline gis::ReadOptions allowEmpty() {

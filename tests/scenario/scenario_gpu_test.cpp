@@ -42,7 +42,7 @@ TEST_F(GlTest, FloodScenarioWritesMapsSeriesAndReport) {
   for (const char* map : {"max_depth", "max_speed", "arrival_time", "inundation_duration", "final_depth"}) {
     const auto path = opt.outDir / "maps" / (std::string(map) + ".tif");
     ASSERT_TRUE(std::filesystem::exists(path)) << path;
-    const std::string info = run("gdalinfo -json '" + path.string() + "'");
+    const std::string info = strata::test::runProgram({"gdalinfo", "-json", path}).output;
     EXPECT_NE(info.find("ID[\\\"EPSG\\\",4326]"), std::string::npos) << map << ": " << info.substr(0, 400);
     EXPECT_NE(info.find("\"noDataValue\":-32768"), std::string::npos) << map;
     const auto at = info.find("\"geoTransform\":[");

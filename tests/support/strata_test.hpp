@@ -1,7 +1,8 @@
 #pragma once
-// Test helpers: where the shared real data and the test outputs live.
+// Test helpers: where the shared real data and the test outputs live; running a program.
 #include <filesystem>
 #include <string>
+#include <vector>
 
 namespace strata::test {
 
@@ -11,5 +12,15 @@ std::string dataPath(const std::string& relative);
 std::filesystem::path outputDir(const std::string& suite);
 /// A fresh empty temporary folder for this test (removed at exit unless STRATA_KEEP_TMP=1).
 std::filesystem::path tempDir(const std::string& name);
+
+/// A program a test ran: its exit status (128 + the signal that ended it; 127: it could not be
+/// started) and what it printed, stdout and stderr together.
+struct ProgramRun {
+  int status = -1;
+  std::string output;
+};
+/// Runs `argv` (argv[0] a path, or a name looked up in PATH) with no shell between: every
+/// argument reaches the program as it is, whatever characters a file name holds.
+ProgramRun runProgram(const std::vector<std::string>& argv);
 
 }  // namespace strata::test
