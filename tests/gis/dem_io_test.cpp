@@ -18,11 +18,10 @@
 namespace strata::gis {
 namespace {
 
-using test::quoted;
 using test::runCommand;
 
 CPLJSONObject gdalinfoJson(const std::string& path) {
-  const auto r = runCommand("gdalinfo -json " + quoted(path));
+  const auto r = runCommand({"gdalinfo", "-json", path});
   EXPECT_EQ(r.status, 0) << "gdalinfo -json " << path;
   CPLJSONDocument doc;
   EXPECT_TRUE(doc.LoadMemory(r.out)) << r.out.substr(0, 200);
@@ -32,13 +31,9 @@ CPLJSONObject gdalinfoJson(const std::string& path) {
 // Raw band values at pixel centres (x + 0.5, y + 0.5) from gdallocationinfo -valonly (one run,
 // points on stdin).
 std::vector<double> gdalValues(const std::string& path, const std::vector<std::pair<int, int>>& pixels) {
-  const auto dir = strata::test::tempDir("loc");
-  const auto coords = dir / "coords.txt";
-  {
-    std::ofstream f(coords);
-    for (auto [x, y] : pixels) f << x << " " << y << "\n";
-  }
-  const auto r = runCommand("gdallocationinfo -valonly " + quoted(path) + " < " + quoted(coords.string()));
+  std::ostringstream coords;
+  for (auto [x, y] : pixels) coords << x << " " << y << "\n";
+  const auto r = runCommand({"gdallocationinfo", "-valonly", path}, false, coords.str());
   EXPECT_EQ(r.status, 0);
   std::vector<double> v;
   std::istringstream in(r.out);

@@ -19,20 +19,20 @@
 namespace strata::gis {
 namespace {
 
-using test::quoted;
 using test::runCommand;
 
-// gdaltransform on a list of "lon lat h" points; returns the transformed triples.
+// gdaltransform on a list of "lon lat h" points (`options`: more of its arguments, e.g. -ct);
+// returns the transformed triples.
 std::vector<std::array<double, 3>> gdaltransform(const std::string& from, const std::string& to,
-                                                 const std::vector<LonLat>& pts) {
-  const auto dir = strata::test::tempDir("gdaltransform");
-  const auto in = dir / "in.txt";
-  {
-    std::ofstream f(in);
-    f.precision(17);
-    for (const auto& p : pts) f << p.lonDeg << " " << p.latDeg << " " << p.heightM << "\n";
-  }
-  const auto r = runCommand("gdaltransform -s_srs " + from + " -t_srs " + to + " < " + quoted(in.string()));
+                                                 const std::vector<LonLat>& pts,
+                                                 const std::vector<std::string>& options = {}) {
+  std::ostringstream in;
+  in.precision(17);
+  for (const auto& p : pts) in << p.lonDeg << " " << p.latDeg << " " << p.heightM << "\n";
+  std::vector<std::string> argv{"gdaltransform", "-s_srs", from};
+  argv.insert(argv.end(), options.begin(), options.end());
+  argv.insert(argv.end(), {"-t_srs", to});
+  const auto r = runCommand(argv, false, in.str());
   EXPECT_EQ(r.status, 0);
   std::vector<std::array<double, 3>> out;
   std::istringstream s(r.out);
@@ -147,8 +147,8 @@ TEST(Geodesy, LocalEnuFrame) {
     ecefPts.push_back({x.x, x.y, x.z});
     ours.push_back(frame.toEnu(k));
   }
-  const auto proj = gdaltransform("EPSG:4978 -ct '+proj=topocentric +ellps=WGS84 +lat_0=36.1 +lon_0=-112.1 +h_0=2100'",
-                                  "EPSG:4978", ecefPts);
+  const auto proj = gdaltransform("EPSG:4978", "EPSG:4978", ecefPts,
+                                  {"-ct", "+proj=topocentric +ellps=WGS84 +lat_0=36.1 +lon_0=-112.1 +h_0=2100"});
   ASSERT_EQ(proj.size(), kPoints.size());
   for (size_t i = 0; i < proj.size(); ++i) {
     EXPECT_NEAR(ours[i].e, proj[i][0], 1e-3) << i;

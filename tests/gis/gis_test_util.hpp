@@ -10,29 +10,25 @@
 #include <string>
 #include <vector>
 
+#include "strata_test.hpp"
+
 namespace strata::gis::test {
 
-/// Runs a shell command and returns its stdout (stderr discarded unless merged) and exit status.
+/// Runs a program (GDAL's tools, strata) with `argv`, no shell between, and returns its stdout
+/// (stderr discarded unless merged) and exit status; `input` goes to its stdin.
 struct CommandOutput {
   std::string out;
   int status = -1;
 };
-inline CommandOutput runCommand(const std::string& command, bool mergeStderr = false) {
-  CommandOutput r;
-  FILE* pipe = ::popen((command + (mergeStderr ? " 2>&1" : " 2>/dev/null")).c_str(), "r");
-  if (!pipe) return r;
-  std::array<char, 4096> buf{};
-  size_t n = 0;
-  while ((n = std::fread(buf.data(), 1, buf.size(), pipe)) > 0) r.out.append(buf.data(), n);
-  r.status = ::pclose(pipe);
-  return r;
+inline CommandOutput runCommand(const std::vector<std::string>& argv, bool mergeStderr = false,
+                                const std::string& input = {}) {
+  auto r = strata::test::runProgram(argv, input, mergeStderr);
+  return {std::move(r.output), r.status};
 }
 
 /// A shared real DEM by path. Uses this binary's STRATA_DATA_DIR (an absolute path): the shared
 /// test main is compiled without it, so strata::test::dataPath() is relative to the working folder.
 inline std::string dataFile(const std::string& relative) { return std::string(STRATA_DATA_DIR) + "/" + relative; }
-
-inline std::string quoted(const std::string& s) { return "'" + s + "'"; }
 
 /// What a synthetic raster looks like.
 struct SyntheticRaster {

@@ -23,9 +23,11 @@ namespace {
 namespace fs = std::filesystem;
 
 // gdal_translate SRC -> DST with extra arguments; fails the test if it fails.
-std::string translate(const std::string& src, const fs::path& dst, const std::string& args) {
-  const auto r =
-      test::runCommand("gdal_translate -q " + args + " " + test::quoted(src) + " " + test::quoted(dst.string()), true);
+std::string translate(const std::string& src, const fs::path& dst, std::vector<std::string> args) {
+  args.insert(args.begin(), {"gdal_translate", "-q"});
+  args.push_back(src);
+  args.push_back(dst.string());
+  const auto r = test::runCommand(args, true);
   EXPECT_EQ(r.status, 0) << r.out;
   return dst.string();
 }
@@ -66,9 +68,9 @@ const std::string kRainier = test::dataFile("rainier/mt_rainier_90m.tif");
 TEST(MosaicGrid, TwoHalvesOfARealDemMosaicToTheWhole) {
   const auto dir = strata::test::tempDir("halves");
   // A 256 x 160 piece of the Rainier SRTM tile (int16, nodata -32768) and its two halves.
-  const auto whole = translate(kRainier, dir / "whole.tif", "-srcwin 600 500 256 160");
-  const auto west = translate(kRainier, dir / "west.tif", "-srcwin 600 500 128 160");
-  const auto east = translate(kRainier, dir / "east.tif", "-srcwin 728 500 128 160");
+  const auto whole = translate(kRainier, dir / "whole.tif", {"-srcwin", "600", "500", "256", "160"});
+  const auto west = translate(kRainier, dir / "west.tif", {"-srcwin", "600", "500", "128", "160"});
+  const auto east = translate(kRainier, dir / "east.tif", {"-srcwin", "728", "500", "128", "160"});
   auto ref = readDem(whole);
   ASSERT_TRUE(ref) << ref.message();
   std::vector<MosaicInput> inputs{{west}, {east}};
@@ -91,8 +93,8 @@ TEST(MosaicGrid, TwoHalvesOfARealDemMosaicToTheWhole) {
 
 TEST(MosaicGrid, ADisjointDemExtendsTheGridOrIsNamed) {
   const auto dir = strata::test::tempDir("disjoint");
-  const auto a = translate(kRainier, dir / "a.tif", "-srcwin 100 100 64 48");
-  const auto b = translate(kRainier, dir / "b.tif", "-srcwin 300 130 40 40");
+  const auto a = translate(kRainier, dir / "a.tif", {"-srcwin", "100", "100", "64", "48"});
+  const auto b = translate(kRainier, dir / "b.tif", {"-srcwin", "300", "130", "40", "40"});
   auto ra = readDem(a), rb = readDem(b);
   ASSERT_TRUE(ra && rb);
   std::vector<MosaicInput> inputs{{a}, {b}};
@@ -139,8 +141,8 @@ TEST(MosaicGrid, AWarpedInputDoesNotDependOnTheWindowSize) {
   // The Web Mercator SRTM DEM onto a geographic grid: every cell is warped (bilinear); reading
   // the grid in windows of 64 or 100 cells gives the same bits as reading it whole.
   const auto dir = strata::test::tempDir("windows");
-  const auto src =
-      translate(test::dataFile("grand_canyon/grandcanyon_srtm_3857.tif"), dir / "srtm.tif", "-srcwin 100 80 200 160");
+  const auto src = translate(test::dataFile("grand_canyon/grandcanyon_srtm_3857.tif"), dir / "srtm.tif",
+                             {"-srcwin", "100", "80", "200", "160"});
   std::vector<MosaicInput> inputs{{src}};
   MosaicGridOptions o;
   o.crs = "EPSG:4326";
@@ -161,7 +163,7 @@ TEST(MosaicGrid, AWarpedInputDoesNotDependOnTheWindowSize) {
 
 TEST(MosaicGrid, MinimumIfCoarserKeepsTheLowestCell) {
   const auto dir = strata::test::tempDir("lowest");
-  const auto src = translate(kRainier, dir / "piece.tif", "-srcwin 400 400 128 96");
+  const auto src = translate(kRainier, dir / "piece.tif", {"-srcwin", "400", "400", "128", "96"});
   auto ref = readDem(src);
   ASSERT_TRUE(ref);
   MosaicInput in{src};
@@ -206,8 +208,9 @@ TEST(MosaicGrid, MinimumIfCoarserKeepsTheLowestCell) {
 
 TEST(AssignGeoref, ADemWithoutOneIsReadPlacedAndDescribed) {
   const auto dir = strata::test::tempDir("assign");
-  const auto src = translate(kRainier, dir / "piece.tif", "-srcwin 500 600 64 40");
-  const auto bare = translate(kRainier, dir / "bare.tif", "-srcwin 500 600 64 40 -co PROFILE=BASELINE");
+  const auto src = translate(kRainier, dir / "piece.tif", {"-srcwin", "500", "600", "64", "40"});
+  const auto bare =
+      translate(kRainier, dir / "bare.tif", {"-srcwin", "500", "600", "64", "40", "-co", "PROFILE=BASELINE"});
   fs::remove(bare + ".aux.xml");
   auto ref = readDem(src);
   ASSERT_TRUE(ref);
@@ -293,7 +296,8 @@ TEST(DemFile, AStripedFileIsReadOnceWindowByWindow) {
   // Rainier as a striped, DEFLATE-compressed GeoTIFF (16 rows a strip), read in 64 x 64 windows
   // row by row, as an ingest does: about the file's bytes are read, not once per window column.
   const auto dir = strata::test::tempDir("striped");
-  const auto path = translate(kRainier, dir / "striped.tif", "-co TILED=NO -co COMPRESS=DEFLATE -co BLOCKYSIZE=16");
+  const auto path =
+      translate(kRainier, dir / "striped.tif", {"-co", "TILED=NO", "-co", "COMPRESS=DEFLATE", "-co", "BLOCKYSIZE=16"});
   auto info = probeDem(path);
   ASSERT_TRUE(info);
   ASSERT_EQ(info->blockWidth, 1201);
@@ -336,7 +340,7 @@ TEST(DemFile, AStripedFileIsReadOnceWindowByWindow) {
 TEST(WriteGeoTiff, NeverReplacesAFileUnlessAskedAndCarriesMetadata) {
   const auto dir = strata::test::tempDir("write");
   const std::string path = (dir / "out.tif").string();
-  auto ref = readDem(translate(kRainier, dir / "piece.tif", "-srcwin 0 0 16 16"));
+  auto ref = readDem(translate(kRainier, dir / "piece.tif", {"-srcwin", "0", "0", "16", "16"}));
   ASSERT_TRUE(ref);
   WriteOptions o;
   o.overwrite = false;
@@ -347,7 +351,7 @@ TEST(WriteGeoTiff, NeverReplacesAFileUnlessAskedAndCarriesMetadata) {
   EXPECT_EQ(again.message(), path + ": already exists (not overwritten)");
   o.overwrite = true;
   EXPECT_TRUE(writeGeoTiff(path, *ref, o));
-  const auto info = test::runCommand("gdalinfo " + test::quoted(path));
+  const auto info = test::runCommand({"gdalinfo", path});
   EXPECT_NE(info.out.find("STRATA_MAX_ERROR_M=0.25"), std::string::npos) << info.out;
   int leftovers = 0;
   for (const auto& e : fs::directory_iterator(dir)) leftovers += e.path().string().find(".tmp") != std::string::npos;

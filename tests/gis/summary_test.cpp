@@ -13,12 +13,11 @@
 namespace strata::gis {
 namespace {
 
-using test::quoted;
 using test::runCommand;
 
 CPLJSONObject gdalinfoStats(const std::string& path) {
   // PAM off: gdalinfo must not try to write .aux.xml next to the read-only shared data.
-  const auto r = runCommand("gdalinfo --config GDAL_PAM_ENABLED NO -json -stats " + quoted(path));
+  const auto r = runCommand({"gdalinfo", "--config", "GDAL_PAM_ENABLED", "NO", "-json", "-stats", path});
   EXPECT_EQ(r.status, 0);
   CPLJSONDocument doc;
   EXPECT_TRUE(doc.LoadMemory(r.out));
@@ -53,7 +52,7 @@ TEST(Summary, ExtentAndResolution) {
   const std::string path = test::dataFile("grand_canyon/grandcanyon_srtm_3857.tif");
   auto s = summarizeDem(path);
   ASSERT_TRUE(s.ok()) << s.message();
-  const auto r = runCommand("gdalinfo -json " + quoted(path));
+  const auto r = runCommand({"gdalinfo", "-json", path});
   CPLJSONDocument doc;
   ASSERT_TRUE(doc.LoadMemory(r.out));
   // gdalinfo's WGS84 extent polygon (printed to 7 decimals): Mercator edges are straight in
@@ -88,8 +87,8 @@ TEST(Summary, ExtentAndResolution) {
 TEST(Summary, StrataInfoCommand) {
   const std::string exe = (std::filesystem::path(STRATA_TEST_OUTPUT_DIR).parent_path() / "apps/strata").string();
   ASSERT_TRUE(std::filesystem::exists(exe)) << exe;
-  const auto ok = runCommand(quoted(exe) + " info " + quoted(test::dataFile("grand_canyon/grandcanyon_srtm_3857.tif")) +
-                             " " + quoted(test::dataFile("moon/LDEM_4.LBL")));
+  const auto ok = runCommand(
+      {exe, "info", test::dataFile("grand_canyon/grandcanyon_srtm_3857.tif"), test::dataFile("moon/LDEM_4.LBL")});
   EXPECT_EQ(ok.status, 0) << ok.out;
   for (const char* line :
        {"driver      GTiff", "CRS         WGS 84 / Pseudo-Mercator (EPSG:3857)",
@@ -98,7 +97,7 @@ TEST(Summary, StrataInfoCommand) {
         "body        Moon (a = 1737400.0 m, sphere)", "CRS         SIMPLE_CYLINDRICAL MOON (no EPSG code)"}) {
     EXPECT_NE(ok.out.find(line), std::string::npos) << "missing '" << line << "' in\n" << ok.out;
   }
-  const auto bad = runCommand(quoted(exe) + " info /nonexistent/dem.tif", true);
+  const auto bad = runCommand({exe, "info", "/nonexistent/dem.tif"}, true);
   EXPECT_NE(bad.status, 0);
   EXPECT_EQ(bad.out, "strata info: /nonexistent/dem.tif: no such file\n");
 }

@@ -20,7 +20,8 @@ struct ProgramRun {
   std::string output;
 };
 /// Runs `argv` (argv[0] a path, or a name looked up in PATH) with no shell between: every
-/// argument reaches the program as it is, whatever characters a file name holds.
-ProgramRun runProgram(const std::vector<std::string>& argv);
+/// argument reaches the program as it is, whatever characters a file name holds. `input` goes to
+/// its stdin (small: written before the output is read); without `keepStderr` only stdout is kept.
+ProgramRun runProgram(const std::vector<std::string>& argv, const std::string& input = {}, bool keepStderr = true);
 
 }  // namespace strata::test

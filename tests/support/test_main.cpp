@@ -2,10 +2,12 @@
 
 #include <gtest/gtest.h>
 
+#include <fcntl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <cerrno>
+#include <csignal>
 #include <cstdlib>
 #include <vector>
 
@@ -45,22 +47,44 @@ std::filesystem::path tempDir(const std::string& name) {
   return dir;
 }
 
-ProgramRun runProgram(const std::vector<std::string>& argv) {
+ProgramRun runProgram(const std::vector<std::string>& argv, const std::string& input, bool keepStderr) {
   ProgramRun r;
-  int fds[2];
+  int fds[2], in[2];
   if (argv.empty() || ::pipe(fds) != 0) return r;
+  if (::pipe(in) != 0) {
+    ::close(fds[0]);
+    ::close(fds[1]);
+    return r;
+  }
   std::vector<char*> args;
   for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
   args.push_back(nullptr);
   const pid_t pid = ::fork();
   if (pid == 0) {
     ::close(fds[0]);
+    ::close(in[1]);
+    ::dup2(in[0], 0);
     ::dup2(fds[1], 1);
-    ::dup2(fds[1], 2);
+    if (keepStderr) {
+      ::dup2(fds[1], 2);
+    } else {
+      const int devnull = ::open("/dev/null", O_WRONLY);
+      ::dup2(devnull, 2);
+    }
     ::execvp(args[0], args.data());
     ::_exit(127);
   }
   ::close(fds[1]);
+  ::close(in[0]);
+  for (size_t at = 0; pid > 0 && at < input.size();) {
+    const ssize_t n = ::write(in[1], input.data() + at, input.size() - at);
+    if (n > 0) {
+      at += size_t(n);
+    } else if (errno != EINTR) {
+      break;
+    }
+  }
+  ::close(in[1]);
   char buf[4096];
   for (ssize_t n; (n = ::read(fds[0], buf, sizeof buf)) != 0;) {
     if (n > 0) {
@@ -83,6 +107,8 @@ ProgramRun runProgram(const std::vector<std::string>& argv) {
 
 int main(int argc, char** argv) {
   ::testing::InitGoogleTest(&argc, argv);
+  // A child of runProgram that exits before reading its input fails the write, not the test.
+  std::signal(SIGPIPE, SIG_IGN);
   if (!std::getenv("STRATA_LOG")) strata::log::setLevel(strata::log::Level::Warn);
   const int rc = RUN_ALL_TESTS();
   const char* keep = std::getenv("STRATA_KEEP_TMP");
