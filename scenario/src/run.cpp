@@ -139,10 +139,11 @@ Result<Engine> startEngine(Backend backend, const ScenarioDomain& d, bool pictur
                            const fs::path& runDir) {
   Engine e;
   Status contextStatus;
+  gl::HeadlessOptions glOptions;
+  // (collective: every rank asks, whether or not it makes a context)
+  if (ranks.distributed()) glOptions.device = sim::rankEglDevice(MPI_COMM_WORLD);
   if (backend != Backend::kCpu || (pictures && ranks.lead())) {
-    gl::HeadlessOptions o;
-    if (ranks.distributed()) o.device = sim::rankEglDevice(MPI_COMM_WORLD);
-    auto ctx = gl::HeadlessContext::create(o);
+    auto ctx = gl::HeadlessContext::create(glOptions);
     if (ctx) {
       e.context.emplace(std::move(ctx).value());
     } else if (backend == Backend::kGpu) {

@@ -186,6 +186,38 @@ TEST(ScenarioMpi, AnErosionRunOverTheRanksEqualsOneProcess) {
   fs::remove_all(dir);
 }
 
+// Pictures: only the lead draws, but the reads behind them (an erosion run's surface and layers)
+// are collective, and so is choosing each rank's EGL device even where no context is made (a run
+// with the CPU backend and pictures once aborted in MPI_Allreduce for that). The same pictures as
+// one process, byte for byte.
+TEST(ScenarioMpi, AnErosionRunWithPicturesDrawsTheOneProcessPictures) {
+  const auto dir = sharedDir("pictures");
+  const Scenario s = load(dir, "erode.toml", erosionText());
+  if (worldRank() == 0) {
+    auto o = options(dir / "one", "erode");
+    o.pictures = true;
+    auto one = runScenario(s, o);
+    ASSERT_TRUE(one) << one.message();
+  }
+  auto o = options(dir / "ranks", "erode");
+  o.pictures = true;
+  o.distributed = true;
+  auto run = runScenario(s, o);
+  ASSERT_TRUE(run) << run.message();
+  MPI_Barrier(MPI_COMM_WORLD);
+  if (worldRank() != 0) return;
+  auto bytes = [](const fs::path& p) {
+    std::ifstream f(p, std::ios::binary);
+    return std::string((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  };
+  for (const char* p : {"before.png", "peak.png", "after.png", "max_depth.png"}) {
+    const std::string a = bytes(dir / "one" / "pictures" / p), b = bytes(dir / "ranks" / "pictures" / p);
+    EXPECT_GT(a.size(), 1000u) << p;
+    EXPECT_TRUE(a == b) << p << " differs";
+  }
+  fs::remove_all(dir);
+}
+
 // Stopped after the first output interval (as Ctrl-C after a checkpoint leaves it), then resumed
 // on the same ranks: the same as the run that was never stopped.
 TEST(ScenarioMpi, AStoppedRunResumesOnItsRanks) {

@@ -145,9 +145,10 @@ class DistributedSolver final : public Solver {
 /// message, after "rank R: " for R > 0), so that no rank is left waiting in a collective call.
 Status collectiveStatus(const Status& local, MPI_Comm comm);
 
-/// The rank of this process among the ranks of `comm` on the same node (MPI_COMM_TYPE_SHARED).
+/// Collective: the rank of this process among the ranks of `comm` on the same node
+/// (MPI_COMM_TYPE_SHARED).
 int localRank(MPI_Comm comm);
-/// The EGL device for this rank's GL context (gl::HeadlessOptions::device): "gpu:<local rank>",
+/// Collective (localRank): the EGL device for this rank's GL context (gl::HeadlessOptions::device): "gpu:<local rank>",
 /// the node's GPUs dealt one per local rank (wrapping when there are more ranks than GPUs; Mesa's
 /// surfaceless platform where there is none). STRATA_EGL_DEVICE, if set, still overrides it.
 std::string rankEglDevice(MPI_Comm comm);
