@@ -38,24 +38,16 @@ void readSeries(ByteReader& r, TimeSeries& s) {
   if (r.ok && !samples.empty()) s = TimeSeries(std::move(samples));
 }
 
-// Material: a name and plain numbers.
-void writeMaterial(ByteWriter& w, const terrain::Material& m) {
-  w.str(m.name);
-  w.pod(m.colour);
-  w.pod(m.erodibility);
-  w.pod(m.dissolutionRate);
-  w.pod(m.talusAngleDeg);
-  w.pod(m.densityKgM3);
-  w.pod(m.weatheringRatePerS);
-}
-void readMaterial(ByteReader& r, terrain::Material& m) {
-  r.str(m.name);
-  r.pod(m.colour);
-  r.pod(m.erodibility);
-  r.pod(m.dissolutionRate);
-  r.pod(m.talusAngleDeg);
-  r.pod(m.densityKgM3);
-  r.pod(m.weatheringRatePerS);
+// A material's fields in order, for a ByteWriter (M = const Material) or a ByteReader.
+template <class IO, class M>
+void materialFields(IO& io, M& m) {
+  io.str(m.name);
+  io.pod(m.colour);
+  io.pod(m.erodibility);
+  io.pod(m.dissolutionRate);
+  io.pod(m.talusAngleDeg);
+  io.pod(m.densityKgM3);
+  io.pod(m.weatheringRatePerS);
 }
 
 // One window of one model input file.
@@ -122,7 +114,7 @@ std::string encodeDomainShape(const ScenarioDomain& d) {
   w.pod(d.input.dyM);
   w.pod(d.input.datumM);
   w.pod(uint64_t(d.input.materials.size()));
-  for (const auto& m : d.input.materials) writeMaterial(w, m);
+  for (const auto& m : d.input.materials) materialFields(w, m);
   w.pod(uint8_t(d.input.waterDepthM.size() > 0));
   w.pod(uint8_t(d.input.rainMmPerHour.size() > 0));
   w.pod(uint64_t(d.sources.size()));
@@ -156,7 +148,7 @@ Result<ScenarioDomain> decodeDomainShape(std::string_view bytes) {
   uint64_t n = 0;
   r.pod(n);
   for (uint64_t i = 0; r.ok && i < n && i < uint64_t(kMaxInputLayers); ++i)
-    readMaterial(r, d.input.materials.emplace_back());
+    materialFields(r, d.input.materials.emplace_back());
   uint8_t water = 0, rain = 0;
   r.pod(water);
   r.pod(rain);

@@ -6,7 +6,6 @@
 // for an erosion run; a run stopped at a checkpoint and resumed must equal the uninterrupted one.
 #include <gtest/gtest.h>
 #include <mpi.h>
-#include <unistd.h>
 
 #include <cmath>
 #include <cstring>
@@ -19,6 +18,7 @@
 #include <strata/scenario/run.hpp>
 #include <strata/scenario/scenario.hpp>
 
+#include "mpi_support.hpp"
 #include "scenario_fixture.hpp"
 
 // This binary has its own main (MPI around GoogleTest), not the test support library's: the one
@@ -33,33 +33,10 @@ namespace {
 namespace fs = std::filesystem;
 using namespace test_support;
 
-int worldRank() {
-  int r = 0;
-  MPI_Comm_rank(MPI_COMM_WORLD, &r);
-  return r;
-}
-int worldSize() {
-  int n = 0;
-  MPI_Comm_size(MPI_COMM_WORLD, &n);
-  return n;
-}
+using test::worldRank;
+using test::worldSize;
 
-// A folder every rank sees: made by rank 0, its name sent to the others.
-fs::path sharedDir(const std::string& name) {
-  std::string path;
-  if (worldRank() == 0) {
-    path = (fs::temp_directory_path() /
-            ("strata-scenario-mpi-" + name + "-" + std::to_string(worldSize()) + "-" + std::to_string(::getpid())))
-               .string();
-    fs::remove_all(path);
-    fs::create_directories(path);
-  }
-  int len = int(path.size());
-  MPI_Bcast(&len, 1, MPI_INT, 0, MPI_COMM_WORLD);
-  path.resize(size_t(len));
-  MPI_Bcast(path.data(), len, MPI_CHAR, 0, MPI_COMM_WORLD);
-  return path;
-}
+fs::path sharedDir(const std::string& name) { return test::sharedTempDir("strata-scenario-mpi-" + name); }
 
 // The shared fixture flood (a 20,000 m3/s river in a piece of the canyon at 600 m cells) with a
 // spin-up of its first flow, rain over the whole run, the DEM conditioned, three open edges.

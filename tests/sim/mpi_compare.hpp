@@ -13,22 +13,15 @@
 
 #include <strata/sim/distributed_solver.hpp>
 
+#include "mpi_support.hpp"
 #include "sim_scenes.hpp"
 
 namespace strata::sim::test_mpi {
 
 using namespace strata::test;
 
-inline int worldRank() {
-  int r = 0;
-  MPI_Comm_rank(MPI_COMM_WORLD, &r);
-  return r;
-}
-inline int worldSize() {
-  int n = 0;
-  MPI_Comm_size(MPI_COMM_WORLD, &n);
-  return n;
-}
+using test::worldRank;
+using test::worldSize;
 
 // ---------------------------------------------------------------------------------------------
 // Scenes

@@ -4,7 +4,6 @@
 // included. Rank 0 compares; the others take part in the collective calls.
 #include <gtest/gtest.h>
 #include <mpi.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -208,22 +207,8 @@ TEST(SimDistributed, ErosionEqualsOneRankBitForBit) {
   }
 }
 
-// A shared folder for this run's files: made by rank 0, its name sent to the others.
-std::filesystem::path sharedTempDir(const std::string& name) {
-  std::string path;
-  if (worldRank() == 0) {
-    path = (std::filesystem::temp_directory_path() /
-            ("strata-mpi-" + name + "-" + std::to_string(worldSize()) + "-" + std::to_string(::getpid())))
-               .string();
-    std::filesystem::remove_all(path);
-    std::filesystem::create_directories(path);
-  }
-  int len = int(path.size());
-  MPI_Bcast(&len, 1, MPI_INT, 0, MPI_COMM_WORLD);
-  path.resize(size_t(len));
-  MPI_Bcast(path.data(), len, MPI_CHAR, 0, MPI_COMM_WORLD);
-  return path;
-}
+// A shared folder for this run's files.
+std::filesystem::path sharedTempDir(const std::string& name) { return test::sharedTempDir("strata-mpi-" + name); }
 
 void writeFile(const std::filesystem::path& p, const std::string& bytes) {
   std::ofstream(p, std::ios::binary).write(bytes.data(), std::streamsize(bytes.size()));
