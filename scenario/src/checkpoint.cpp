@@ -15,7 +15,7 @@
 namespace strata::scenario {
 namespace {
 
-constexpr char kMagic[8] = {'S', 'T', 'R', 'A', 'T', 'A', 'C', '4'};
+constexpr char kMagic[8] = {'S', 'T', 'R', 'A', 'T', 'A', 'C', '5'};
 
 }  // namespace
 

@@ -208,11 +208,21 @@ Status writeReport(const fs::path& runDir, const ReportInput& in) {
           " m³/s, " + millions(f.hydrograph.integral(0, s.durationS)) + " in the run |\n";
   }
   if (const auto& u = in.summary.spinUp; u.seconds > 0) {
-    md += "| base flow | " + fmt("%.0f", u.baseFlowM3S) + " m³/s (the inflows at t = 0), run for a spin-up of " +
-          formatDuration(u.seconds) + " before t = 0 (" + std::to_string(u.steps) +
-          " steps): at t = 0 the region held " + millions(u.storedM3) + "; over the spin-up's last tenth " +
-          fmt("%.0f", u.outflowM3S) + " m³/s left it and the stored water changed by " +
-          fmt("%+.0f", u.storageRateM3S) +
+    const std::string tolerance = fmt("%g", 100 * u.toleranceRel) + "% of the base flow";
+    std::string length = "run for a spin-up of " + formatDuration(u.seconds) + " before t = 0";
+    if (u.steady) {
+      length = "run until steady: " + formatDuration(u.seconds) + " before t = 0 (of at most " +
+               formatDuration(u.longestS) + "; it ends once the stored water changes by less than " + tolerance +
+               ", judged every " + formatDuration(u.longestS / 20) + " over the last " + formatDuration(u.windowS) +
+               ")";
+    } else if (u.toleranceRel > 0) {
+      length += " (at most; **not steady**: the stored water still changed by more than " + tolerance +
+                ": lengthen time.spin_up)";
+    }
+    md += "| base flow | " + fmt("%.0f", u.baseFlowM3S) + " m³/s (the inflows at t = 0), " + length + ", " +
+          std::to_string(u.steps) + " steps: at t = 0 the region held " + millions(u.storedM3) + "; over the last " +
+          formatDuration(u.windowS) + " of it " + fmt("%.0f", u.outflowM3S) +
+          " m³/s left it and the stored water changed by " + fmt("%+.0f", u.storageRateM3S) +
           " m³/s. Every result below is of the run from t = 0: the river's water at t = 0 is the initial water, and "
           "cells wet at t = 0 count as flooded from the start |\n";
   }

@@ -371,39 +371,47 @@ class Run {
     return true;
   }
 
-  // The spin-up: from -seconds to 0 with every source and level at its t = 0 value (a series
-  // holds its first sample before it) and no rain (it starts at t >= 0); then the budgets and the
-  // flood statistics start over, so that every output is of the run from t = 0.
-  Result<SpinUpSummary> spinUp(double seconds, const std::string& name) {
+  // The spin-up: from -longestS towards 0 with every source and level at its t = 0 value (a
+  // series holds its first sample before it) and no rain (it starts at t >= 0); then the budgets
+  // and the flood statistics start over, so that every output is of the run from t = 0. Judged
+  // every twentieth of longestS over the last tenth (two twentieths): with a tolerance it ends as
+  // soon as the stored water changed by less than that fraction of the base flow there, and the
+  // clock moves on to 0 (nothing it holds changes with time; Solver::restartAt).
+  Result<SpinUpSummary> spinUp(double longestS, double tolerance, const std::string& name) {
     auto& sv = solver();
     SpinUpSummary u;
-    u.seconds = seconds;
+    u.longestS = longestS;
+    u.toleranceRel = tolerance;
     for (const auto& src : d_.sources) u.baseFlowM3S += src.dischargeM3S.at(0.0);
-    sv.startClockAt(-seconds);
-    Progress progress("spin-up " + name, seconds);
-    // Progress 20 times; the stats also where the last tenth starts (equilibrium is judged there).
-    constexpr int kReports = 20;
-    const double tailStart = -0.1 * seconds;
-    sim::SimStats atTail;
-    for (int c = 1; c <= kReports; ++c) {
-      const double t = c == kReports ? 0.0 : -seconds + seconds * c / kReports;
-      for (const double stop : {std::min(t, tailStart), t}) {
-        STRATA_TRY(const bool done, advanceTo(stop));
-        if (!done) return fail("interrupted during the spin-up (before t = 0: nothing to resume from)");
-        if (atTail.steps == 0 && sv.timeS() >= tailStart - 1e-9 * seconds) atTail = sv.stats();
-      }
-      progress.update(seconds + sv.timeS(), "t = -" + formatDuration(-sv.timeS()));
+    sv.startClockAt(-longestS);
+    Progress progress("spin-up " + name, longestS);
+    constexpr int kChecks = 20, kWindow = 2;
+    std::vector<sim::SimStats> at{sv.stats()};  // at each check so far
+    for (int c = 1; c <= kChecks; ++c) {
+      STRATA_TRY(const bool done, advanceTo(c == kChecks ? 0.0 : -longestS + longestS * c / kChecks));
+      if (!done) return fail("interrupted during the spin-up (before t = 0: nothing to resume from)");
+      at.push_back(sv.stats());  // collective over ranks: every rank judges the same numbers
+      progress.update(longestS + sv.timeS(), "t = -" + formatDuration(-sv.timeS()));
+      if (c < kWindow) continue;
+      const auto& from = at[size_t(c - kWindow)];
+      const auto& to = at[size_t(c)];
+      u.windowS = to.timeS - from.timeS;
+      u.outflowM3S = (to.outflowM3 - from.outflowM3) / u.windowS;
+      u.storageRateM3S = (to.storedWaterM3 - from.storedWaterM3) / u.windowS;
+      u.steady = tolerance > 0 && std::abs(u.storageRateM3S) < tolerance * u.baseFlowM3S;
+      if (u.steady) break;
     }
-    const auto end = sv.stats();
-    const double dt = end.timeS - atTail.timeS;
-    if (dt > 0) {
-      u.outflowM3S = (end.outflowM3 - atTail.outflowM3) / dt;
-      u.storageRateM3S = (end.storedWaterM3 - atTail.storedWaterM3) / dt;
+    u.seconds = longestS + sv.timeS();
+    u.storedM3 = at.back().storedWaterM3;
+    u.steps = at.back().steps;
+    if (tolerance > 0 && !u.steady) {
+      log::warn("spin-up") << "after " << formatDuration(longestS) << " the stored water still changes by "
+                           << u.storageRateM3S << " m3/s, more than " << tolerance
+                           << " of the base flow: the river is not steady at t = 0 (lengthen time.spin_up)";
     }
-    u.storedM3 = end.storedWaterM3;
-    u.steps = end.steps;
-    progress.finish(std::to_string(end.steps) + " steps");
-    sv.restartBudgets();
+    progress.finish(std::to_string(u.steps) + " steps" +
+                    (u.steady ? ", steady at " + formatDuration(u.seconds) : std::string()));
+    sv.restartAt(0.0);
     sv.enableFloodStats(float(s_.outputs.wetThresholdM));
     return u;
   }
@@ -723,7 +731,7 @@ Result<RunSummary> runScenario(const Scenario& s, const RunOptions& opt) {
   installInterruptHandler();
   SpinUpSummary spinUp;
   if (s.spinUpS > 0 && !opt.resume) {
-    STRATA_TRY(spinUp, run.spinUp(s.spinUpS, name));
+    STRATA_TRY(spinUp, run.spinUp(s.spinUpS, s.spinUpTolerance, name));
   }
 
   // Pictures: the state read on every rank, drawn by the lead.

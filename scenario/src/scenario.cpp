@@ -284,6 +284,7 @@ constexpr Range kMaxStep{0, 86400, true, "1 d"};
 constexpr Range kErosionConstant{0, 100, false, "100"};
 constexpr Range kDuration{0, 3650 * 86400.0, true, "3650 d"};
 constexpr Range kSpinUp{0, 365 * 86400.0, false, "365 d"};
+constexpr Range kSpinUpTolerance{0, 0.5, true, "0.5"};
 constexpr Range kWetThreshold{0, 100, true, "100 m"};
 
 Result<TimeSeries> readHydrograph(const Reader& r, const toml::table& t, const std::string& prefix) {
@@ -625,12 +626,16 @@ Status readWater(const Reader& r, const toml::table& root, Scenario& s) {
 Status readTime(const Reader& r, const toml::table& root, Scenario& s) {
   const auto* t = root["time"].as_table();
   if (!t) return fail(r.file + ": missing [time] (duration = \"6 h\", output_interval = \"30 min\")");
-  STRATA_TRY_STATUS(r.onlyKeys(*t, "time", {"duration", "output_interval", "spin_up"}));
+  STRATA_TRY_STATUS(r.onlyKeys(*t, "time", {"duration", "output_interval", "spin_up", "spin_up_tolerance"}));
   const auto* d = t->get("duration");
   if (!d) return r.errorAt(int(t->source().begin.line), "time.duration", "missing");
   STRATA_TRY(s.durationS, r.quantity(*d, "time.duration", "time", kDuration));
   if (const auto* u = t->get("spin_up")) {
     STRATA_TRY(s.spinUpS, r.quantity(*u, "time.spin_up", "time", kSpinUp));
+  }
+  if (const auto* u = t->get("spin_up_tolerance")) {
+    STRATA_TRY(s.spinUpTolerance, r.number(*u, "time.spin_up_tolerance", kSpinUpTolerance));
+    if (s.spinUpS <= 0) return r.error(*u, "time.spin_up_tolerance", "needs a spin_up (the longest it may run)");
   }
   s.outputIntervalS = s.durationS / 10;
   if (const auto* o = t->get("output_interval")) {
@@ -794,6 +799,10 @@ Result<Scenario> parseScenario(std::string_view text, const std::filesystem::pat
   if (s.spinUpS > 0 && !s.water.damBreaks.empty()) {
     return fail(s.at("time.spin_up") +
                 "a dam break releases its water at t = 0 and the spin-up runs before it: use one or the other");
+  }
+  if (s.spinUpTolerance > 0 && s.water.inflows.empty()) {
+    return fail(s.at("time.spin_up_tolerance") +
+                "is a fraction of the base flow (the inflows at t = 0), and [water] has no inflow");
   }
   for (const auto& m : erosionOutputMaps()) {
     if (std::find(s.outputs.maps.begin(), s.outputs.maps.end(), m) != s.outputs.maps.end() && !s.erosion.enabled) {

@@ -129,12 +129,17 @@ std::string AdaptiveSolver::backendName() const {
 
 int AdaptiveSolver::ownerOf(int bx, int by) const { return (by / o_.tileSize) * tilesX_ + bx / o_.tileSize; }
 
-void AdaptiveSolver::onClockStarted() {
+void AdaptiveSolver::forEachPart(const std::function<void(Solver&)>& f) {
   for (auto& t : tiles_) {
     for (auto& sim : t.sims) {
-      if (sim) sim->startClockAt(timeS());
+      if (sim) f(*sim);
     }
   }
+}
+
+// Its solvers hold the accumulators (each tile's levels made so far; one made later starts at 0).
+void AdaptiveSolver::clearAccumulators() {
+  forEachPart([](Solver& sim) { sim.restartAt(sim.timeS()); });
 }
 
 Status AdaptiveSolver::onSourceAdded(const Source& source) {

@@ -226,17 +226,27 @@ FloodStats floodStatsFromCells(const std::vector<float>& v, int width, int heigh
 
 void Solver::startClockAt(double timeS) {
   STRATA_CHECK(c_.steps == 0 && std::isfinite(timeS)) << "the clock is set before the first step";
-  c_.timeS = timeS;
-  onClockStarted();
+  setClock(timeS);
 }
 
-void Solver::restartBudgets() {
-  CellBlock b = readBlock(0, 0, grid_.width, grid_.height, kBlockAccum);
-  std::fill(b.accum.begin(), b.accum.end(), 0.0f);
-  writeBlock(b);
+void Solver::setClock(double timeS) {
+  c_.timeS = timeS;
+  forEachPart([timeS](Solver& part) { part.setClock(timeS); });
+}
+
+void Solver::restartAt(double timeS) {
+  STRATA_CHECK(std::isfinite(timeS)) << "restart at " << timeS;
+  setClock(timeS);
+  clearAccumulators();
   c_.inflowM3 = 0;
   c_.rainM3 = 0;
   recordInitialTotals();
+}
+
+void Solver::clearAccumulators() {
+  CellBlock b = readBlock(0, 0, grid_.width, grid_.height, kBlockAccum);
+  std::fill(b.accum.begin(), b.accum.end(), 0.0f);
+  writeBlock(b);
 }
 
 void Solver::enableFloodStats(float wetThresholdM) {

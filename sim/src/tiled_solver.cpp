@@ -54,8 +54,8 @@ std::string TiledSolver::backendName() const {
 
 int TiledSolver::ownerOf(int x, int y) const { return (y / options_.tileHeight) * tilesX_ + x / options_.tileWidth; }
 
-void TiledSolver::onClockStarted() {
-  for (auto& tile : tiles_) tile.solver->startClockAt(timeS());
+void TiledSolver::forEachPart(const std::function<void(Solver&)>& f) {
+  for (auto& tile : tiles_) f(*tile.solver);
 }
 
 Status TiledSolver::onSourceAdded(const Source& source) {

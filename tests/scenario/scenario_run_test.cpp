@@ -3,11 +3,13 @@
 #include <gdal.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
 
+#include <strata/core/progress.hpp>
 #include <strata/gis/geodesy.hpp>
 #include <strata/scenario/run.hpp>
 
@@ -213,6 +215,76 @@ TEST(ScenarioRun, SpinUpStartsTheRunWithTheBaseFlowInItsBed) {
   ASSERT_FALSE(refused);
   EXPECT_NE(refused.message().find("key 'time.spin_up': a dam break releases its water at t = 0"), std::string::npos)
       << refused.message();
+}
+
+// A spin-up with a tolerance ends as soon as the river is steady (the stored water changing by
+// less than that fraction of the base flow over a tenth of the longest spin-up), and the clock
+// moves on to t = 0; one that cannot get there in time runs its whole length and says so.
+TEST(ScenarioRun, SpinUpEndsOnceTheRiverIsSteady) {
+  const auto dir = strata::test::tempDir("spin-up-steady");
+  auto run = [&](const std::string& spinUp, const std::string& name) {
+    std::string text = scenarioText();
+    text.replace(text.find("[[0, 0], [5, 20000]"), 19, "[[0, 400], [5, 20000]");
+    text.replace(text.find("[time]\n"), 7, "[time]\n" + spinUp);
+    // Unconditioned, the river fills the DEM's pits and is still not steady after 48 h (nothing leaves).
+    text.replace(text.find("[region]"), 8, "breach_inflows = true\nfill_depressions = true\n[region]");
+    std::ofstream(dir / (name + ".toml")) << text;
+    auto scenario = loadScenario(dir / (name + ".toml"));
+    EXPECT_TRUE(scenario) << scenario.message();
+    RunOptions opt;
+    opt.outDir = dir / name;
+    opt.backend = Backend::kCpu;
+    opt.pictures = false;
+    opt.plots = false;
+    auto summary = runScenario(*scenario, opt);
+    EXPECT_TRUE(summary) << summary.message();
+    return std::pair{summary->spinUp, slurp(opt.outDir / "report.md")};
+  };
+  const auto [steady, report] = run("spin_up = \"48 h\"\nspin_up_tolerance = 0.01\n", "steady");
+  EXPECT_TRUE(steady.steady);
+  EXPECT_LT(steady.seconds, 0.75 * 48 * 3600) << "steady long before the longest spin-up";
+  EXPECT_GT(steady.seconds, 48 * 3600 / 20.0) << "a river from dry is not steady at the first check";
+  EXPECT_NEAR(std::fmod(steady.seconds, 48 * 3600 / 20.0), 0.0, 1e-6) << "it ends at a check";
+  EXPECT_EQ(steady.windowS, 48 * 3600 / 10.0);
+  EXPECT_LT(std::abs(steady.storageRateM3S), 0.01 * 400);
+  EXPECT_NEAR(steady.outflowM3S + steady.storageRateM3S, 400.0, 0.4) << "what came in left or was stored";
+  EXPECT_NE(
+      report.find("run until steady: " + strata::formatDuration(steady.seconds) + " before t = 0 (of at most 48 h"),
+      std::string::npos)
+      << report;
+  // Steady means it: twice as long a spin-up holds the same water at t = 0, within 1%.
+  const auto [longer, longerReport] =
+      run("spin_up = \"" + std::to_string(int(2 * steady.seconds)) + " s\"\n", "longer");
+  EXPECT_FALSE(longer.steady);
+  EXPECT_EQ(longer.seconds, double(int(2 * steady.seconds)));
+  EXPECT_NEAR(steady.storedM3, longer.storedM3, 0.01 * longer.storedM3);
+  EXPECT_LT(std::abs(longer.storageRateM3S), std::abs(steady.storageRateM3S));
+  // Too short to get there: it runs its whole length, warns and says so in the report.
+  const auto [early, earlyReport] = run("spin_up = \"1 h\"\nspin_up_tolerance = 0.01\n", "early");
+  EXPECT_FALSE(early.steady);
+  EXPECT_EQ(early.seconds, 3600.0);
+  EXPECT_GT(early.storageRateM3S, 0.01 * 400);
+  EXPECT_NE(earlyReport.find("**not steady**"), std::string::npos) << earlyReport;
+
+  // A tolerance needs a spin-up and an inflow, and is a fraction in (0, 0.5]: refused naming the key.
+  auto refused = [&](const std::string& time, const std::string& expected, bool noInflow = false) {
+    std::string text = scenarioText();
+    text.replace(text.find("[time]\n"), 7, "[time]\n" + time);
+    if (noInflow) {
+      const auto from = text.find("[[water.inflow]]"), to = text.find("[time]");
+      text.replace(from, to - from, "[water.rain]\nrate = \"10 mm/h\"\n");
+    }
+    std::ofstream(dir / "bad.toml") << text;
+    auto s = loadScenario(dir / "bad.toml");
+    ASSERT_FALSE(s) << time;
+    const auto line = std::count(text.begin(), text.begin() + std::ptrdiff_t(text.find("spin_up_tolerance")), '\n') + 1;
+    EXPECT_NE(s.message().find("bad.toml:" + std::to_string(line) + ": " + expected), std::string::npos) << s.message();
+  };
+  refused("spin_up_tolerance = 0.01\n", "key 'time.spin_up_tolerance': needs a spin_up");
+  refused("spin_up = \"1 h\"\nspin_up_tolerance = 0\n", "key 'time.spin_up_tolerance': must be positive");
+  refused("spin_up = \"1 h\"\nspin_up_tolerance = 0.6\n", "key 'time.spin_up_tolerance': must be at most 0.5");
+  refused("spin_up = \"1 h\"\nspin_up_tolerance = 0.01\n",
+          "key 'time.spin_up_tolerance': is a fraction of the base flow", true);
 }
 
 }  // namespace

@@ -618,8 +618,8 @@ CellBlock DistributedSolver::readLocalBlock(const CellRect& rect, unsigned parts
   return {};
 }
 
-void DistributedSolver::onClockStarted() {
-  for (auto& b : impl_->blocks) b.solver->startClockAt(timeS());
+void DistributedSolver::forEachPart(const std::function<void(Solver&)>& f) {
+  for (auto& b : impl_->blocks) f(*b.solver);
 }
 
 Status DistributedSolver::onSourceAdded(const Source& source) {

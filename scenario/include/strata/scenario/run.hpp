@@ -77,11 +77,15 @@ struct MaterialBudget {
 
 /// What a spin-up (Scenario::spinUpS) did: how the river stood at t = 0.
 struct SpinUpSummary {
-  double seconds = 0;         ///< 0: no spin-up
+  double seconds = 0;         ///< how long it ran; 0: no spin-up
+  double longestS = 0;        ///< the scenario's spin_up: the longest it could run
+  double toleranceRel = 0;    ///< the scenario's spin_up_tolerance (0: none, it ran longestS)
+  bool steady = false;        ///< the stored water changed by less than the tolerance (it stopped there)
+  double windowS = 0;         ///< the last tenth of longestS, over which the two rates below are taken
   double baseFlowM3S = 0;     ///< the inflows at t = 0, held through the spin-up
   double storedM3 = 0;        ///< water in the region at t = 0
-  double outflowM3S = 0;      ///< leaving through open edges and levels over the spin-up's last tenth
-  double storageRateM3S = 0;  ///< change of the stored water over that tenth (0 at equilibrium)
+  double outflowM3S = 0;      ///< leaving through open edges and levels over the window
+  double storageRateM3S = 0;  ///< change of the stored water over the window (0 at equilibrium)
   long long steps = 0;
 };
 

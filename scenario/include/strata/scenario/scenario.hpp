@@ -138,6 +138,9 @@ struct Scenario {
   /// Time run before t = 0 with every inflow and level held at its t = 0 value and no rain (a
   /// river's base flow settling into its bed); the outputs and the balance start at t = 0.
   double spinUpS = 0;
+  /// > 0: the spin-up ends early, at a twentieth of spinUpS, once the stored water changed by
+  /// less than this fraction of the base flow over its last tenth (steady); 0: it runs spinUpS.
+  double spinUpTolerance = 0;
 
   struct {
     std::vector<std::string> maps{"max_depth", "max_speed", "arrival_time", "inundation_duration", "final_depth"};

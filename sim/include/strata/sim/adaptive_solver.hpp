@@ -91,7 +91,8 @@ class AdaptiveSolver final : public Solver {
                  const SolverFactory& makeTile);
   void runStep(const StepInputs& step) override;
   Status onSourceAdded(const Source& source) override;
-  void onClockStarted() override;
+  void forEachPart(const std::function<void(Solver&)>& f) override;
+  void clearAccumulators() override;
   Status onLevelAdded(const LevelBoundary& level) override;
   void saveCells(SolverState& out) const override;
   Status restoreCells(const SolverState& in) override;

@@ -129,7 +129,7 @@ class DistributedSolver final : public Solver {
   void runStep(const StepInputs& step) override;
   void onParamsChanged() override;
   Status onSourceAdded(const Source& source) override;
-  void onClockStarted() override;
+  void forEachPart(const std::function<void(Solver&)>& f) override;
   Status onLevelAdded(const LevelBoundary& level) override;
   RainTotals rainTotals() const override;
   bool keepsFloodStats() const override { return true; }

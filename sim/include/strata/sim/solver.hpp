@@ -169,9 +169,12 @@ class Solver {
   /// Sets the clock before the first step (a run with a spin-up starts at -spin-up, so that the
   /// sources and levels hold their t = 0 values through it).
   void startClockAt(double timeS);
-  /// The budgets start over now: inflow, rain, outflow, evaporation and level exchanges back to
-  /// 0, the initial water and material those stored now (the end of a spin-up).
-  void restartBudgets();
+  /// The run starts over at `timeS` (the end of a spin-up): the budgets (inflow, rain, outflow,
+  /// evaporation, level exchanges) back to 0, the initial water and material those stored now,
+  /// and the clock at `timeS`. A spin-up that reached its steady state early ends here too: its
+  /// sources and levels held their t = 0 values all through it, so the time skipped would have
+  /// changed nothing. The caller keeps that promise: the clock moves without a step.
+  void restartAt(double timeS);
 
   /// Starts per-cell flood statistics with `wetThresholdM` (>= 0) as the wet/dry depth (m).
   void enableFloodStats(float wetThresholdM);
@@ -244,9 +247,11 @@ class Solver {
   void updateRainTotals();
   /// A source or level was added (runners hand them on to the solvers they hold).
   virtual Status onSourceAdded(const Source& /*source*/) { return {}; }
-  /// startClockAt() set the clock (runners set their parts' clocks: a part's sources and levels
-  /// follow its own clock).
-  virtual void onClockStarted() {}
+  /// The solvers a runner steps (tiles, blocks), each once: they follow the run's clock (a
+  /// part's sources and levels follow its own clock). None for a backend.
+  virtual void forEachPart(const std::function<void(Solver&)>& /*f*/) {}
+  /// restartAt(): every cell's accumulators (outflow, evaporation, level exchanges) back to 0.
+  virtual void clearAccumulators();
   virtual Status onLevelAdded(const LevelBoundary& /*level*/) { return {}; }
 
   /// Per-cell sums for stats(): the cells' depth, suspended load and layers, and the totals of
@@ -284,6 +289,7 @@ class Solver {
  private:
   void updateHostFloodStats();
   void takeStep(double dtS, bool run);
+  void setClock(double timeS);  // this solver's and its parts'
 
   SimParams params_;
   CellGrid grid_;

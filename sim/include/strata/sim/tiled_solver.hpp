@@ -47,7 +47,7 @@ class TiledSolver final : public Solver {
   void runStep(const StepInputs& step) override;
   void onParamsChanged() override;
   Status onSourceAdded(const Source& source) override;
-  void onClockStarted() override;
+  void forEachPart(const std::function<void(Solver&)>& f) override;
   Status onLevelAdded(const LevelBoundary& level) override;
   bool keepsFloodStats() const override { return true; }
   void resetFloodStats() override;
