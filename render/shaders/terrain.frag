@@ -32,6 +32,7 @@ layout(binding = SLOT_LONLAT) uniform sampler2D uLonLat;  // lon/lat (deg) of th
 uniform float uGraticuleDeg;     // lines of longitude and latitude this far apart (deg); 0: none
 layout(binding = SLOT_SHADOW) uniform sampler2D uShadow;  // fraction of the sun each cell sees, optional
 uniform int uHasShadow;
+uniform vec2 uOverviewUvScale;   // uShadow's and uLonLat's coordinates are uv times this (streamed scenes)
 uniform float uAmbient;          // light where the sun does not reach
 uniform vec3 uSiltColour;        // water colour at high sediment concentration
 uniform float uSiltConcentration; // concentration s / h at which water is 1 - 1/e of the way to silt
@@ -144,7 +145,10 @@ void main() {
     albedo = mix(albedo, d.rgb, d.a * uDrapeOpacity);
   }
   float sunLit = 1.0;
-  if (uHasShadow != 0) sunLit = textureGrad(uShadow, uv, dFdx(q) / uTexSize, dFdy(q) / uTexSize).r;
+  if (uHasShadow != 0) {
+    sunLit = textureGrad(uShadow, uv * uOverviewUvScale, dFdx(q) / uTexSize * uOverviewUvScale,
+                         dFdy(q) / uTexSize * uOverviewUvScale).r;
+  }
   float light = uAmbient + (1.0 - uAmbient) * max(dot(n, uSunDir), 0.0) * sunLit;
   vec3 colour = albedo * light;
 
@@ -177,7 +181,7 @@ void main() {
     // Distance in pixels to the nearest line of each family (the lon/lat's own screen derivative),
     // a line 1.5 pixels wide with soft edges; a family whose lines come closer than ~5 pixels
     // fades out rather than whiten the view.
-    vec2 g = textureLod(uLonLat, uv, 0.0).rg / uGraticuleDeg;
+    vec2 g = textureLod(uLonLat, uv * uOverviewUvScale, 0.0).rg / uGraticuleDeg;
     vec2 fw = max(fwidth(g), vec2(1e-12));
     vec2 px = abs(fract(g + 0.5) - 0.5) / fw;
     vec2 line = (1.0 - smoothstep(0.75, 1.5, px)) * (1.0 - smoothstep(0.1, 0.2, fw));

@@ -65,12 +65,22 @@ Result<DrapeImage> loadDrape(const std::string& path, const gis::Georef& scene, 
   probe.allowAllNoData = true;
   STRATA_TRY(gis::DemInfo info, gis::probeDem(path, probe));
   if (options.texelsPerCell < 1) return fail(path + ": drape texels per cell must be at least 1");
+  // `texelsPerCell` texels a cell while that stays within 8192 a side; a larger (or streamed)
+  // scene gets at most 8192 texels a side over its whole extent, each covering several cells.
+  constexpr int kMaxSide = 8192;
   int f = options.texelsPerCell;
-  while (f > 1 && std::max(scene.width, scene.height) * f > 8192) --f;
+  while (f > 1 && std::max(scene.width, scene.height) * f > kMaxSide) --f;
   gis::Georef target = scene;
   target.width = scene.width * f;
   target.height = scene.height * f;
-  for (int k : {1, 2, 4, 5}) target.transform.c[k] /= f;
+  if (std::max(scene.width, scene.height) > kMaxSide) {
+    const double shrink = double(kMaxSide) / std::max(scene.width, scene.height);
+    target.width = std::max(1, int(std::lround(scene.width * shrink)));
+    target.height = std::max(1, int(std::lround(scene.height * shrink)));
+  }
+  const double fx = double(target.width) / scene.width, fy = double(target.height) / scene.height;
+  for (int k : {1, 4}) target.transform.c[k] /= fx;
+  for (int k : {2, 5}) target.transform.c[k] /= fy;
 
   const bool bytes = info.bandType == "Byte";
   const int bands = bytes ? std::min(info.bandCount, 4) : 1;

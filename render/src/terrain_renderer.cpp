@@ -141,6 +141,7 @@ Status setCommonUniforms(const gl::Program& p, const TerrainScene& scene, const 
   if (scene.drapeTexture()) scene.drapeTexture()->bind(slots::kDrape);
   p.set("uHasShadow", scene.shadowTexture() ? 1 : 0);
   if (scene.shadowTexture()) scene.shadowTexture()->bind(slots::kShadow);
+  p.set("uOverviewUvScale", scene.overviewUvScale());
   p.set("uAmbient", shading.ambient);
   const bool graticule = scene.lonLatTexture() && shading.graticuleDeg > 0;
   p.set("uGraticuleDeg", graticule ? float(shading.graticuleDeg) : 0.0f);
@@ -420,13 +421,20 @@ Status TerrainScene::setMaterialLayers(const std::vector<gis::Grid<float>>& thic
 }
 
 Status TerrainScene::setDrape(const DrapeImage& image) {
-  if (streamed_) return fail("render: a drape is drawn on whole-DEM scenes only (this one is streamed)");
-  if (image.width < width() || image.height < height() || image.width % width() != 0 || image.height % height() != 0 ||
-      image.width / width() != image.height / height() ||
-      image.rgba.size() != size_t(image.width) * size_t(image.height) * 4) {
+  // The texels must cover the scene's extent (loadDrape warps onto it: on the scene's cells, or
+  // at most 8192 texels a side over a larger or streamed scene), whatever their size.
+  const auto& a = georef_.transform;
+  const auto& b = image.georef.transform;
+  const double tol = 1e-6 * std::max(std::abs(a.c[1]), std::abs(a.c[5]));
+  const bool covers = image.georef.width == image.width && image.georef.height == image.height &&
+                      std::abs(a.x(0, 0) - b.x(0, 0)) <= tol && std::abs(a.y(0, 0) - b.y(0, 0)) <= tol &&
+                      std::abs(a.x(width(), height()) - b.x(image.width, image.height)) <= tol &&
+                      std::abs(a.y(width(), height()) - b.y(image.width, image.height)) <= tol;
+  if (image.width < 1 || image.height < 1 || image.rgba.size() != size_t(image.width) * size_t(image.height) * 4 ||
+      !covers) {
     return fail("render: drape of " + std::to_string(image.width) + "x" + std::to_string(image.height) +
-                " texels is not on the DEM's grid (" + std::to_string(width()) + "x" + std::to_string(height()) +
-                " cells; loadDrape makes it so)");
+                " texels does not cover the scene's extent (" + std::to_string(width()) + "x" +
+                std::to_string(height()) + " cells; loadDrape makes it so)");
   }
   drape_ = gl::Texture::create2D(gl::TextureFormat::kRGBA8, image.width, image.height, 0);
   drape_.upload(image.rgba.data());
@@ -434,10 +442,27 @@ Status TerrainScene::setDrape(const DrapeImage& image) {
   return {};
 }
 
+// Streamed scenes compute shadows and the graticule's lon/lat once over the whole terrain, on
+// the store's finest level at most this many cells a side.
+constexpr int kOverviewSide = 2048;
+
+Result<gis::Raster> TerrainScene::overviewHeights() const {
+  if (!streamed_) return gis::Raster{georef_, heights_};
+  STRATA_TRY(gis::Raster r, streamed_->overview(kOverviewSide));
+  return r;
+}
+
+void TerrainScene::setOverviewGrid(const gis::Georef& grid) {
+  // uv spans the scene's cells; an overview level's cells may reach past them (ceil(n / 2^L)).
+  overviewUvScale_ = glm::vec2(float(double(width()) * georef_.transform.c[1] / (grid.width * grid.transform.c[1])),
+                               float(double(height()) * georef_.transform.c[5] / (grid.height * grid.transform.c[5])));
+}
+
 Status TerrainScene::castShadows(const SunSpec& sun, float exaggeration) {
-  if (streamed_) return fail("render: shadows are cast on whole-DEM scenes only (this one is streamed)");
-  const gis::Grid<float> lit = render::castShadows(heights_, georef_, sun, exaggeration, metresPerUnit_);
-  shadow_ = gl::Texture::create2D(gl::TextureFormat::kR32F, width(), height(), 0);
+  STRATA_TRY(const gis::Raster over, overviewHeights());
+  const gis::Grid<float> lit = render::castShadows(over.values, over.georef, sun, exaggeration, metresPerUnit_);
+  setOverviewGrid(over.georef);
+  shadow_ = gl::Texture::create2D(gl::TextureFormat::kR32F, lit.width, lit.height, 0);
   shadow_.upload(lit.data.data());
   shadow_.generateMipmap();
   shadowSun_ = sun;
@@ -449,14 +474,20 @@ Status TerrainScene::castShadows(const SunSpec& sun, float exaggeration) {
 Status TerrainScene::recastShadows() { return shadowSun_ ? castShadows(*shadowSun_, shadowExaggeration_) : Status{}; }
 
 Status TerrainScene::enableGraticule() {
-  if (streamed_) return fail("render: a graticule is drawn on whole-DEM scenes only (this one is streamed)");
-  const size_t n = size_t(width()) * size_t(height());
+  // Lon/lat at the cell centres (of the overview level on a streamed scene, bilinear between).
+  gis::Georef grid = georef_;
+  if (streamed_) {
+    STRATA_TRY(const gis::Raster over, overviewHeights());
+    grid = over.georef;
+  }
+  const int gw = grid.width, gh = grid.height;
+  const size_t n = size_t(gw) * size_t(gh);
   std::vector<double> x(n), y(n);
-  const auto& t = georef_.transform;
-  for (int r = 0; r < height(); ++r) {
-    for (int c = 0; c < width(); ++c) {
-      x[size_t(r) * size_t(width()) + size_t(c)] = t.x(c + 0.5, r + 0.5);
-      y[size_t(r) * size_t(width()) + size_t(c)] = t.y(c + 0.5, r + 0.5);
+  const auto& t = grid.transform;
+  for (int r = 0; r < gh; ++r) {
+    for (int c = 0; c < gw; ++c) {
+      x[size_t(r) * size_t(gw) + size_t(c)] = t.x(c + 0.5, r + 0.5);
+      y[size_t(r) * size_t(gw) + size_t(c)] = t.y(c + 0.5, r + 0.5);
     }
   }
   if (!georef_.geographic) {
@@ -465,7 +496,8 @@ Status TerrainScene::enableGraticule() {
   }
   std::vector<float> packed(n * 2);
   for (size_t i = 0; i < n; ++i) packed[i * 2] = float(x[i]), packed[i * 2 + 1] = float(y[i]);
-  lonLat_ = gl::Texture::create2D(gl::TextureFormat::kRG32F, width(), height(), 1);
+  setOverviewGrid(grid);
+  lonLat_ = gl::Texture::create2D(gl::TextureFormat::kRG32F, gw, gh, 1);
   lonLat_.upload(packed.data());
   return {};
 }

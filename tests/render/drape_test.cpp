@@ -22,6 +22,42 @@ gis::Georef canyonGeoref() {
   return info.ok() ? info->georef : gis::Georef{};
 }
 
+// Where the UTM marker (drape_raster.hpp) is drawn in `img`: metres east and north of where it
+// is, and how many texels it covers. Every texel must be opaque (the raster covers the scene).
+struct MarkerFound {
+  double eastM = 0, northM = 0;
+  int texels = 0;
+};
+MarkerFound findMarker(const DrapeImage& img) {
+  double sx = 0, sy = 0;
+  int red = 0, blue = 0;  // and a few texels on the marker's edge, blended half and half
+  for (int y = 0; y < img.height; ++y) {
+    for (int x = 0; x < img.width; ++x) {
+      const uint8_t* p = &img.rgba[(size_t(y) * size_t(img.width) + size_t(x)) * 4];
+      EXPECT_EQ(p[3], 255) << "the raster covers the whole scene: every texel opaque, not at " << x << ", " << y;
+      if (p[3] != 255) return {};
+      if (p[0] > 128) {
+        sx += x + 0.5, sy += y + 0.5, ++red;
+      } else {
+        blue += p[2] > 128;
+      }
+    }
+  }
+  EXPECT_GT(red, 0);
+  EXPECT_GT(red + blue, img.width * img.height - 100);
+  if (red == 0) return {};
+  const double lon = img.georef.transform.x(sx / red, sy / red), lat = img.georef.transform.y(sx / red, sy / red);
+  auto ct = gis::CrsTransform::create("EPSG:32612", "EPSG:4326");
+  EXPECT_TRUE(ct) << ct.message();
+  double mx = test::kMarkerUtm[0], my = test::kMarkerUtm[1];
+  EXPECT_TRUE(ct->transform(1, &mx, &my));
+  const double kDeg = std::numbers::pi / 180, r = 6371000;
+  MarkerFound f{(lon - mx) * kDeg * r * std::cos(my * kDeg), (lat - my) * kDeg * r, red};
+  std::printf("marker at %.6f, %.6f; drawn at %.6f, %.6f: %.1f m east, %.1f m north; %d texels\n", mx, my, lon, lat,
+              f.eastM, f.northM, red);
+  return f;
+}
+
 TEST(Drape, AUtmPixelLandsOnItsGroundPointOnALonLatDem) {
   // The issue's check: a draped raster's pixel lands on its georeferenced ground point within
   // one pixel. The DEM is in lon/lat (EPSG:4326), the raster in UTM 12N.
@@ -35,36 +71,44 @@ TEST(Drape, AUtmPixelLandsOnItsGroundPointOnALonLatDem) {
   ASSERT_TRUE(img) << img.message();
   EXPECT_EQ(img->width, 1024);
   EXPECT_EQ(img->description, "RGB (3 Byte bands)");
-  double sx = 0, sy = 0;
-  int red = 0, blue = 0;  // and a few texels on the marker's edge, blended half and half
-  for (int y = 0; y < img->height; ++y) {
-    for (int x = 0; x < img->width; ++x) {
-      const uint8_t* p = &img->rgba[(size_t(y) * size_t(img->width) + size_t(x)) * 4];
-      ASSERT_EQ(p[3], 255) << "the raster covers the whole DEM: every texel opaque, not at " << x << ", " << y;
-      if (p[0] > 128) {
-        sx += x + 0.5, sy += y + 0.5, ++red;
-      } else {
-        blue += p[2] > 128;
-      }
-    }
-  }
-  ASSERT_GT(red, 0);
-  EXPECT_GT(red + blue, img->width * img->height - 100);
-  const double lon = img->georef.transform.x(sx / red, sy / red), lat = img->georef.transform.y(sx / red, sy / red);
+  const MarkerFound f = findMarker(*img);
+  // The issue asks for one raster pixel (500 m); 12 m measured. 50 m, under half a drape texel
+  // (87 x 111 m), catches a drape moved by a texel or a DEM cell (pixel-is-point, a flipped row).
+  EXPECT_LT(std::hypot(f.eastM, f.northM), 50.0);
+  // The marker is 1.5 km square: about that many texels of 1/1024 degree.
+  const double kDeg = std::numbers::pi / 180, r = 6371000;
+  const double texelArea = (1.0 / 1024 * kDeg * r) * (1.0 / 1024 * kDeg * r * std::cos(36.1 * kDeg));
+  EXPECT_NEAR(f.texels * texelArea / (1500.0 * 1500.0), 1.0, 0.3);
+}
+
+// A scene wider than 8192 cells (a streamed store) gets at most 8192 texels a side over its
+// whole extent, each several cells, and the marker still lands on its ground point. The scene:
+// 20,000 x 200 cells over the canyon DEM's longitudes, a strip of latitudes around the marker.
+TEST(Drape, OnASceneWiderThanTheTextureTheTexelsSpanItsExtent) {
+  const auto dir = strata::test::tempDir("drape-wide");
+  const std::string path = (dir / "utm_marker.tif").string();
+  ASSERT_TRUE(test::writeUtmMarker(path));
+  const gis::Georef canyon = canyonGeoref();
   auto ct = gis::CrsTransform::create("EPSG:32612", "EPSG:4326");
   ASSERT_TRUE(ct) << ct.message();
   double mx = test::kMarkerUtm[0], my = test::kMarkerUtm[1];
   ASSERT_TRUE(ct->transform(1, &mx, &my));
-  const double kDeg = std::numbers::pi / 180, r = 6371000;
-  const double eastM = (lon - mx) * kDeg * r * std::cos(my * kDeg), northM = (lat - my) * kDeg * r;
-  std::printf("marker at %.6f, %.6f; drawn at %.6f, %.6f: %.1f m east, %.1f m north; %d texels\n", mx, my, lon, lat,
-              eastM, northM, red);
-  // The issue asks for one raster pixel (500 m); 12 m measured. 50 m, under half a drape texel
-  // (87 x 111 m), catches a drape moved by a texel or a DEM cell (pixel-is-point, a flipped row).
-  EXPECT_LT(std::hypot(eastM, northM), 50.0);
-  // The marker is 1.5 km square: about that many texels of 1/1024 degree.
-  const double texelArea = (1.0 / 1024 * kDeg * r) * (1.0 / 1024 * kDeg * r * std::cos(my * kDeg));
-  EXPECT_NEAR(red * texelArea / (1500.0 * 1500.0), 1.0, 0.3);
+  gis::Georef scene = canyon;
+  scene.width = 20000;
+  scene.height = 200;
+  scene.transform.c[1] = canyon.transform.c[1] * canyon.width / scene.width;
+  scene.transform.c[5] = -1.0 / 2048;
+  scene.transform.c[3] = my + 100.0 / 2048;
+  auto img = loadDrape(path, scene);
+  ASSERT_TRUE(img) << img.message();
+  EXPECT_EQ(img->width, 8192);
+  EXPECT_EQ(img->height, 82);  // 200 x 8192 / 20000, rounded
+  const auto& t = img->georef.transform;
+  EXPECT_NEAR(t.x(img->width, img->height), scene.transform.x(scene.width, scene.height), 1e-9);
+  EXPECT_NEAR(t.y(img->width, img->height), scene.transform.y(scene.width, scene.height), 1e-9);
+  const MarkerFound f = findMarker(*img);
+  // Texels of ~11 x 133 m: 50 m catches a drape moved by half a texel north or south.
+  EXPECT_LT(std::hypot(f.eastM, f.northM), 50.0);
 }
 
 TEST(Drape, OneBandRampsOverItsRangeAndHidesWhatIsBelowAndNoData) {

@@ -13,7 +13,9 @@
 #include <tuple>
 
 #include <strata/gis/dem_io.hpp>
+#include <strata/render/drape.hpp>
 #include <strata/render/gpu_tile_cache.hpp>
+#include <strata/render/image_io.hpp>
 #include <strata/render/screen_error.hpp>
 #include <strata/render/sliding_grid.hpp>
 #include <strata/render/streamed_elevation.hpp>
@@ -22,6 +24,7 @@
 #include <strata/terrain/ingest.hpp>
 #include <strata/terrain/tile_store.hpp>
 
+#include "drape_raster.hpp"
 #include "gl_fixture.hpp"
 #include "strata_test.hpp"
 
@@ -253,6 +256,65 @@ TEST_F(GlTest, StreamedRenderMatchesTheWholeDemRender) {
   EXPECT_LT(d.elevP99M, 15.0);
   EXPECT_LT(d.colourFraction, 0.02);
   EXPECT_LT(d.terrainMismatch, size_t(w * h / 100));
+}
+
+// A drape, cast shadows and a graticule on a streamed scene (the drape over the whole terrain,
+// shadows and lon/lat on the overview level: here level 0, the store's 512^2) look as on the
+// whole-DEM scene, up to the streamed elevation's own difference (the test above); and they
+// are drawn (the picture differs from the one without them).
+TEST_F(GlTest, DrapeShadowsAndGraticuleOnAStreamedSceneMatchTheWholeDem) {
+  auto whole = storeAsWholeScene();
+  ASSERT_TRUE(whole) << whole.message();
+  const StreamParams params{.clipSize = 128, .pageSize = 32, .uploadPagesPerFrame = 1000};
+  auto streamed = TerrainScene::createStreamed(openStore(), params);
+  ASSERT_TRUE(streamed) << streamed.message();
+  auto plain = TerrainScene::createStreamed(openStore(), params);
+  ASSERT_TRUE(plain) << plain.message();
+  // The UTM marker raster of the drape tests (blue, a red square), reprojected onto each scene.
+  const std::string drapePath = (test::tempDir("streamed-drape") / "utm_marker.tif").string();
+  ASSERT_TRUE(test::writeUtmMarker(drapePath));
+  SunSpec sun;
+  sun.dirEnu = glm::normalize(glm::dvec3(-1.0, 0.3, 0.35));  // low in the west
+  for (TerrainScene* scene : {&*whole, &*streamed}) {
+    auto drape = loadDrape(drapePath, scene->georef());
+    ASSERT_TRUE(drape) << drape.message();
+    ASSERT_TRUE(scene->setDrape(*drape));
+    ASSERT_TRUE(scene->castShadows(sun, 1.0f));
+    ASSERT_TRUE(scene->enableGraticule());
+    EXPECT_EQ(scene->overviewUvScale(), glm::vec2(1.0f, 1.0f));
+  }
+  // A store wider than the overview's side gives a coarser level with its own cells.
+  auto over = streamed->streamed()->overview(100);
+  ASSERT_TRUE(over) << over.message();
+  EXPECT_EQ(over->georef.width, 64);  // level 3 of 512
+  EXPECT_EQ(over->georef.transform.c[1], 8 * whole->georef().transform.c[1]);
+  auto level3 = openStore().readWindow(0, {0, 0, 64, 64}, 3);
+  ASSERT_TRUE(level3) << level3.message();
+  EXPECT_EQ(over->values.data, level3->data);
+  auto ring = RingRenderer::create({.circles = 64});
+  ASSERT_TRUE(ring) << ring.message();
+  const int w = 256, h = 160;
+  auto t1 = OffscreenTarget::create(w, h), t2 = OffscreenTarget::create(w, h), t3 = OffscreenTarget::create(w, h);
+  ASSERT_TRUE(t1 && t2 && t3);
+  Shading shading;
+  shading.fogM = 150000;
+  shading.tintRangeM = glm::vec2(whole->minElevationM(), whole->maxElevationM());
+  shading.sunDir = glm::vec3(glm::normalize(glm::dvec3(-1.0, 0.3, 0.35)));
+  shading.drapeOpacity = 0.6f;
+  shading.graticuleDeg = 0.05;
+  ASSERT_TRUE((*ring)->draw(*whole, kCanyonCamera, shading, *t1));
+  ASSERT_TRUE((*ring)->draw(*streamed, kCanyonCamera, shading, *t2));
+  ASSERT_TRUE((*ring)->draw(*plain, kCanyonCamera, shading, *t3));
+  ASSERT_TRUE(writeImage8((test::outputDir("render") / "streamed_drape_shadows_graticule.png").string(), w, h, 4,
+                          t2->colour()));
+  const Diff same = compare(*t1, *t2, 8);
+  const Diff without = compare(*t3, *t2, 8);
+  std::printf(
+      "streamed vs whole, both with drape, shadows, graticule: %.4f of pixels over 8, max %d; "
+      "vs streamed without them: %.4f\n",
+      same.colourFraction, same.maxChannel, without.colourFraction);
+  EXPECT_LT(same.colourFraction, 0.03);
+  EXPECT_GT(without.colourFraction, 0.3) << "the drape, shadows and graticule are drawn";
 }
 
 TEST_F(GlTest, SlidingGridDrawsAStreamedScene) {

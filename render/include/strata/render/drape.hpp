@@ -1,8 +1,8 @@
 #pragma once
 // A georeferenced raster draped over a terrain scene (an orthophoto, a hillshade, a flood map):
 // warped by GDAL onto the scene's own grid (its CRS and extent, `texelsPerCell` texels a DEM
-// cell a side), so the texture lines up with the height texture's coordinates whatever the
-// raster's CRS. What the bands become:
+// cell a side; at most 8192 texels a side over the whole extent of a larger or streamed scene),
+// so the texture lines up with the height texture's coordinates whatever the raster's CRS. What the bands become:
 // - 3 or 4 Byte bands: red, green, blue (and alpha);
 // - 1 Byte band: grey (a hillshade); 2 Byte bands: grey and alpha;
 // - 1 band of any other type (depths, speeds, times): a colour ramp over `range` (default: the

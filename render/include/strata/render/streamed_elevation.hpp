@@ -95,6 +95,12 @@ class StreamedElevation {
   /// or, without waitForDisk, while its tile is being decoded).
   std::array<float, 4> cellQuad(int i, int j);
 
+  /// The whole terrain at the finest level of the store at most `maxSide` cells a side (or the
+  /// coarsest it has), voids filled, and that level's grid (cells 2^level base cells a side,
+  /// from the same corner; the last row and column may reach past the base grid's extent). For
+  /// what is computed once over the whole terrain: shadows, the graticule's lon/lat.
+  Result<gis::Raster> overview(int maxSide);
+
   StreamStats stats() const;
   size_t gpuBytes() const;
   GpuTileCache& cache() { return *cache_; }

@@ -117,11 +117,14 @@ class TerrainScene {
   Status setMaterialLayers(const std::vector<gis::Grid<float>>& thicknessM);
   /// A raster draped over the terrain (loadDrape, on this scene's grid): drawn over the elevation
   /// tint and the material layers, times its alpha and Shading::drapeOpacity, lit by the sun;
-  /// water is drawn over it. Whole-DEM scenes only.
+  /// water is drawn over it. On a streamed scene the drape covers the whole terrain at loadDrape's
+  /// resolution (at most 8192 texels a side).
   Status setDrape(const DrapeImage& image);
   /// Cast shadows for `sun` at vertical exaggeration `exaggeration` (render::castShadows on the
   /// CPU, a lit-fraction texture the lighting multiplies): recast them when the sun, the
-  /// exaggeration or the heights change. Whole-DEM scenes only.
+  /// exaggeration or the heights change. On a streamed scene they are cast once over the whole
+  /// terrain on the store's finest level at most 2048 cells a side (StreamedElevation::overview):
+  /// ridges cast the shadows of that level, not of the finer pages streamed around the viewer.
   Status castShadows(const SunSpec& sun, float exaggeration);
   /// Whether heights changed (writeHeights, heightsEditedOnGpu) since the shadows were cast.
   bool shadowsStale() const { return shadowsStale_; }
@@ -129,7 +132,9 @@ class TerrainScene {
   /// none were.
   Status recastShadows();
   /// Lon/lat of every cell centre on the GPU (through the CRS's own datum for projected DEMs), so
-  /// that Shading::graticuleDeg can draw lines of longitude and latitude. Whole-DEM scenes only.
+  /// that Shading::graticuleDeg can draw lines of longitude and latitude. On a streamed scene at
+  /// the cells of the overview level (as castShadows), bilinear between them: exact on a
+  /// geographic store, within the CRS's curvature over one such cell on a projected one.
   Status enableGraticule();
   /// Replaces the elevations of the `patch.width` x `patch.height` cells at (x, y) (m), on the
   /// GPU and in the CPU copy; the mip chain is rebuilt. The patch must lie inside the grid.
@@ -178,6 +183,9 @@ class TerrainScene {
   const gl::Texture* drapeTexture() const { return drape_ ? &drape_ : nullptr; }
   const gl::Texture* lonLatTexture() const { return lonLat_ ? &lonLat_ : nullptr; }
   const gl::Texture* shadowTexture() const { return shadow_ ? &shadow_ : nullptr; }
+  /// The shadow and lon/lat textures' coordinates are uv times this: (1, 1) on a whole-DEM scene;
+  /// on a streamed one their overview level may reach past the scene's cells.
+  glm::vec2 overviewUvScale() const { return overviewUvScale_; }
   /// Lon/lat (deg) of the DEM's centre (its own for geographic DEMs; through its CRS otherwise,
   /// NaN where that fails).
   glm::dvec2 centreLonLat() const { return centreLonLat_; }
@@ -197,6 +205,12 @@ class TerrainScene {
   float shadowExaggeration_ = 1;
   bool shadowsStale_ = false;
   std::shared_ptr<StreamedElevation> streamed_;
+  glm::vec2 overviewUvScale_{1.0f, 1.0f};
+
+  // The heights shadows and the graticule are computed on: the DEM's, or a streamed scene's
+  // overview level (StreamedElevation::overview).
+  Result<gis::Raster> overviewHeights() const;
+  void setOverviewGrid(const gis::Georef& grid);
 };
 
 /// Everything the shaders need about one frame's view, computed in double on the CPU.
