@@ -446,10 +446,9 @@ Status TerrainScene::setDrape(const DrapeImage& image) {
 // the store's finest level at most this many cells a side.
 constexpr int kOverviewSide = 2048;
 
-Result<gis::Raster> TerrainScene::overviewHeights() const {
-  if (!streamed_) return gis::Raster{georef_, heights_};
-  STRATA_TRY(gis::Raster r, streamed_->overview(kOverviewSide));
-  return r;
+Result<gis::Raster> TerrainScene::streamedOverview() const {
+  STRATA_CHECK(streamed_) << "streamedOverview on a whole-DEM scene";
+  return streamed_->overview(kOverviewSide);
 }
 
 void TerrainScene::setOverviewGrid(const gis::Georef& grid) {
@@ -459,9 +458,14 @@ void TerrainScene::setOverviewGrid(const gis::Georef& grid) {
 }
 
 Status TerrainScene::castShadows(const SunSpec& sun, float exaggeration) {
-  STRATA_TRY(const gis::Raster over, overviewHeights());
-  const gis::Grid<float> lit = render::castShadows(over.values, over.georef, sun, exaggeration, metresPerUnit_);
-  setOverviewGrid(over.georef);
+  std::optional<gis::Raster> over;
+  if (streamed_) {
+    STRATA_TRY(over, streamedOverview());
+  }
+  const gis::Georef& grid = over ? over->georef : georef_;
+  const gis::Grid<float> lit =
+      render::castShadows(over ? over->values : heights_, grid, sun, exaggeration, metresPerUnit_);
+  setOverviewGrid(grid);
   shadow_ = gl::Texture::create2D(gl::TextureFormat::kR32F, lit.width, lit.height, 0);
   shadow_.upload(lit.data.data());
   shadow_.generateMipmap();
@@ -477,7 +481,7 @@ Status TerrainScene::enableGraticule() {
   // Lon/lat at the cell centres (of the overview level on a streamed scene, bilinear between).
   gis::Georef grid = georef_;
   if (streamed_) {
-    STRATA_TRY(const gis::Raster over, overviewHeights());
+    STRATA_TRY(const gis::Raster over, streamedOverview());
     grid = over.georef;
   }
   const int gw = grid.width, gh = grid.height;

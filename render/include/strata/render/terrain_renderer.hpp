@@ -207,9 +207,9 @@ class TerrainScene {
   std::shared_ptr<StreamedElevation> streamed_;
   glm::vec2 overviewUvScale_{1.0f, 1.0f};
 
-  // The heights shadows and the graticule are computed on: the DEM's, or a streamed scene's
-  // overview level (StreamedElevation::overview).
-  Result<gis::Raster> overviewHeights() const;
+  // A streamed scene's shadows and graticule are computed on its overview level
+  // (StreamedElevation::overview); a whole-DEM scene's on its own cells.
+  Result<gis::Raster> streamedOverview() const;
   void setOverviewGrid(const gis::Georef& grid);
 };
 
