@@ -234,16 +234,27 @@ size_t StreamedElevation::gpuBytes() const {
   return b + cache_->stats().bytesAllocated;
 }
 
-Result<gis::Raster> StreamedElevation::overview(int maxSide) {
-  auto& st = *store_;
+int StreamedElevation::overviewLevel(int maxSide) const {
+  const auto& st = *store_;
   int level = 0;
   while (level < st.maxLod() && (st.levelWidth(level) > maxSide || st.levelHeight(level) > maxSide)) ++level;
+  return level;
+}
+
+gis::Georef StreamedElevation::overviewGrid(int maxSide) const {
+  const int level = overviewLevel(maxSide);
+  gis::Georef g = store_->desc().georef;
+  g.width = store_->levelWidth(level);
+  g.height = store_->levelHeight(level);
+  for (int k : {1, 2, 4, 5}) g.transform.c[k] *= double(1 << level);
+  return g;
+}
+
+Result<gis::Raster> StreamedElevation::overview(int maxSide) {
   gis::Raster r;
-  r.georef = st.desc().georef;
-  r.georef.width = st.levelWidth(level);
-  r.georef.height = st.levelHeight(level);
-  for (int k : {1, 2, 4, 5}) r.georef.transform.c[k] *= double(1 << level);
-  STRATA_TRY(r.values, st.readWindow(field_, {0, 0, r.georef.width, r.georef.height}, level));
+  r.georef = overviewGrid(maxSide);
+  const int level = overviewLevel(maxSide);
+  STRATA_TRY(r.values, store_->readWindow(field_, {0, 0, r.georef.width, r.georef.height}, level));
   STRATA_TRY(const size_t filled, gis::fillVoids(r.values));
   (void)filled;
   return r;

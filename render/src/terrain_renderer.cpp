@@ -480,10 +480,7 @@ Status TerrainScene::recastShadows() { return shadowSun_ ? castShadows(*shadowSu
 Status TerrainScene::enableGraticule() {
   // Lon/lat at the cell centres (of the overview level on a streamed scene, bilinear between).
   gis::Georef grid = georef_;
-  if (streamed_) {
-    STRATA_TRY(const gis::Raster over, streamedOverview());
-    grid = over.georef;
-  }
+  if (streamed_) grid = streamed_->overviewGrid(kOverviewSide);
   const int gw = grid.width, gh = grid.height;
   const size_t n = size_t(gw) * size_t(gh);
   std::vector<double> x(n), y(n);

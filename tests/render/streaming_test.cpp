@@ -287,6 +287,7 @@ TEST_F(GlTest, DrapeShadowsAndGraticuleOnAStreamedSceneMatchTheWholeDem) {
   auto over = streamed->streamed()->overview(100);
   ASSERT_TRUE(over) << over.message();
   EXPECT_EQ(over->georef.width, 64);  // level 3 of 512
+  EXPECT_EQ(streamed->streamed()->overviewGrid(100).transform.c[1], over->georef.transform.c[1]);
   EXPECT_EQ(over->georef.transform.c[1], 8 * whole->georef().transform.c[1]);
   auto level3 = openStore().readWindow(0, {0, 0, 64, 64}, 3);
   ASSERT_TRUE(level3) << level3.message();

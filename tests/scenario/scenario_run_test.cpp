@@ -231,6 +231,7 @@ TEST(ScenarioRun, SpinUpEndsOnceTheRiverIsSteady) {
     std::ofstream(dir / (name + ".toml")) << text;
     auto scenario = loadScenario(dir / (name + ".toml"));
     EXPECT_TRUE(scenario) << scenario.message();
+    if (!scenario) return std::pair{SpinUpSummary{}, std::string()};
     RunOptions opt;
     opt.outDir = dir / name;
     opt.backend = Backend::kCpu;
@@ -238,6 +239,7 @@ TEST(ScenarioRun, SpinUpEndsOnceTheRiverIsSteady) {
     opt.plots = false;
     auto summary = runScenario(*scenario, opt);
     EXPECT_TRUE(summary) << summary.message();
+    if (!summary) return std::pair{SpinUpSummary{}, std::string()};
     return std::pair{summary->spinUp, slurp(opt.outDir / "report.md")};
   };
   const auto [steady, report] = run("spin_up = \"48 h\"\nspin_up_tolerance = 0.01\n", "steady");

@@ -100,6 +100,8 @@ class StreamedElevation {
   /// from the same corner; the last row and column may reach past the base grid's extent). For
   /// what is computed once over the whole terrain: shadows, the graticule's lon/lat.
   Result<gis::Raster> overview(int maxSide);
+  /// The grid overview(maxSide) reads (its level's cells), without reading anything.
+  gis::Georef overviewGrid(int maxSide) const;
 
   StreamStats stats() const;
   size_t gpuBytes() const;
@@ -112,6 +114,7 @@ class StreamedElevation {
   };
   StreamedElevation() = default;
   void moveWindow(int level, glm::ivec2 origin);
+  int overviewLevel(int maxSide) const;
   bool inWindow(int level, int px, int py) const;
   int slots() const { return params_.clipSize / params_.pageSize; }
   size_t flagIndex(int level, int px, int py) const;
