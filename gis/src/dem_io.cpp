@@ -329,41 +329,24 @@ Result<GeoTransform> parseGeoTransform(std::string_view text, const std::string&
   return t;
 }
 
-Status writeGeoTiff(const std::string& path, const Raster& raster, const WriteOptions& options) {
-  detail::ensureGdal();
-  const Georef& g = raster.georef;
-  if (g.width <= 0 || g.height <= 0 || raster.values.width != g.width || raster.values.height != g.height) {
-    return fail(path + ": cannot write: raster is " + std::to_string(raster.values.width) + "x" +
-                std::to_string(raster.values.height) + ", georeference says " + std::to_string(g.width) + "x" +
-                std::to_string(g.height));
-  }
-  if (options.blockSize < 16 || options.blockSize > 4096 || (options.blockSize & (options.blockSize - 1))) {
-    return fail(path + ": block size " + std::to_string(options.blockSize) + " is not a power of two in 16..4096");
-  }
-  if (std::isnan(options.nodata)) return fail(path + ": the nodata value written must be a number");
-  // Substitute the nodata value for NaN; a real value equal to it would turn into nodata.
-  Grid<float> out = raster.values;
+namespace {
+
+// `values` with the nodata value for NaN; a real value equal to it would turn into nodata.
+Result<Grid<float>> withNoData(const std::string& path, const Grid<float>& values, float nodata) {
+  Grid<float> out = values;
   for (float& v : out.data) {
     if (std::isnan(v)) {
-      v = options.nodata;
-    } else if (v == options.nodata) {
-      return fail(path + ": cannot write: the value " + std::to_string(options.nodata) +
+      v = nodata;
+    } else if (v == nodata) {
+      return fail(path + ": cannot write: the value " + std::to_string(nodata) +
                   " occurs in the data and is the nodata value");
     }
   }
-  const bool virtualPath = path.rfind("/vsi", 0) == 0;
-  if (!options.overwrite) {
-    VSIStatBufL st;
-    if (VSIStatL(path.c_str(), &st) == 0) return fail(path + ": already exists (not overwritten)");
-  }
-  auto mem = detail::memDataset(g, &out);
-  if (!mem) return fail(path + ": cannot write: " + mem.message());
-  (*mem)->GetRasterBand(1)->SetNoDataValue(options.nodata);
-  for (const auto& [name, value] : options.metadata) (*mem)->SetMetadataItem(name.c_str(), value.c_str());
+  return out;
+}
 
-  GdalErrorCapture errors;
-  GDALDriver* driver = GetGDALDriverManager()->GetDriverByName(options.cog ? "COG" : "GTiff");
-  if (!driver) return fail(path + ": GDAL has no " + std::string(options.cog ? "COG" : "GTiff") + " driver");
+// Creation options of the GeoTIFFs Strata writes (tiled, DEFLATE with the float predictor).
+CPLStringList geoTiffOptions(const WriteOptions& options) {
   const std::string block = std::to_string(options.blockSize);
   CPLStringList co;
   co.SetNameValue("COMPRESS", "DEFLATE");
@@ -378,6 +361,99 @@ Status writeGeoTiff(const std::string& path, const Raster& raster, const WriteOp
     co.SetNameValue("BLOCKYSIZE", block.c_str());
     co.SetNameValue("PREDICTOR", "3");
   }
+  return co;
+}
+
+Status checkBlockSize(const std::string& path, const WriteOptions& options) {
+  if (options.blockSize < 16 || options.blockSize > 4096 || (options.blockSize & (options.blockSize - 1))) {
+    return fail(path + ": block size " + std::to_string(options.blockSize) + " is not a power of two in 16..4096");
+  }
+  if (std::isnan(options.nodata)) return fail(path + ": the nodata value written must be a number");
+  return {};
+}
+
+}  // namespace
+
+Status createGeoTiff(const std::string& path, const Georef& g, const WriteOptions& options) {
+  detail::ensureGdal();
+  if (g.width <= 0 || g.height <= 0) {
+    return fail(path + ": cannot write an empty raster (" + std::to_string(g.width) + "x" + std::to_string(g.height) +
+                ")");
+  }
+  STRATA_TRY_STATUS(checkBlockSize(path, options));
+  if (options.cog) return fail(path + ": a COG cannot be written window by window");
+  GdalErrorCapture errors;
+  GDALDriver* driver = GetGDALDriverManager()->GetDriverByName("GTiff");
+  if (!driver) return fail(path + ": GDAL has no GTiff driver");
+  CPLStringList co = geoTiffOptions(options);
+  co.SetNameValue("SPARSE_OK", "TRUE");  // tiles never written take no space and read as nodata
+  DatasetPtr ds(driver->Create(path.c_str(), g.width, g.height, 1, GDT_Float32, co.List()));
+  if (!ds) return fail(path + ": cannot create GeoTIFF: " + errors.last());
+  double gt[6];
+  for (int i = 0; i < 6; ++i) gt[i] = g.transform.c[i];
+  ds->SetGeoTransform(gt);
+  auto srs = detail::srsOf(g);
+  if (!srs) {
+    ds.reset();
+    VSIUnlink(path.c_str());
+    return fail(path + ": " + srs.message());
+  }
+  ds->SetSpatialRef(&*srs);
+  ds->GetRasterBand(1)->SetNoDataValue(options.nodata);
+  for (const auto& [name, value] : options.metadata) ds->SetMetadataItem(name.c_str(), value.c_str());
+  ds.reset();  // flush and close
+  if (CPLGetLastErrorType() >= CE_Failure) {
+    VSIUnlink(path.c_str());
+    return fail(path + ": cannot create GeoTIFF: " + errors.last());
+  }
+  return {};
+}
+
+Status writeGeoTiffWindow(const std::string& path, int x, int y, const Grid<float>& values, float nodata) {
+  detail::ensureGdal();
+  STRATA_TRY(Grid<float> out, withNoData(path, values, nodata));
+  GdalErrorCapture errors;
+  DatasetPtr ds(GDALDataset::Open(path.c_str(), GDAL_OF_RASTER | GDAL_OF_UPDATE, nullptr, nullptr, nullptr));
+  if (!ds) return fail(path + ": cannot open for writing: " + errors.last());
+  if (x < 0 || y < 0 || values.width <= 0 || values.height <= 0 || x + values.width > ds->GetRasterXSize() ||
+      y + values.height > ds->GetRasterYSize()) {
+    return fail(path + ": the window (" + std::to_string(x) + ", " + std::to_string(y) + ") " +
+                std::to_string(values.width) + "x" + std::to_string(values.height) + " is not inside its " +
+                std::to_string(ds->GetRasterXSize()) + "x" + std::to_string(ds->GetRasterYSize()) + " cells");
+  }
+  if (ds->GetRasterBand(1)->RasterIO(GF_Write, x, y, values.width, values.height, out.data.data(), values.width,
+                                     values.height, GDT_Float32, 0, 0) != CE_None) {
+    return fail(path + ": cannot write a window: " + errors.last());
+  }
+  ds.reset();  // flush and close: the next writer opens it after
+  if (CPLGetLastErrorType() >= CE_Failure) return fail(path + ": cannot write a window: " + errors.last());
+  return {};
+}
+
+Status writeGeoTiff(const std::string& path, const Raster& raster, const WriteOptions& options) {
+  detail::ensureGdal();
+  const Georef& g = raster.georef;
+  if (g.width <= 0 || g.height <= 0 || raster.values.width != g.width || raster.values.height != g.height) {
+    return fail(path + ": cannot write: raster is " + std::to_string(raster.values.width) + "x" +
+                std::to_string(raster.values.height) + ", georeference says " + std::to_string(g.width) + "x" +
+                std::to_string(g.height));
+  }
+  STRATA_TRY_STATUS(checkBlockSize(path, options));
+  STRATA_TRY(Grid<float> out, withNoData(path, raster.values, options.nodata));
+  const bool virtualPath = path.rfind("/vsi", 0) == 0;
+  if (!options.overwrite) {
+    VSIStatBufL st;
+    if (VSIStatL(path.c_str(), &st) == 0) return fail(path + ": already exists (not overwritten)");
+  }
+  auto mem = detail::memDataset(g, &out);
+  if (!mem) return fail(path + ": cannot write: " + mem.message());
+  (*mem)->GetRasterBand(1)->SetNoDataValue(options.nodata);
+  for (const auto& [name, value] : options.metadata) (*mem)->SetMetadataItem(name.c_str(), value.c_str());
+
+  GdalErrorCapture errors;
+  GDALDriver* driver = GetGDALDriverManager()->GetDriverByName(options.cog ? "COG" : "GTiff");
+  if (!driver) return fail(path + ": GDAL has no " + std::string(options.cog ? "COG" : "GTiff") + " driver");
+  const CPLStringList co = geoTiffOptions(options);
   const std::string tmp = path + ".tmp" + std::to_string(::getpid());
   DatasetPtr written(driver->CreateCopy(tmp.c_str(), mem->get(), FALSE, co.List(), nullptr, nullptr));
   if (!written) {

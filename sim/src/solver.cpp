@@ -264,6 +264,29 @@ FloodStats Solver::readFloodStats() const {
   return floodStatsFromCells(keepsFloodStats() ? floodStatsCells() : hostFlood_, grid_.width, grid_.height);
 }
 
+std::vector<gis::CellRect> Solver::localRects() const { return {{0, 0, grid_.width, grid_.height}}; }
+
+CellBlock Solver::readLocal(const gis::CellRect& rect, unsigned parts) const {
+  return readBlock(rect.x, rect.y, rect.width, rect.height, parts);
+}
+
+FloodStats Solver::readLocalFloodStats(const gis::CellRect& rect) const {
+  const FloodStats all = readFloodStats();
+  if (rect.x == 0 && rect.y == 0 && rect.width == grid_.width && rect.height == grid_.height) return all;
+  return cropFloodStats(all, rect);
+}
+
+FloodStats cropFloodStats(const FloodStats& f, const gis::CellRect& r) {
+  auto crop = [&](const gis::Grid<float>& g) {
+    gis::Grid<float> out(r.width, r.height);
+    for (int y = 0; y < r.height; ++y) {
+      std::copy_n(&g.at(r.x, r.y + y), size_t(r.width), &out.at(0, y));
+    }
+    return out;
+  };
+  return {crop(f.maxDepthM), crop(f.maxSpeedMS), crop(f.arrivalS), crop(f.wetDurationS)};
+}
+
 // The same per-cell update as the backends' own (e.g. sim/shaders/flood_stats.comp), on the host.
 void Solver::updateHostFloodStats() {
   const auto h = readWaterDepth();

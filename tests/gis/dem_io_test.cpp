@@ -272,6 +272,77 @@ TEST(DemIo, WrittenGeoTiffReadsBackInGdalinfo) {
   EXPECT_TRUE(a.IsSame(&b)) << moonBack->georef.crsWkt;
 }
 
+// A GeoTIFF written window by window (what each MPI rank does with its blocks of a map) holds
+// the same cells, CRS and geotransform as one written whole; cells no window wrote read as
+// nodata; a window outside the raster or holding the nodata value is refused, naming the file.
+TEST(DemIo, GeoTiffWrittenByWindowsEqualsOneWrittenWhole) {
+  const auto dir = strata::test::tempDir("windows");
+  ReadOptions o;
+  o.window = CellRect{100, 50, 150, 90};
+  auto src = readDem(test::dataFile("grand_canyon/grandcanyon_srtm_3857.tif"), o);
+  ASSERT_TRUE(src.ok()) << src.message();
+  src->values.at(7, 9) = kNoData;
+  WriteOptions w;
+  w.blockSize = 64;  // windows below cut tiles, so some tiles are written by two windows
+  w.metadata = {{"STRATA_TEST", "windows"}};
+  const std::string whole = (dir / "whole.tif").string(), parts = (dir / "parts.tif").string();
+  ASSERT_TRUE(writeGeoTiff(whole, *src, w).ok());
+  ASSERT_TRUE(createGeoTiff(parts, src->georef, w).ok());
+  auto window = [&](int x, int y, int width, int height) {
+    Grid<float> g(width, height);
+    for (int r = 0; r < height; ++r) {
+      for (int c = 0; c < width; ++c) g.at(c, r) = src->values.at(x + c, y + r);
+    }
+    return g;
+  };
+  // Three of four quadrants, in an order that revisits tiles.
+  ASSERT_TRUE(writeGeoTiffWindow(parts, 70, 40, window(70, 40, 80, 50)).ok());
+  ASSERT_TRUE(writeGeoTiffWindow(parts, 0, 0, window(0, 0, 70, 40)).ok());
+  ASSERT_TRUE(writeGeoTiffWindow(parts, 70, 0, window(70, 0, 80, 40)).ok());
+  auto partial = readDem(parts, [] {
+    ReadOptions r;
+    r.allowAllNoData = true;
+    return r;
+  }());
+  ASSERT_TRUE(partial.ok()) << partial.message();
+  for (int y = 0; y < 90; ++y) {
+    for (int x = 0; x < 150; ++x) {
+      const float a = src->values.at(x, y), b = partial->values.at(x, y);
+      if (x < 70 && y >= 40) {
+        ASSERT_TRUE(std::isnan(b)) << x << ", " << y << ": never written, reads " << b;
+      } else {
+        ASSERT_TRUE(a == b || (std::isnan(a) && std::isnan(b))) << x << ", " << y;
+      }
+    }
+  }
+  ASSERT_TRUE(writeGeoTiffWindow(parts, 0, 40, window(0, 40, 70, 50)).ok());
+  const CPLJSONObject a = gdalinfoJson(whole), b = gdalinfoJson(parts);
+  EXPECT_EQ(gdalEpsg(b), 3857);
+  for (int i = 0; i < 6; ++i)
+    EXPECT_EQ(a.GetArray("geoTransform")[i].ToDouble(), b.GetArray("geoTransform")[i].ToDouble());
+  EXPECT_EQ(b.GetString("metadata/IMAGE_STRUCTURE/COMPRESSION"), "DEFLATE");
+  EXPECT_EQ(b.GetArray("bands")[0].GetDouble("noDataValue"), -32768.0);
+  EXPECT_NE(runCommand({"gdalinfo", parts}).out.find("STRATA_TEST=windows"), std::string::npos);
+  auto x = readDem(whole), y = readDem(parts);
+  ASSERT_TRUE(x.ok() && y.ok());
+  for (size_t i = 0; i < x->values.size(); ++i) {
+    const float p = x->values.data[i], q = y->values.data[i];
+    ASSERT_TRUE(p == q || (std::isnan(p) && std::isnan(q))) << i;
+  }
+  auto outside = writeGeoTiffWindow(parts, 100, 50, window(0, 0, 60, 41));
+  ASSERT_FALSE(outside.ok());
+  EXPECT_NE(outside.message().find(parts + ": the window (100, 50) 60x41 is not inside its 150x90 cells"),
+            std::string::npos)
+      << outside.message();
+  Grid<float> clash(2, 2, 1.0f);
+  clash.at(1, 0) = -32768.0f;
+  auto refused = writeGeoTiffWindow(parts, 0, 0, clash);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_NE(refused.message().find(parts + ": cannot write: the value -32768"), std::string::npos);
+  auto missing = writeGeoTiffWindow((dir / "none.tif").string(), 0, 0, Grid<float>(2, 2, 1.0f));
+  EXPECT_FALSE(missing.ok());
+}
+
 TEST(DemIo, WriteRefusesAValueEqualToNodata) {
   Raster r;
   r.georef.width = r.georef.height = 2;

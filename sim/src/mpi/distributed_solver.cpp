@@ -8,14 +8,13 @@
 
 #include <strata/sim/state_codec.hpp>
 
+#include <strata/sim/exact_sum.hpp>
 #include "decomposition.hpp"
-#include "exact_sum.hpp"
 #include "tile_common.hpp"
 
 namespace strata::sim {
 
 using detail::BlockGrid;
-using detail::ExactSum;
 using detail::HaloPiece;
 
 namespace {
@@ -121,8 +120,6 @@ Status collectiveStatus(const Status& local, MPI_Comm comm) {
   return fail(first == 0 ? msg : "rank " + std::to_string(first) + ": " + msg);
 }
 
-namespace detail {
-
 void allreduceExact(ExactSum* sums, int n, MPI_Comm comm) {
   MPI_Datatype type;
   MPI_Type_contiguous(int(sizeof(ExactSum)), MPI_BYTE, &type);
@@ -139,8 +136,6 @@ void allreduceExact(ExactSum* sums, int n, MPI_Comm comm) {
   MPI_Op_free(&op);
   MPI_Type_free(&type);
 }
-
-}  // namespace detail
 
 // -------------------------------------------------------------------------------------------------
 
@@ -200,6 +195,7 @@ struct DistributedSolver::Impl {
   Block& block(int id) { return blocks[size_t(localIndex[size_t(id)])]; }
   const Block& block(int id) const { return blocks[size_t(localIndex[size_t(id)])]; }
   bool mine(int id) const { return localIndex[size_t(id)] >= 0; }
+  const Block& holding(const CellRect& rect) const;
 
   SimParams blockParams(const SimParams& p, const CellRect& e) const {
     SimParams sp = p;
@@ -597,25 +593,36 @@ int DistributedSolver::blockCount() const { return impl_->grid.count(); }
 const std::vector<int>& DistributedSolver::owners() const { return impl_->owner; }
 const DistributedCounters& DistributedSolver::counters() const { return impl_->counters; }
 
-std::vector<CellRect> DistributedSolver::localBlocks() const {
+std::vector<CellRect> DistributedSolver::localRects() const {
   std::vector<CellRect> out;
   for (const auto& b : impl_->blocks) out.push_back(b.interior);
   return out;
 }
 
-CellBlock DistributedSolver::readLocalBlock(const CellRect& rect, unsigned parts) const {
-  for (const auto& b : impl_->blocks) {
-    if (intersect(rect, b.interior).width == rect.width && intersect(rect, b.interior).height == rect.height) {
-      const CellRect l = b.local(rect);
-      CellBlock out = b.solver->readBlock(l.x, l.y, l.width, l.height, parts);
-      out.x0 = rect.x;
-      out.y0 = rect.y;
-      return out;
-    }
+// The block of this rank whose interior holds `rect` (an internal check: the caller asks only
+// for rectangles of localRects()).
+const DistributedSolver::Impl::Block& DistributedSolver::Impl::holding(const CellRect& rect) const {
+  for (const auto& b : blocks) {
+    const CellRect in = intersect(rect, b.interior);
+    if (in.width == rect.width && in.height == rect.height) return b;
   }
-  STRATA_CHECK(false) << "readLocalBlock: (" << rect.x << ", " << rect.y << ") " << rect.width << "x" << rect.height
+  STRATA_CHECK(false) << "(" << rect.x << ", " << rect.y << ") " << rect.width << "x" << rect.height
                       << " is not inside one of this rank's blocks";
-  return {};
+  return blocks.front();
+}
+
+CellBlock DistributedSolver::readLocal(const CellRect& rect, unsigned parts) const {
+  const auto& b = impl_->holding(rect);
+  const CellRect l = b.local(rect);
+  CellBlock out = b.solver->readBlock(l.x, l.y, l.width, l.height, parts);
+  out.x0 = rect.x;
+  out.y0 = rect.y;
+  return out;
+}
+
+FloodStats DistributedSolver::readLocalFloodStats(const CellRect& rect) const {
+  const auto& b = impl_->holding(rect);
+  return cropFloodStats(b.solver->readFloodStats(), b.local(rect));
 }
 
 void DistributedSolver::forEachPart(const std::function<void(Solver&)>& f) {
@@ -657,7 +664,7 @@ Solver::RainTotals DistributedSolver::rainTotals() const {
   }
   RainTotals r;
   MPI_Allreduce(&maxRaster, &r.maxRasterMmH, 1, MPI_DOUBLE, MPI_MAX, impl_->comm);
-  detail::allreduceExact(&volume, 1, impl_->comm);
+  allreduceExact(&volume, 1, impl_->comm);
   r.volumeM3S = volume.value() / 3.6e6;
   return r;
 }
@@ -823,7 +830,7 @@ SimStats DistributedSolver::stats() const {
       maxDepth = std::max(maxDepth, st[0]);
     }
   }
-  detail::allreduceExact(sums, 8, m.comm);
+  allreduceExact(sums, 8, m.comm);
   float globalMax = 0;
   MPI_Allreduce(&maxDepth, &globalMax, 1, MPI_FLOAT, MPI_MAX, m.comm);
   SimStats s = counterStats();

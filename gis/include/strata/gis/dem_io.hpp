@@ -117,4 +117,14 @@ struct WriteOptions {
 /// With `overwrite` false the temporary is linked into place (fails if `path` exists) instead.
 Status writeGeoTiff(const std::string& path, const Raster& raster, const WriteOptions& options = {});
 
+/// A float32 GeoTIFF written window by window, by one process or by several in turn (each rank of
+/// a run over MPI writes its own blocks; docs/distributed.md): createGeoTiff makes `path` (a
+/// temporary, committed by the caller) with `georef`'s size, CRS and geotransform and no cells
+/// written (sparse tiles: every cell reads as nodata until written); writeGeoTiffWindow then
+/// writes `values` at cell (x, y), opening and closing the file each time (one writer at a time).
+/// Same encoding as writeGeoTiff (DEFLATE, float predictor, tiles of `options.blockSize`; `cog`
+/// is not available: a COG's overviews need the whole raster).
+Status createGeoTiff(const std::string& path, const Georef& georef, const WriteOptions& options = {});
+Status writeGeoTiffWindow(const std::string& path, int x, int y, const Grid<float>& values, float nodata = -32768.0f);
+
 }  // namespace strata::gis

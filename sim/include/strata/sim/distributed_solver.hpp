@@ -115,10 +115,10 @@ class DistributedSolver final : public Solver {
   int rank() const;   ///< local
   int ranks() const;  ///< local
   int blockCount() const;
-  /// This rank's blocks: their interiors (global cells), e.g. to write outputs per rank (local).
-  std::vector<CellRect> localBlocks() const;
-  /// `parts` of a rectangle inside one of localBlocks() (global cells; local, not collective).
-  CellBlock readLocalBlock(const CellRect& rect, unsigned parts) const;
+  /// This rank's blocks: their interiors (global cells), what outputs are written from per rank.
+  std::vector<CellRect> localRects() const override;
+  CellBlock readLocal(const CellRect& rect, unsigned parts) const override;
+  FloodStats readLocalFloodStats(const CellRect& rect) const override;
   /// The rank of every block (local: every rank holds the same).
   const std::vector<int>& owners() const;
   const DistributedCounters& counters() const;  ///< local

@@ -181,6 +181,15 @@ class Solver {
   /// The statistics so far (no depth, no speed, never arrived, never wet if never enabled).
   virtual FloodStats readFloodStats() const;
 
+  // What this process holds of the grid, read without gathering: a solver over MPI ranks holds
+  // only its rank's blocks, and outputs are written per rank from these (local, not collective).
+  /// The rectangles of cells this process holds: the whole grid, or its rank's blocks.
+  virtual std::vector<gis::CellRect> localRects() const;
+  /// `parts` of a rectangle inside one of localRects() (global cells).
+  virtual CellBlock readLocal(const gis::CellRect& rect, unsigned parts) const;
+  /// The flood statistics of a rectangle inside one of localRects().
+  virtual FloodStats readLocalFloodStats(const gis::CellRect& rect) const;
+
   /// The state to continue from later (a checkpoint).
   SolverState saveState() const;
   /// Continues from a saved state of a solver of the same grid and parameters (set the
@@ -310,5 +319,7 @@ bool blockFits(const CellBlock& block, int width, int height, int layers);
 /// and its 4-per-cell form.
 std::vector<float> initialFloodStatsCells(size_t cells);
 FloodStats floodStatsFromCells(const std::vector<float>& cells, int width, int height);
+/// The part of `stats` (of a grid) inside `rect` (inside that grid).
+FloodStats cropFloodStats(const FloodStats& stats, const gis::CellRect& rect);
 
 }  // namespace strata::sim

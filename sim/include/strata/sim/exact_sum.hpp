@@ -10,7 +10,7 @@
 #include <cstdint>
 #include <limits>
 
-namespace strata::sim::detail {
+namespace strata::sim {
 
 __extension__ typedef __int128 Int128;
 
@@ -38,4 +38,4 @@ static_assert(sizeof(ExactSum) == 32);
 /// Allreduce of `n` ExactSums in place over `comm` (collective).
 void allreduceExact(ExactSum* sums, int n, MPI_Comm comm);
 
-}  // namespace strata::sim::detail
+}  // namespace strata::sim
