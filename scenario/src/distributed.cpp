@@ -105,10 +105,37 @@ std::pair<long long, long long> Ranks::minMax(long long value) const {
 
 bool Ranks::all(bool value) const { return minMax(value ? 1 : 0).first == 1; }
 
+void Ranks::sum(std::vector<sim::ExactSum>& sums) const {
+  if (distributed_) sim::allreduceExact(sums.data(), int(sums.size()), MPI_COMM_WORLD);
+}
+
+std::vector<double> Ranks::allGather(const std::vector<double>& values) const {
+  if (!distributed_) return values;
+  std::vector<double> all(values.size() * size_t(size_));
+  MPI_Allgather(values.data(), int(values.size()), MPI_DOUBLE, all.data(), int(values.size()), MPI_DOUBLE,
+                MPI_COMM_WORLD);
+  return all;
+}
+
+// A georeference's fields in order, for a ByteWriter (G = const Georef) or a ByteReader.
+template <class IO, class G>
+void georefFields(IO& io, G& g) {
+  io.str(g.crsWkt);
+  io.str(g.crsName);
+  io.pod(g.geographic);
+  io.pod(g.transform.c);
+  io.pod(g.width);
+  io.pod(g.height);
+  io.str(g.body.name);
+  io.pod(g.body.semiMajorM);
+  io.pod(g.body.flattening);
+  io.str(g.verticalUnit);
+}
+
 std::string encodeDomainShape(const ScenarioDomain& d) {
   ByteWriter w;
-  w.pod(int32_t(d.bed.georef.width));
-  w.pod(int32_t(d.bed.georef.height));
+  georefFields(w, d.bed.georef);
+  w.pod(int32_t(d.bed.georef.epsg.value_or(-1)));
   w.pod(d.params);
   w.vec(d.input.rowDxM);
   w.pod(d.input.dyM);
@@ -136,11 +163,10 @@ std::string encodeDomainShape(const ScenarioDomain& d) {
 Result<ScenarioDomain> decodeDomainShape(std::string_view bytes) {
   ByteReader r{bytes};
   ScenarioDomain d;
-  int32_t width = 0, height = 0;
-  r.pod(width);
-  r.pod(height);
-  d.bed.georef.width = width;
-  d.bed.georef.height = height;
+  georefFields(r, d.bed.georef);
+  int32_t epsg = -1;
+  r.pod(epsg);
+  if (epsg >= 0) d.bed.georef.epsg = epsg;
   r.pod(d.params);
   r.vec(d.input.rowDxM);
   r.pod(d.input.dyM);

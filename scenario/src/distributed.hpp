@@ -15,6 +15,7 @@
 
 #include <strata/core/result.hpp>
 #include <strata/scenario/domain.hpp>
+#include <strata/sim/exact_sum.hpp>
 #include <strata/sim/region.hpp>
 
 namespace strata::scenario::detail {
@@ -42,6 +43,10 @@ class Ranks {
   std::pair<long long, long long> minMax(long long value) const;
   /// Collective: whether `value` holds on every rank.
   bool all(bool value) const;
+  /// Collective: `sums` added over the ranks, in place (exact: the same on any number of ranks).
+  void sum(std::vector<sim::ExactSum>& sums) const;
+  /// Collective: every rank's `values` (the same count on each), in rank order, on every rank.
+  std::vector<double> allGather(const std::vector<double>& values) const;
 
  private:
   bool distributed_ = false;

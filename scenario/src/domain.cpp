@@ -324,18 +324,21 @@ Result<RegionFrame> regionWindow(const Scenario& s, const TerrainSource& source,
 // Bytes a run holds per cell at its peak with `layers` material layers: the CPU backend's buffers
 // (nine 4-vectors: state, next state, Heun stage, pipe fluxes and diagonals, x and y face fluxes,
 // thermal flows, flood statistics; 8 accumulators; base, bed, tilt, outflow limit, rain; a float
-// per layer), the domain (bed, mask, area in double, base, layers, water, rain), what the run
-// reads back at each interval (depth, flood statistics, layers, terrain change), and the
-// checkpoint (the saved state, and its encoding beside it). Over `ranks` MPI ranks the lead (the
-// heaviest) holds the whole domain and the gathered read-backs, and a 1/ranks share of the solver
-// and checkpoint (its blocks' halos add ~10% at the default block sizes).
+// per layer), the checkpoint (the saved state, and its encoding beside it), what the outputs read
+// back at each interval (detail::readPieces: the state block, depth, flood statistics, mask, the
+// model input's window, in erosion runs suspended sediment and the layers now and at the start),
+// the domain (bed, mask, area in double, base, layers, water, rain) and the depth gathered for
+// pictures (with the surface and top four layers in erosion runs). Over `ranks` MPI ranks each
+// rank holds a 1/ranks share of the first three (its blocks' halos add ~10% at the default block
+// sizes); the lead, the heaviest, also holds the whole domain and the pictures' gather.
 double bytesPerCell(int layers, int ranks) {
   const double solver = 4.0 * (9 * 4 + 8 + 5 + layers);
-  const double domain = 4 + 1 + 8 + 4 + 4.0 * layers + 4 + 4;
-  const double readBack = 4 + 16 + 4.0 * layers + 8;
   const double checkpoint = 2 * 4.0 * (4 + 4 + 4 + 8 + 4 + layers);
+  const double readBack = 16 + 4 + 16 + 1 + 4.0 * (3 + layers) + 4 + 8.0 * layers;
+  const double domain = 4 + 1 + 8 + 4 + 4.0 * layers + 4 + 4;
+  const double pictures = 4 + 4 + 16;
   const double share = ranks > 1 ? 1.1 / ranks : 1.0;
-  return (solver + checkpoint) * share + domain + readBack;
+  return (solver + checkpoint + readBack) * share + domain + pictures;
 }
 
 // The key a message about the region's size names: cell_size when given, else the region, else

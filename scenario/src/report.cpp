@@ -40,22 +40,6 @@ std::string where(const gis::Georef& g, int x, int y) {
          (lon >= 0 ? " E" : " W");
 }
 
-struct Extreme {
-  double value = -1;
-  int x = 0, y = 0;
-};
-
-Extreme maxOf(const gis::Grid<float>& g, const gis::Grid<uint8_t>& inside) {
-  Extreme e;
-  for (int y = 0; y < g.height; ++y) {
-    for (int x = 0; x < g.width; ++x) {
-      const float v = g.at(x, y);
-      if (inside.at(x, y) && std::isfinite(v) && v > e.value) e = {double(v), x, y};
-    }
-  }
-  return e;
-}
-
 // Runs an embedded plotting script with Debian's Python (where python3-matplotlib is): the
 // script on standard input, the paths as arguments (no shell: any file name works).
 Status runPlotScript(const std::string& script, const std::vector<std::string>& args) {
@@ -242,12 +226,7 @@ Status writeReport(const fs::path& runDir, const ReportInput& in) {
     const auto peakA = *std::max_element(sum.series.begin(), sum.series.end(), [](const auto& a, const auto& b) {
       return a.floodedAreaKm2 < b.floodedAreaKm2;
     });
-    const auto deep = maxOf(in.flood.maxDepthM, d.inside);
-    const auto fast = maxOf(in.flood.maxSpeedMS, d.inside);
-    double everWet = 0;
-    for (size_t i = 0; i < in.flood.maxDepthM.size(); ++i) {
-      if (d.inside.data[i] && in.flood.maxDepthM.data[i] > s.outputs.wetThresholdM) everWet += d.cellAreaM2.data[i];
-    }
+    const auto& f = in.flood;
     const double supplied = last.inflowM3 + last.rainM3 + d.damBreakVolumeM3 + sum.spinUp.storedM3;
     md += "| quantity | value |\n|---|---|\n";
     md +=
@@ -259,30 +238,14 @@ Status writeReport(const fs::path& runDir, const ReportInput& in) {
     md += "| most water in the region | " + millions(peakW.waterM3) + " at " + hours(peakW.timeS) + " |\n";
     md += "| largest flooded area | " + fmt("%.1f", peakA.floodedAreaKm2) + " km² at " + hours(peakA.timeS) + " (" +
           fmt("%.1f", 100 * peakA.floodedAreaKm2 * 1e6 / d.totalAreaM2) + "% of the region) |\n";
-    md += "| area flooded at some time | " + fmt("%.1f", everWet / 1e6) + " km² |\n";
-    md += "| deepest water | " + fmt("%.1f", deep.value) + " m at " + where(g, deep.x, deep.y) + " |\n";
-    md += "| fastest water | " + fmt("%.1f", fast.value) + " m/s at " + where(g, fast.x, fast.y) + " |\n";
+    md += "| area flooded at some time | " + fmt("%.1f", f.everWetM2 / 1e6) + " km² |\n";
+    md += "| deepest water | " + fmt("%.1f", f.deepest.value) + " m at " + where(g, f.deepest.x, f.deepest.y) + " |\n";
+    md +=
+        "| fastest water | " + fmt("%.1f", f.fastest.value) + " m/s at " + where(g, f.fastest.x, f.fastest.y) + " |\n";
     if (!d.sources.empty()) {
-      // How far the water got: the wet cell farthest (geodesic) from the first inflow.
-      const auto& c0 = d.sources.front().cells.front();
-      auto from = gis::pixelToLonLat(g, c0.first + 0.5, c0.second + 0.5);
-      double farM = 0;
-      int fx = c0.first, fy = c0.second;
-      for (int y = 0; from && y < g.height; ++y) {
-        for (int x = 0; x < g.width; ++x) {
-          if (!(in.flood.maxDepthM.at(x, y) > s.outputs.wetThresholdM)) continue;
-          auto to = gis::pixelToLonLat(g, x + 0.5, y + 0.5);
-          const double m = to ? gis::geodesicDistanceM(*from, *to, g.body) : 0;
-          if (m > farM) {
-            farM = m;
-            fx = x;
-            fy = y;
-          }
-        }
-      }
-      const double arrival = in.flood.arrivalS.at(fx, fy);
-      md += "| farthest reach | " + fmt("%.1f", farM / 1e3) + " km (straight line) from \"" + d.sourceNames.front() +
-            "\", at " + where(g, fx, fy) + (arrival >= 0 ? ", reached at " + hours(arrival) : "") + " |\n";
+      md += "| farthest reach | " + fmt("%.1f", std::max(0.0, f.farthest.value) / 1e3) + " km (straight line) from \"" +
+            d.sourceNames.front() + "\", at " + where(g, f.farthest.x, f.farthest.y) +
+            (f.farthestArrivalS >= 0 ? ", reached at " + hours(f.farthestArrivalS) : "") + " |\n";
     }
     md += "| water that left through the edges | " + millions(last.outflowM3) +
           (supplied > 0 ? " (" + fmt("%.0f", 100 * last.outflowM3 / supplied) + "% of what entered" +

@@ -15,6 +15,7 @@
 #include <strata/core/log.hpp>
 #include <strata/core/progress.hpp>
 #include <strata/gis/dem_io.hpp>
+#include <strata/gis/geodesy.hpp>
 #include <strata/gl/context.hpp>
 #include <strata/render/image_io.hpp>
 #include <strata/render/terrain_renderer.hpp>
@@ -26,6 +27,7 @@
 
 #include "checkpoint.hpp"
 #include "distributed.hpp"
+#include "pieces.hpp"
 
 namespace strata::scenario {
 namespace fs = std::filesystem;
@@ -39,15 +41,13 @@ std::string slurp(const fs::path& p) {
   return s.str();
 }
 
-// Total material thickness per cell (m), for terrain change (empty without layers: a rank other
-// than the lead reads no grids).
-gis::Grid<float> materialThickness(const std::vector<gis::Grid<float>>& layers) {
-  if (layers.empty() || layers.front().size() == 0) return {};
-  gis::Grid<float> t(layers.front().width, layers.front().height, 0.0f);
-  for (const auto& l : layers) {
-    for (size_t i = 0; i < t.size(); ++i) t.data[i] += l.data[i];
-  }
-  return t;
+// The net change of material thickness at cell i of a piece (m): the layers summed in float,
+// bottom first, now less at the start.
+float materialChange(const detail::Piece& p, size_t i) {
+  float now = 0, before = 0;
+  for (const auto& l : p.layers) now += l.data[i];
+  for (const auto& l : p.initialLayers) before += l.data[i];
+  return now - before;
 }
 
 // The layer_thickness map of layer k (1 = the bottom one).
@@ -312,12 +312,15 @@ int exposedLayer(int layers, Thickness&& thickness) {
 class Run {
  public:
   Run(const Scenario& s, const RunOptions& opt, const Ranks& ranks, ScenarioDomain d, Engine e)
-      : s_(s),
-        opt_(opt),
-        ranks_(ranks),
-        d_(std::move(d)),
-        e_(std::move(e)),
-        initialMaterial_(materialThickness(solver().readLayers())) {}
+      : s_(s), opt_(opt), ranks_(ranks), d_(std::move(d)), e_(std::move(e)) {
+    if (ranks_.distributed()) {
+      input_ = detail::modelInputSource(opt_.outDir, d_).read;
+    } else {
+      input_ = [this](const gis::CellRect& r) { return sim::cutRegion(d_.input, r); };
+    }
+  }
+  Run(const Run&) = delete;  // input_ holds `this`
+  Run& operator=(const Run&) = delete;
 
   sim::Solver& solver() { return *e_.solver; }
   /// The solver when it runs over MPI ranks (else null).
@@ -419,8 +422,14 @@ class Run {
   /// The step W10 chose last (before any shortening to land on an output time or a rain edge).
   double chosenDtS() const { return chosenDtS_; }
 
-  // The series row of the interval that just ended.
-  SeriesRow row(const gis::Grid<float>& depth) {
+  /// This process's pieces of the state (local: nothing is gathered).
+  Result<std::vector<detail::Piece>> pieces() const {
+    return detail::readPieces(*e_.solver, input_, s_.erosion.enabled);
+  }
+
+  // The series row of the interval that just ended (collective: the areas and volumes are exact
+  // sums over the ranks, over the model's cell areas).
+  SeriesRow row(const std::vector<detail::Piece>& pieces) {
     const auto st = solver().stats();
     SeriesRow r;
     r.timeS = st.timeS;
@@ -437,69 +446,65 @@ class Run {
     const double supplied = st.initialWaterM3 + st.rainM3 + st.inflowM3;
     r.balanceErrorRel = supplied > 0 ? st.waterBalanceM3() / supplied : 0.0;
     r.maxDepthM = st.maxDepthM;
-    double area = 0;
-    for (size_t i = 0; i < depth.size(); ++i) {
-      if (d_.inside.data[i] && depth.data[i] > s_.outputs.wetThresholdM) area += d_.cellAreaM2.data[i];
-    }
-    r.floodedAreaKm2 = area / 1e6;
-    r.sedimentM3 = st.suspendedM3;
-    if (s_.erosion.enabled) {
-      change_ = materialThickness(solver().readLayers());
-      for (size_t i = 0; i < change_.size(); ++i) {
-        change_.data[i] -= initialMaterial_.data[i];
-        const double v = double(change_.data[i]) * d_.cellAreaM2.data[i];
-        (v < 0 ? r.erodedM3 : r.depositedM3) += std::abs(v);
+    std::vector<sim::ExactSum> sums(3);  // flooded area, eroded, deposited
+    forEachCell(pieces, [&](const detail::Piece& p, size_t i, int, int, double area) {
+      if (p.inside.data[i] && p.depth.data[i] > s_.outputs.wetThresholdM) sums[0].add(area);
+      if (s_.erosion.enabled) {
+        const double v = double(materialChange(p, i)) * area;
+        sums[v < 0 ? 1 : 2].add(std::abs(v));
       }
-    }
+    });
+    ranks_.sum(sums);
+    r.floodedAreaKm2 = sums[0].value() / 1e6;
+    r.sedimentM3 = st.suspendedM3;
+    r.erodedM3 = sums[1].value();
+    r.depositedM3 = sums[2].value();
     return r;
   }
 
-  // The maps the scenario asks for, as GeoTIFFs in the region's CRS.
-  // Collective: every rank reads, the lead writes.
-  Status writeMaps(const gis::Grid<float>& depth) {
-    const auto flood = solver().readFloodStats();
-    std::vector<gis::Grid<float>> layers;
-    gis::Grid<float> suspended;
-    if (s_.erosion.enabled) {
-      layers = solver().readLayers();
-      suspended = solver().readSuspended();
-    }
-    if (!ranks_.lead()) return {};
-    auto writeMap = [&](const std::string& name, const gis::Grid<float>& values, bool wetOnly,
+  // The maps the scenario asks for, as GeoTIFFs in the region's CRS (collective: each rank
+  // writes its pieces).
+  Status writeMaps(const std::vector<detail::Piece>& pieces) {
+    const auto& maps = s_.outputs.maps;
+    const bool layerMaps = std::find(maps.begin(), maps.end(), "layer_thickness") != maps.end();
+    // `values` of a piece, no data outside the region and, `wetOnly`, where it never was wet.
+    auto writeMap = [&](const std::string& file, bool asked, bool wetOnly,
+                        const std::function<gis::Grid<float>(const detail::Piece&)>& values,
                         const std::vector<std::pair<std::string, std::string>>& metadata = {}) -> Status {
-      if (std::find(s_.outputs.maps.begin(), s_.outputs.maps.end(), name) == s_.outputs.maps.end()) return {};
-      gis::Raster r{d_.bed.georef, values};
-      for (size_t i = 0; i < r.values.size(); ++i) {
-        if (!d_.inside.data[i] || (wetOnly && !(flood.maxDepthM.data[i] > s_.outputs.wetThresholdM))) {
-          r.values.data[i] = gis::kNoData;
-        }
-      }
+      if (!asked) return {};
       gis::WriteOptions o;
       o.metadata = metadata;
-      return gis::writeGeoTiff((opt_.outDir / ("maps/" + name + ".tif")).string(), r, o);
+      return detail::writeMapFile(ranks_, opt_.outDir / file, d_.bed.georef, o, pieces, [&](const detail::Piece& p) {
+        gis::Grid<float> g = values(p);
+        for (size_t i = 0; i < g.size(); ++i) {
+          if (!p.inside.data[i] || (wetOnly && !(p.flood.maxDepthM.data[i] > s_.outputs.wetThresholdM))) {
+            g.data[i] = gis::kNoData;
+          }
+        }
+        return g;
+      });
     };
-    STRATA_TRY_STATUS(writeMap("max_depth", flood.maxDepthM, false));
-    STRATA_TRY_STATUS(writeMap("max_speed", flood.maxSpeedMS, false));
-    STRATA_TRY_STATUS(writeMap("arrival_time", flood.arrivalS, true));
-    STRATA_TRY_STATUS(writeMap("inundation_duration", flood.wetDurationS, false));
-    STRATA_TRY_STATUS(writeMap("final_depth", depth, false));
-    if (s_.erosion.enabled) STRATA_TRY_STATUS(writeErosionMaps(writeMap, layers, suspended));
-    return {};
-  }
-
-  // terrain_change (net cut and fill, m), exposed_material (exposedLayer: bottom = 0; none: no
-  // data), suspended_sediment (m of material in the water) and
-  // layer_thickness (maps/layer_K.tif, K = 1 the bottom layer, each naming its material).
-  template <class WriteMap>
-  Status writeErosionMaps(WriteMap&& writeMap, const std::vector<gis::Grid<float>>& layers,
-                          const gis::Grid<float>& suspended) {
-    STRATA_TRY_STATUS(writeMap("terrain_change", change_, false));
-    const int L = int(layers.size());
-    gis::Grid<float> top(layers.front().width, layers.front().height, gis::kNoData);
-    for (size_t i = 0; i < top.size(); ++i) {
-      const int l = exposedLayer(L, [&](int k) { return layers[size_t(k)].data[i]; });
-      if (l >= 0) top.data[i] = float(l);
-    }
+    auto map = [&](const std::string& name, bool wetOnly,
+                   const std::function<gis::Grid<float>(const detail::Piece&)>& values,
+                   const std::vector<std::pair<std::string, std::string>>& metadata = {}) {
+      return writeMap("maps/" + name + ".tif", std::find(maps.begin(), maps.end(), name) != maps.end(), wetOnly, values,
+                      metadata);
+    };
+    STRATA_TRY_STATUS(map("max_depth", false, [](const detail::Piece& p) { return p.flood.maxDepthM; }));
+    STRATA_TRY_STATUS(map("max_speed", false, [](const detail::Piece& p) { return p.flood.maxSpeedMS; }));
+    STRATA_TRY_STATUS(map("arrival_time", true, [](const detail::Piece& p) { return p.flood.arrivalS; }));
+    STRATA_TRY_STATUS(map("inundation_duration", false, [](const detail::Piece& p) { return p.flood.wetDurationS; }));
+    STRATA_TRY_STATUS(map("final_depth", false, [](const detail::Piece& p) { return p.depth; }));
+    if (!s_.erosion.enabled) return {};
+    // terrain_change (net cut and fill, m), exposed_material (exposedLayer: bottom = 0; none: no
+    // data), suspended_sediment (m of material in the water) and layer_thickness
+    // (maps/layer_K.tif, K = 1 the bottom layer, each naming its material).
+    STRATA_TRY_STATUS(map("terrain_change", false, [](const detail::Piece& p) {
+      gis::Grid<float> g(p.rect.width, p.rect.height);
+      for (size_t i = 0; i < g.size(); ++i) g.data[i] = materialChange(p, i);
+      return g;
+    }));
+    const int L = int(d_.input.materials.size());
     // Each value's material and colour (STRATA_MATERIAL_k, STRATA_COLOUR_k "r,g,b"): GIS tools
     // list them, and the plot draws its legend from them.
     std::vector<std::pair<std::string, std::string>> legend;
@@ -510,58 +515,101 @@ class Run {
       legend.push_back({"STRATA_MATERIAL_" + std::to_string(l), m.name});
       legend.push_back({"STRATA_COLOUR_" + std::to_string(l), rgb});
     }
-    STRATA_TRY_STATUS(writeMap("exposed_material", top, false, legend));
-    STRATA_TRY_STATUS(writeMap("suspended_sediment", suspended, false));
-    if (std::find(s_.outputs.maps.begin(), s_.outputs.maps.end(), "layer_thickness") == s_.outputs.maps.end()) {
-      return {};
-    }
+    STRATA_TRY_STATUS(map(
+        "exposed_material", false,
+        [L](const detail::Piece& p) {
+          gis::Grid<float> top(p.rect.width, p.rect.height, gis::kNoData);
+          for (size_t i = 0; i < top.size(); ++i) {
+            const int l = exposedLayer(L, [&](int k) { return p.layers[size_t(k)].data[i]; });
+            if (l >= 0) top.data[i] = float(l);
+          }
+          return top;
+        },
+        legend));
+    STRATA_TRY_STATUS(map("suspended_sediment", false, [](const detail::Piece& p) { return p.suspended; }));
     for (int l = 0; l < std::min(L, kMaxLayerMaps); ++l) {
-      gis::Raster r{d_.bed.georef, layers[size_t(l)]};
-      for (size_t i = 0; i < r.values.size(); ++i) {
-        if (!d_.inside.data[i]) r.values.data[i] = gis::kNoData;
-      }
-      gis::WriteOptions o;
-      o.metadata = {{"STRATA_LAYER", std::to_string(l + 1)},
-                    {"STRATA_MATERIAL", d_.input.materials[size_t(l)].name},
-                    {"STRATA_UNITS", "m"}};
-      STRATA_TRY_STATUS(gis::writeGeoTiff((opt_.outDir / layerMapFile(l + 1)).string(), r, o));
+      STRATA_TRY_STATUS(writeMap(layerMapFile(l + 1), layerMaps, false,
+                                 [l](const detail::Piece& p) { return p.layers[size_t(l)]; },
+                                 {{"STRATA_LAYER", std::to_string(l + 1)},
+                                  {"STRATA_MATERIAL", d_.input.materials[size_t(l)].name},
+                                  {"STRATA_UNITS", "m"}}));
     }
     return {};
   }
 
+  // The flood's extremes and the area ever wet (collective: reduced over the ranks).
+  FloodSummary floodSummary(const std::vector<detail::Piece>& pieces) {
+    const double wet = s_.outputs.wetThresholdM;
+    const auto& g = d_.bed.georef;
+    detail::Extreme deep, fast, far;
+    std::vector<sim::ExactSum> everWet(1);
+    std::optional<std::pair<int, int>> c0;
+    std::optional<gis::LonLat> from;
+    if (!d_.sources.empty()) {
+      c0 = d_.sources.front().cells.front();
+      auto ll = gis::pixelToLonLat(g, c0->first + 0.5, c0->second + 0.5);
+      if (ll) from = *ll;
+    }
+    forEachCell(pieces, [&](const detail::Piece& p, size_t i, int x, int y, double area) {
+      const float depth = p.flood.maxDepthM.data[i], speed = p.flood.maxSpeedMS.data[i];
+      if (p.inside.data[i] && std::isfinite(depth) && detail::beats({depth, x, y, 0}, deep)) deep = {depth, x, y, 0};
+      if (p.inside.data[i] && std::isfinite(speed) && detail::beats({speed, x, y, 0}, fast)) fast = {speed, x, y, 0};
+      const double arrival = p.flood.arrivalS.data[i];
+      // How far the water got: the wet cell farthest from the first inflow (the inflow's own cell
+      // when none is farther).
+      if (c0 && x == c0->first && y == c0->second && detail::beats({0, x, y, arrival}, far)) far = {0, x, y, arrival};
+      if (!(depth > wet)) return;
+      if (p.inside.data[i]) everWet[0].add(area);
+      if (!from) return;
+      auto to = gis::pixelToLonLat(g, x + 0.5, y + 0.5);
+      const double m = to ? gis::geodesicDistanceM(*from, *to, g.body) : 0;
+      if (m > 0 && detail::beats({m, x, y, arrival}, far)) far = {m, x, y, arrival};
+    });
+    deep = detail::largest(ranks_, deep);
+    fast = detail::largest(ranks_, fast);
+    far = detail::largest(ranks_, far);
+    ranks_.sum(everWet);
+    FloodSummary f;
+    f.deepest = {deep.value, deep.x, deep.y};
+    f.fastest = {fast.value, fast.x, fast.y};
+    f.farthest = {far.value, far.x, far.y};
+    f.farthestArrivalS = far.with;
+    f.everWetM2 = everWet[0].value();
+    return f;
+  }
+
   // Where the material went (the report's balance): per layer, and the solver's totals
   // (collective; computed on the lead).
-  MaterialBudget materialBudget() {
+  MaterialBudget materialBudget(const std::vector<detail::Piece>& pieces) {
     MaterialBudget b;
-    const auto layers = solver().readLayers();
     const auto st = solver().stats();
-    if (!ranks_.lead()) return b;
-    const int w = layers.front().width, h = layers.front().height;
-    for (size_t l = 0; l < layers.size(); ++l) {
-      b.layers.push_back(d_.input.materials[l].name);
-      b.initialM3.push_back(0);
-      b.finalM3.push_back(0);
-      b.exposedInitialM2.push_back(0);
-      b.exposedFinalM2.push_back(0);
-    }
-    for (int y = 0; y < h; ++y) {
-      const double area = solver().grid().area(y);  // as the solver's totals (float32 dy)
-      for (int x = 0; x < w; ++x) {
-        double change = 0;
-        for (size_t l = 0; l < layers.size(); ++l) {
-          const double before = d_.input.layersM[l].at(x, y), after = layers[l].at(x, y);
-          b.initialM3[l] += before * area;
-          b.finalM3[l] += after * area;
-          change += after - before;
-        }
-        (change < 0 ? b.erodedM3 : b.depositedM3) += std::abs(change) * area;
-        const int topBefore =
-            exposedLayer(int(layers.size()), [&](int k) { return d_.input.layersM[size_t(k)].at(x, y); });
-        const int topAfter = exposedLayer(int(layers.size()), [&](int k) { return layers[size_t(k)].at(x, y); });
-        if (topBefore >= 0) b.exposedInitialM2[size_t(topBefore)] += area;
-        if (topAfter >= 0) b.exposedFinalM2[size_t(topAfter)] += area;
+    const size_t L = d_.input.materials.size();
+    // Per layer: at the start, at the end, exposed at the start, at the end; then eroded, deposited.
+    std::vector<sim::ExactSum> sums(4 * L + 2);
+    forEachCell(pieces, [&](const detail::Piece& p, size_t i, int, int, double area) {
+      double change = 0;
+      for (size_t l = 0; l < L; ++l) {
+        const double before = p.initialLayers[l].data[i], after = p.layers[l].data[i];
+        sums[l].add(before * area);
+        sums[L + l].add(after * area);
+        change += after - before;
       }
+      sums[4 * L + (change < 0 ? 0 : 1)].add(std::abs(change) * area);
+      const int topBefore = exposedLayer(int(L), [&](int k) { return p.initialLayers[size_t(k)].data[i]; });
+      const int topAfter = exposedLayer(int(L), [&](int k) { return p.layers[size_t(k)].data[i]; });
+      if (topBefore >= 0) sums[2 * L + size_t(topBefore)].add(area);
+      if (topAfter >= 0) sums[3 * L + size_t(topAfter)].add(area);
+    });
+    ranks_.sum(sums);
+    for (size_t l = 0; l < L; ++l) {
+      b.layers.push_back(d_.input.materials[l].name);
+      b.initialM3.push_back(sums[l].value());
+      b.finalM3.push_back(sums[L + l].value());
+      b.exposedInitialM2.push_back(sums[2 * L + l].value());
+      b.exposedFinalM2.push_back(sums[3 * L + l].value());
     }
+    b.erodedM3 = sums[4 * L].value();
+    b.depositedM3 = sums[4 * L + 1].value();
     b.suspendedM3 = st.suspendedM3;
     b.outflowM3 = st.sedimentOutflowM3;
     b.initialM3Total = st.initialMaterialM3;
@@ -580,12 +628,26 @@ class Run {
   std::string backendName() const { return e_.solver->backendName(); }
 
  private:
+  // f(piece, index in the piece, global column, global row, the model's area of the cell) for
+  // every cell of the pieces.
+  template <class F>
+  void forEachCell(const std::vector<detail::Piece>& pieces, F&& f) const {
+    for (const auto& p : pieces) {
+      for (int y = 0; y < p.rect.height; ++y) {
+        const double area = e_.solver->grid().area(p.rect.y + y);  // as the solver's totals (float32 dy)
+        for (int x = 0; x < p.rect.width; ++x) {
+          f(p, size_t(y) * size_t(p.rect.width) + size_t(x), p.rect.x + x, p.rect.y + y, area);
+        }
+      }
+    }
+  }
+
   const Scenario& s_;
   const RunOptions& opt_;
   const Ranks& ranks_;
   ScenarioDomain d_;
   Engine e_;
-  gis::Grid<float> initialMaterial_, change_;
+  detail::InputWindow input_;  // the model input of a window: what the solver started from
   double chosenDtS_ = 0, minChosenDtS_ = 1e300;
 };
 
@@ -811,17 +873,21 @@ Result<RunSummary> runScenario(const Scenario& s, const RunOptions& opt) {
     if (stopped) break;
 
     // The interval is complete: its row, maps, pictures and checkpoint. The stored water, and so
-    // which interval is the peak, is the same exact sum on every rank.
-    const auto depth = run.solver().readWaterDepth();
-    const SeriesRow row = run.row(depth);
+    // which interval is the peak, is the same exact sum on every rank. Each rank reads its own
+    // pieces of the state; only pictures gather the depth to the lead.
+    auto pieces = run.pieces();
+    STRATA_TRY_STATUS(ranks.agree(statusOf(pieces)));
+    const SeriesRow row = run.row(*pieces);
     summary.series.push_back(row);
     ++interval;
     if (opt.pictures) {
       // The peak picture is redrawn whenever the stored water reaches a new high at an interval.
       const bool peak = std::all_of(summary.series.begin(), summary.series.end(),
                                     [&](const SeriesRow& r) { return r.waterM3 <= row.waterM3; });
+      const bool last = interval == intervals;
+      const auto depth = peak || last ? run.solver().readWaterDepth() : gis::Grid<float>();
       if (peak) STRATA_TRY_STATUS(drawPicture(depth, "peak.png"));
-      if (interval == intervals) {
+      if (last) {
         STRATA_TRY_STATUS(drawPicture(depth, "after.png"));
         const auto maxDepth = run.solver().readFloodStats().maxDepthM;
         STRATA_TRY_STATUS(ranks.agree(pictures ? pictures->drawMaxDepth(maxDepth, run.domain().bed.georef,
@@ -829,7 +895,7 @@ Result<RunSummary> runScenario(const Scenario& s, const RunOptions& opt) {
                                                : Status{}));
       }
     }
-    status = run.writeMaps(depth);
+    status = run.writeMaps(*pieces);
     if (status.ok() && ranks.lead()) status = writeFileAtomic(opt.outDir / "series.csv", seriesCsv(summary.series));
     STRATA_TRY_STATUS(ranks.agree(status));
     // Over MPI ranks the blocks are dealt again by their work before each checkpoint.
@@ -882,20 +948,22 @@ Result<RunSummary> runScenario(const Scenario& s, const RunOptions& opt) {
     if (fs::exists(opt.outDir / p)) pictureFiles.push_back(p);
   }
   summary.files.insert(summary.files.end(), pictureFiles.begin(), pictureFiles.end());
+  auto finalPieces = run.pieces();
+  STRATA_TRY_STATUS(ranks.agree(statusOf(finalPieces)));
   if (s.erosion.enabled) {
-    summary.material = run.materialBudget();
+    summary.material = run.materialBudget(*finalPieces);
     for (int k = 1; k <= kMaxLayerMaps; ++k) {
       if (fs::exists(opt.outDir / layerMapFile(k))) summary.files.push_back(layerMapFile(k));
     }
   }
-  const auto floodStats = run.solver().readFloodStats();
+  const FloodSummary flood = run.floodSummary(*finalPieces);
   if (!ranks.lead()) return summary;  // the lead writes the plots and the report
   if (opt.plots) {
     STRATA_TRY(auto plots, writePlots(opt.outDir, run.domain().bed, summary.completed));
     summary.files.insert(summary.files.end(), plots.begin(), plots.end());
   }
   STRATA_TRY_STATUS(writeReport(
-      opt.outDir, ReportInput{s, run.domain(), summary, floodStats, run.backendName(), pictureFiles, maxDepthLegend}));
+      opt.outDir, ReportInput{s, run.domain(), summary, flood, run.backendName(), pictureFiles, maxDepthLegend}));
   summary.files.push_back("report.md");
   return summary;
 }

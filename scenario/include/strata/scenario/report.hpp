@@ -13,11 +13,25 @@
 
 namespace strata::scenario {
 
+/// The flood's extremes over the run (cells of the region, (x, y) = (column, row); value -1 and
+/// no cell when nothing was wet), reduced over the ranks of a run over MPI.
+struct FloodSummary {
+  struct AtCell {
+    double value = -1;
+    int x = 0, y = 0;
+  };
+  AtCell deepest;                ///< the largest depth (m)
+  AtCell fastest;                ///< the largest speed (m/s)
+  AtCell farthest;               ///< the wet cell farthest (geodesic, m) from the first inflow's first cell
+  double farthestArrivalS = -1;  ///< when water first reached it (-1: never above the threshold)
+  double everWetM2 = 0;          ///< area of the cells wet at some time (the model's cell areas)
+};
+
 struct ReportInput {
   const strata::scenario::Scenario& scenario;
   const strata::scenario::ScenarioDomain& domain;
   const RunSummary& summary;
-  sim::FloodStats flood;                   ///< per-cell maxima, arrival and duration at the end of the run
+  FloodSummary flood;                      ///< over the whole run, at its end
   std::string backend;                     ///< what ran the simulation (Solver::backendName)
   std::vector<std::string> pictures = {};  ///< rendered pictures (relative paths), if any
   std::string maxDepthLegend = {};         ///< what the max-depth picture's colours mean
