@@ -409,21 +409,24 @@ Status createGeoTiff(const std::string& path, const Georef& g, const WriteOption
   return {};
 }
 
-Status writeGeoTiffWindow(const std::string& path, int x, int y, const Grid<float>& values, float nodata) {
+Status writeGeoTiffWindows(const std::string& path, const std::vector<GridWindow>& windows, float nodata) {
   detail::ensureGdal();
-  STRATA_TRY(Grid<float> out, withNoData(path, values, nodata));
   GdalErrorCapture errors;
   DatasetPtr ds(GDALDataset::Open(path.c_str(), GDAL_OF_RASTER | GDAL_OF_UPDATE, nullptr, nullptr, nullptr));
   if (!ds) return fail(path + ": cannot open for writing: " + errors.last());
-  if (x < 0 || y < 0 || values.width <= 0 || values.height <= 0 || x + values.width > ds->GetRasterXSize() ||
-      y + values.height > ds->GetRasterYSize()) {
-    return fail(path + ": the window (" + std::to_string(x) + ", " + std::to_string(y) + ") " +
-                std::to_string(values.width) + "x" + std::to_string(values.height) + " is not inside its " +
-                std::to_string(ds->GetRasterXSize()) + "x" + std::to_string(ds->GetRasterYSize()) + " cells");
-  }
-  if (ds->GetRasterBand(1)->RasterIO(GF_Write, x, y, values.width, values.height, out.data.data(), values.width,
-                                     values.height, GDT_Float32, 0, 0) != CE_None) {
-    return fail(path + ": cannot write a window: " + errors.last());
+  for (const auto& w : windows) {
+    const int width = w.values.width, height = w.values.height;
+    if (w.x < 0 || w.y < 0 || width <= 0 || height <= 0 || w.x + width > ds->GetRasterXSize() ||
+        w.y + height > ds->GetRasterYSize()) {
+      return fail(path + ": the window (" + std::to_string(w.x) + ", " + std::to_string(w.y) + ") " +
+                  std::to_string(width) + "x" + std::to_string(height) + " is not inside its " +
+                  std::to_string(ds->GetRasterXSize()) + "x" + std::to_string(ds->GetRasterYSize()) + " cells");
+    }
+    STRATA_TRY(Grid<float> out, withNoData(path, w.values, nodata));
+    if (ds->GetRasterBand(1)->RasterIO(GF_Write, w.x, w.y, width, height, out.data.data(), width, height, GDT_Float32,
+                                       0, 0) != CE_None) {
+      return fail(path + ": cannot write a window: " + errors.last());
+    }
   }
   ds.reset();  // flush and close: the next writer opens it after
   if (CPLGetLastErrorType() >= CE_Failure) return fail(path + ": cannot write a window: " + errors.last());

@@ -43,10 +43,9 @@ Status writeMapFile(const Ranks& ranks, const fs::path& file, const gis::Georef&
   for (int r = 0; r < ranks.size(); ++r) {
     Status status;
     if (r == ranks.rank()) {
-      for (const auto& p : pieces) {
-        status = gis::writeGeoTiffWindow(tmp, p.rect.x, p.rect.y, values(p), options.nodata);
-        if (!status.ok()) break;
-      }
+      std::vector<gis::GridWindow> windows;
+      for (const auto& p : pieces) windows.push_back({p.rect.x, p.rect.y, values(p)});
+      status = gis::writeGeoTiffWindows(tmp, windows, options.nodata);
     }
     status = ranks.agree(status);
     if (!status.ok()) {

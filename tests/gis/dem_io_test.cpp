@@ -296,9 +296,8 @@ TEST(DemIo, GeoTiffWrittenByWindowsEqualsOneWrittenWhole) {
     return g;
   };
   // Three of four quadrants, in an order that revisits tiles.
-  ASSERT_TRUE(writeGeoTiffWindow(parts, 70, 40, window(70, 40, 80, 50)).ok());
-  ASSERT_TRUE(writeGeoTiffWindow(parts, 0, 0, window(0, 0, 70, 40)).ok());
-  ASSERT_TRUE(writeGeoTiffWindow(parts, 70, 0, window(70, 0, 80, 40)).ok());
+  ASSERT_TRUE(writeGeoTiffWindows(parts, {{70, 40, window(70, 40, 80, 50)}, {0, 0, window(0, 0, 70, 40)}}).ok());
+  ASSERT_TRUE(writeGeoTiffWindows(parts, {{70, 0, window(70, 0, 80, 40)}}).ok());
   auto partial = readDem(parts, [] {
     ReadOptions r;
     r.allowAllNoData = true;
@@ -315,7 +314,7 @@ TEST(DemIo, GeoTiffWrittenByWindowsEqualsOneWrittenWhole) {
       }
     }
   }
-  ASSERT_TRUE(writeGeoTiffWindow(parts, 0, 40, window(0, 40, 70, 50)).ok());
+  ASSERT_TRUE(writeGeoTiffWindows(parts, {{0, 40, window(0, 40, 70, 50)}}).ok());
   const CPLJSONObject a = gdalinfoJson(whole), b = gdalinfoJson(parts);
   EXPECT_EQ(gdalEpsg(b), 3857);
   for (int i = 0; i < 6; ++i)
@@ -329,17 +328,17 @@ TEST(DemIo, GeoTiffWrittenByWindowsEqualsOneWrittenWhole) {
     const float p = x->values.data[i], q = y->values.data[i];
     ASSERT_TRUE(p == q || (std::isnan(p) && std::isnan(q))) << i;
   }
-  auto outside = writeGeoTiffWindow(parts, 100, 50, window(0, 0, 60, 41));
+  auto outside = writeGeoTiffWindows(parts, {{100, 50, window(0, 0, 60, 41)}});
   ASSERT_FALSE(outside.ok());
   EXPECT_NE(outside.message().find(parts + ": the window (100, 50) 60x41 is not inside its 150x90 cells"),
             std::string::npos)
       << outside.message();
   Grid<float> clash(2, 2, 1.0f);
   clash.at(1, 0) = -32768.0f;
-  auto refused = writeGeoTiffWindow(parts, 0, 0, clash);
+  auto refused = writeGeoTiffWindows(parts, {{0, 0, clash}});
   ASSERT_FALSE(refused.ok());
   EXPECT_NE(refused.message().find(parts + ": cannot write: the value -32768"), std::string::npos);
-  auto missing = writeGeoTiffWindow((dir / "none.tif").string(), 0, 0, Grid<float>(2, 2, 1.0f));
+  auto missing = writeGeoTiffWindows((dir / "none.tif").string(), {{0, 0, Grid<float>(2, 2, 1.0f)}});
   EXPECT_FALSE(missing.ok());
 }
 

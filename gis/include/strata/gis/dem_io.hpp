@@ -120,11 +120,16 @@ Status writeGeoTiff(const std::string& path, const Raster& raster, const WriteOp
 /// A float32 GeoTIFF written window by window, by one process or by several in turn (each rank of
 /// a run over MPI writes its own blocks; docs/distributed.md): createGeoTiff makes `path` (a
 /// temporary, committed by the caller) with `georef`'s size, CRS and geotransform and no cells
-/// written (sparse tiles: every cell reads as nodata until written); writeGeoTiffWindow then
-/// writes `values` at cell (x, y), opening and closing the file each time (one writer at a time).
+/// written (sparse tiles: every cell reads as nodata until written); writeGeoTiffWindows then
+/// writes each window's values at its cell (x, y), opening the file once and closing it after
+/// (one writer at a time; a tile is written once per call, again by a later call that touches it).
 /// Same encoding as writeGeoTiff (DEFLATE, float predictor, tiles of `options.blockSize`; `cog`
 /// is not available: a COG's overviews need the whole raster).
+struct GridWindow {
+  int x = 0, y = 0;  ///< the top-left cell of `values` in the raster
+  Grid<float> values;
+};
 Status createGeoTiff(const std::string& path, const Georef& georef, const WriteOptions& options = {});
-Status writeGeoTiffWindow(const std::string& path, int x, int y, const Grid<float>& values, float nodata = -32768.0f);
+Status writeGeoTiffWindows(const std::string& path, const std::vector<GridWindow>& windows, float nodata = -32768.0f);
 
 }  // namespace strata::gis
