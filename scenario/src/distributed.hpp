@@ -4,8 +4,8 @@
 // fill_depressions and breach_inflows, needs the whole region), writes the model's input as
 // GeoTIFFs into the run folder (input/) and sends every rank what it needs besides cells (the
 // shape, the model, the sources and levels); each rank then reads only its blocks' windows (plus
-// halo) of those files. Every rank runs the same loop; only the lead touches shared files,
-// except each rank's own checkpoint part.
+// halo) of those files. Every rank runs the same loop, and writes its own blocks of the maps
+// (pieces.hpp) and its own checkpoint part; only the lead writes the other files.
 
 #include <filesystem>
 #include <string>
