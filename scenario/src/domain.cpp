@@ -12,6 +12,7 @@
 #include <strata/core/memory.hpp>
 #include <strata/core/progress.hpp>
 #include <strata/gis/dem_io.hpp>
+#include <strata/gis/fill_depressions.hpp>
 #include <strata/gis/fill_nodata.hpp>
 #include <strata/gis/geodesy.hpp>
 #include <strata/gis/mosaic.hpp>
@@ -874,52 +875,39 @@ Status breachInflowPaths(const Scenario& s, ScenarioDomain& d) {
 }
 
 // [terrain] fill_depressions: every cell not draining to an open edge is raised to the level at
-// which it would spill (priority flood from the open edges, Barnes et al. 2014), so that no water
-// is lost filling the pits a coarse DEM has where the real ground has none. Cells outside a
-// polygon region are walls and are not crossed.
+// which it would spill (priority flood from the open edges, Barnes et al. 2014; gis::fillDepressions,
+// which also runs tile by tile), so that no water is lost filling the pits a coarse DEM has where
+// the real ground has none. Cells outside a polygon region are walls and are not crossed.
 Status fillDepressions(const Scenario& s, ScenarioDomain& d) {
   if (!s.terrain.fillDepressions) return {};
   const int w = d.bed.georef.width, h = d.bed.georef.height;
   const auto& open = s.model.boundaries;  // W E S N
   auto& z = d.input.baseM;
-  using Entry = std::pair<float, int>;
-  std::priority_queue<Entry, std::vector<Entry>, std::greater<>> queue;
-  std::vector<uint8_t> seen(size_t(w) * size_t(h), 0);
+  gis::Grid<uint8_t> drains(w, h, 0);
+  bool any = false;
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
       const size_t c = size_t(y) * size_t(w) + size_t(x);
       const bool edge = (x == 0 && open[0] == Boundary::Open) || (x == w - 1 && open[1] == Boundary::Open) ||
                         (y == h - 1 && open[2] == Boundary::Open) || (y == 0 && open[3] == Boundary::Open);
       const bool hole = s.terrain.voids == decltype(s.terrain)::Voids::kHoles && d.voids.data[c];
-      if ((edge || hole) && d.inside.data[c]) {
-        seen[c] = 1;
-        queue.push({z.data[c], int(c)});
-      }
+      drains.data[c] = edge || hole ? 1 : 0;
+      any |= (edge || hole) && d.inside.data[c];
     }
   }
-  if (queue.empty()) {
+  if (!any) {
     return fail(s.at("terrain.fill_depressions") +
                 "no edge is open (model.boundary) and no void is a hole: nothing drains");
   }
-  while (!queue.empty()) {
-    const auto [level, cell] = queue.top();
-    queue.pop();
-    const int x = cell % w, y = cell / w;
-    const int next[4][2] = {{x - 1, y}, {x + 1, y}, {x, y - 1}, {x, y + 1}};
-    for (const auto& n : next) {
-      if (n[0] < 0 || n[0] >= w || n[1] < 0 || n[1] >= h) continue;
-      const size_t c = size_t(n[1]) * size_t(w) + size_t(n[0]);
-      if (seen[c] || !d.inside.data[c]) continue;
-      seen[c] = 1;
-      if (z.data[c] < level) {
-        d.filled.cells += 1;
-        d.filled.maxM = std::max(d.filled.maxM, double(level) - double(z.data[c]));
-        d.filled.volumeM3 += (double(level) - double(z.data[c])) * d.cellAreaM2.data[c];
-        z.data[c] = level;
-        d.bed.values.data[c] = level;
-      }
-      queue.push({z.data[c], int(c)});
-    }
+  const gis::Grid<float> filled = gis::fillDepressions({&z, &d.inside, &drains}, {{0, 0, w, h}});
+  for (size_t c = 0; c < z.size(); ++c) {
+    if (!(filled.data[c] > z.data[c])) continue;
+    const double raised = double(filled.data[c]) - double(z.data[c]);
+    d.filled.cells += 1;
+    d.filled.maxM = std::max(d.filled.maxM, raised);
+    d.filled.volumeM3 += raised * d.cellAreaM2.data[c];
+    z.data[c] = filled.data[c];
+    d.bed.values.data[c] = filled.data[c];
   }
   return {};
 }
