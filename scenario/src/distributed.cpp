@@ -132,6 +132,25 @@ void georefFields(IO& io, G& g) {
   io.str(g.verticalUnit);
 }
 
+// What the report says of the domain's build, for a ByteWriter (D = const ScenarioDomain) or a
+// ByteReader.
+template <class IO, class D>
+void reportFields(IO& io, D& d) {
+  for (auto* names : {&d.sourceNames, &d.levelNames}) {
+    uint64_t n = names->size();
+    io.pod(n);
+    if constexpr (!std::is_const_v<D>) names->resize(size_t(std::min<uint64_t>(n, io.left())));
+    for (auto& name : *names) io.str(name);
+  }
+  io.pod(d.damBreakVolumeM3);
+  io.pod(d.totalAreaM2);
+  io.pod(d.bedRangeM);
+  io.pod(d.breach);
+  io.pod(d.filled);
+  io.pod(d.voidCells);
+  io.vec(d.layerCellsTooSteep);
+}
+
 std::string encodeDomainShape(const ScenarioDomain& d) {
   ByteWriter w;
   georefFields(w, d.bed.georef);
@@ -157,6 +176,7 @@ std::string encodeDomainShape(const ScenarioDomain& d) {
   w.pod(d.rainMmPerHour);
   w.pod(d.rainStartS);
   w.pod(d.rainEndS);
+  reportFields(w, d);
   return w.out;
 }
 
@@ -196,6 +216,7 @@ Result<ScenarioDomain> decodeDomainShape(std::string_view bytes) {
   r.pod(d.rainMmPerHour);
   r.pod(d.rainStartS);
   r.pod(d.rainEndS);
+  reportFields(r, d);
   if (!r.ok || r.left() != 0)
     return fail("the domain sent by rank 0 is damaged (" + std::to_string(bytes.size()) + " bytes)");
   return d;

@@ -53,8 +53,9 @@ class Ranks {
   int rank_ = 0, size_ = 1;
 };
 
-/// What every rank needs of the domain besides its cells: the region's size (bed.georef's width
-/// and height), the model, inflows, levels, rain, materials, cell sizes and datum.
+/// What every rank needs of the domain besides its cells: the region's georeference, the model,
+/// inflows, levels, rain, materials, cell sizes and datum, and what the report says of the
+/// domain's build (names, areas, volumes, the bed's range, the conditioning's counts).
 std::string encodeDomainShape(const ScenarioDomain& d);
 /// The domain with no cells from encodeDomainShape's bytes: every grid empty but waterDepthM and
 /// rainMmPerHour, which are 1 x 1 where the lead's domain has them (modelInputSource reads them).

@@ -328,18 +328,19 @@ Result<RegionFrame> regionWindow(const Scenario& s, const TerrainSource& source,
 // per layer), the checkpoint (the saved state, and its encoding beside it), what the outputs read
 // back at each interval (detail::readPieces: the state block, depth, flood statistics, mask, the
 // model input's window, in erosion runs suspended sediment and the layers now and at the start),
-// the domain (bed, mask, area in double, base, layers, water, rain) and the depth gathered for
-// pictures (with the surface and top four layers in erosion runs). Over `ranks` MPI ranks each
-// rank holds a 1/ranks share of the first three (its blocks' halos add ~10% at the default block
-// sizes); the lead, the heaviest, also holds the whole domain and the pictures' gather.
+// the domain (bed, mask, area in double, base, layers, water, rain) and what pictures hold (the
+// bed, and the depth gathered with, in erosion runs, the surface and top four layers). Over
+// `ranks` MPI ranks the lead, the heaviest, first builds the whole domain and writes it as the
+// model input; during the run every rank holds a 1/ranks share (its blocks' halos add ~10% at
+// the default block sizes) of the solver, checkpoint and read-back, and the lead the pictures'.
 double bytesPerCell(int layers, int ranks) {
   const double solver = 4.0 * (9 * 4 + 8 + 5 + layers);
   const double checkpoint = 2 * 4.0 * (4 + 4 + 4 + 8 + 4 + layers);
   const double readBack = 16 + 4 + 16 + 1 + 4.0 * (3 + layers) + 4 + 8.0 * layers;
   const double domain = 4 + 1 + 8 + 4 + 4.0 * layers + 4 + 4;
-  const double pictures = 4 + 4 + 16;
-  const double share = ranks > 1 ? 1.1 / ranks : 1.0;
-  return (solver + checkpoint + readBack) * share + domain + pictures;
+  const double pictures = 4 + 4 + 4 + 16;
+  if (ranks <= 1) return solver + checkpoint + readBack + domain + pictures;
+  return std::max(domain, (solver + checkpoint + readBack) * 1.1 / ranks + pictures);
 }
 
 // The key a message about the region's size names: cell_size when given, else the region, else
@@ -971,6 +972,12 @@ Result<ScenarioDomain> buildDomain(const Scenario& s, uint64_t memoryBudgetBytes
   placeVoidHoles(s, d);
   STRATA_TRY_STATUS(placeRain(s, d));
   STRATA_TRY_STATUS(placeDamBreaks(s, mapper, frame, d));
+  d.bedRangeM = {std::numeric_limits<float>::max(), std::numeric_limits<float>::lowest()};
+  for (size_t i = 0; i < d.bed.values.size(); ++i) {
+    if (!d.inside.data[i]) continue;
+    d.bedRangeM[0] = std::min(d.bedRangeM[0], d.bed.values.data[i]);
+    d.bedRangeM[1] = std::max(d.bedRangeM[1], d.bed.values.data[i]);
+  }
   return d;
 }
 

@@ -120,12 +120,7 @@ Status writeReport(const fs::path& runDir, const ReportInput& in) {
 
   // --- Scenario
   md += "## Scenario\n\n";
-  float lo = 1e30f, hi = -1e30f;
-  for (size_t i = 0; i < d.bed.values.size(); ++i) {
-    if (!d.inside.data[i]) continue;
-    lo = std::min(lo, d.bed.values.data[i]);
-    hi = std::max(hi, d.bed.values.data[i]);
-  }
+  const auto [lo, hi] = d.bedRangeM;
   md += "| | |\n|---|---|\n";
   const std::string terrain =
       s.terrain.store.empty() ? "`" + s.terrain.dems.front() + "`" : "tile store `" + s.terrain.store + "`";
@@ -171,7 +166,7 @@ Status writeReport(const fs::path& runDir, const ReportInput& in) {
   }
   for (size_t l = 0; l < s.terrain.layers.size() && l < d.layerCellsTooSteep.size(); ++l) {
     if (!s.terrain.layers[l].atRest) continue;
-    const size_t k = d.input.layersM.size() - s.terrain.layers.size() + l;  // the scenario's layers are on top
+    const size_t k = d.input.materials.size() - s.terrain.layers.size() + l;  // the scenario's layers are on top
     md += "| " + s.terrain.layers[l].material + " at rest | none on the " + std::to_string(d.layerCellsTooSteep[l]) +
           " cells whose ground is steeper than its " + fmt("%.0f", d.input.materials[k].talusAngleDeg) +
           "° angle of repose ([[terrain.layer]] at_rest) |\n";

@@ -773,13 +773,16 @@ Result<RunSummary> runScenario(const Scenario& s, const RunOptions& opt) {
   STRATA_TRY_STATUS(ranks.agree(status));
   const std::string scenarioText = ranks.fromLead(ranks.lead() ? slurp(s.file) : std::string());
   if (ranks.distributed()) {
+    // Every rank, the lead too, runs on the domain's shape and reads its blocks from input/: the
+    // lead lets go of the domain's grids but for the bed, which pictures and the elevation map
+    // need.
     const std::string shape = ranks.fromLead(ranks.lead() ? detail::encodeDomainShape(domain) : std::string());
-    if (!ranks.lead()) {
-      auto decoded = detail::decodeDomainShape(shape);
-      if (decoded) domain = std::move(decoded).value();
-      status = statusOf(decoded);
-    }
-    STRATA_TRY_STATUS(ranks.agree(status));
+    gis::Grid<float> bed;
+    if (ranks.lead() && (opt.pictures || opt.plots)) bed = std::move(domain.bed.values);
+    auto decoded = detail::decodeDomainShape(shape);
+    if (decoded) domain = std::move(decoded).value();
+    domain.bed.values = std::move(bed);
+    STRATA_TRY_STATUS(ranks.agree(statusOf(decoded)));
   }
   const CheckpointOwner owner{opt.command, fnv1a(scenarioText)};
   const fs::path checkpointPath =

@@ -127,10 +127,21 @@ TEST(ScenarioMpi, AFloodOverTheRanksEqualsOneProcess) {
   expectSameRun(dir / "one", dir / "ranks",
                 {"max_depth", "max_speed", "arrival_time", "inundation_duration", "final_depth"},
                 "flood on " + std::to_string(worldSize()) + " ranks");
-  // The report says what ran it.
-  std::ifstream report(dir / "ranks" / "report.md");
-  const std::string text((std::istreambuf_iterator<char>(report)), std::istreambuf_iterator<char>());
+  // The report says what ran it, and otherwise what the one process's says: every number of
+  // the domain's build and of the flood (its extremes, areas and volumes are reduced over the
+  // ranks), up to the list of files (checkpoint parts and model input).
+  auto reportOf = [](const fs::path& folder) {
+    std::ifstream report(folder / "report.md");
+    return std::string((std::istreambuf_iterator<char>(report)), std::istreambuf_iterator<char>());
+  };
+  const std::string text = reportOf(dir / "ranks"), alone = reportOf(dir / "one");
   EXPECT_NE(text.find(std::to_string(worldSize()) + " MPI ranks"), std::string::npos);
+  auto body = [](const std::string& t) {
+    const auto from = t.find("## Scenario"), to = t.find("## Files");
+    return from == std::string::npos || to == std::string::npos ? std::string() : t.substr(from, to - from);
+  };
+  EXPECT_GT(body(alone).size(), 500u);
+  EXPECT_EQ(body(text), body(alone));
   fs::remove_all(dir);
 }
 

@@ -5,6 +5,7 @@
 // simulation: the region must lie inside the DEM and every source inside the region; messages
 // name the scenario file, line and key.
 
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -26,10 +27,11 @@ struct ScenarioDomain {
   std::vector<std::string> sourceNames;
   std::vector<sim::LevelBoundary> levels;  ///< fixed water levels, on cells (stage in m above the DEM's reference)
   std::vector<std::string> levelNames;
-  double rainMmPerHour = 0;             ///< uniform rain rate while it falls
-  double rainStartS = 0, rainEndS = 0;  ///< rain falls in [start, end)
-  double damBreakVolumeM3 = 0;          ///< initial water from dam breaks
-  double totalAreaM2 = 0;               ///< area of the region's cells
+  double rainMmPerHour = 0;              ///< uniform rain rate while it falls
+  double rainStartS = 0, rainEndS = 0;   ///< rain falls in [start, end)
+  double damBreakVolumeM3 = 0;           ///< initial water from dam breaks
+  double totalAreaM2 = 0;                ///< area of the region's cells
+  std::array<float, 2> bedRangeM{0, 0};  ///< the lowest and highest bed of the region's cells (m)
   /// What [terrain] breach_inflows carved (nothing when off).
   struct {
     int paths = 0, cells = 0;          ///< paths carved, cells changed on them
