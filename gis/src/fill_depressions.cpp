@@ -26,19 +26,36 @@ void join(std::map<std::pair<int64_t, int64_t>, float>& joins, int64_t a, int64_
   if (!added) it->second = std::min(it->second, level);
 }
 
+// The input's area and the whole grid's width.
+CellRect areaOf(const FillInput& in) {
+  return in.area.empty() ? CellRect{0, 0, in.elevation->width, in.elevation->height} : in.area;
+}
+int64_t gridWidthOf(const FillInput& in) { return in.gridWidth > 0 ? in.gridWidth : in.elevation->width; }
+
+// The input's grids at whole-grid cell (x, y) (inside its area).
+struct At {
+  const FillInput& in;
+  CellRect a;
+  size_t index(int x, int y) const { return size_t(y - a.y) * size_t(a.width) + size_t(x - a.x); }
+  float z(int x, int y) const { return in.elevation->data[index(x, y)]; }
+  bool inside(int x, int y) const { return in.inside->data[index(x, y)] != 0; }
+  bool drains(int x, int y) const { return in.drains->data[index(x, y)] != 0; }
+};
+
 }  // namespace
 
 TileFlood floodTile(const FillInput& in, const CellRect& t) {
-  const Grid<float>& z = *in.elevation;
-  const Grid<uint8_t>& inside = *in.inside;
-  const Grid<uint8_t>& drains = *in.drains;
-  const int gw = z.width;
+  const CellRect a = areaOf(in);
+  STRATA_CHECK(t.x >= a.x && t.y >= a.y && t.x + t.width <= a.x + a.width && t.y + t.height <= a.y + a.height)
+      << "fill: a tile outside the input's area";
+  const At at{in, a};
+  const int64_t gw = gridWidthOf(in);
   TileFlood f;
   f.tile = t;
   f.filled = Grid<float>(t.width, t.height);
   f.label = Grid<int64_t>(t.width, t.height, 0);
   for (int y = 0; y < t.height; ++y) {
-    for (int x = 0; x < t.width; ++x) f.filled.at(x, y) = z.at(t.x + x, t.y + y);
+    for (int x = 0; x < t.width; ++x) f.filled.at(x, y) = at.z(t.x + x, t.y + y);
   }
   // Seeds: the draining cells, and the tile's perimeter (each its own label).
   struct Entry {
@@ -50,9 +67,9 @@ TileFlood floodTile(const FillInput& in, const CellRect& t) {
   for (int y = 0; y < t.height; ++y) {
     for (int x = 0; x < t.width; ++x) {
       const int gx = t.x + x, gy = t.y + y;
-      if (!inside.at(gx, gy)) continue;
+      if (!at.inside(gx, gy)) continue;
       const bool perimeter = x == 0 || y == 0 || x == t.width - 1 || y == t.height - 1;
-      if (drains.at(gx, gy)) {
+      if (at.drains(gx, gy)) {
         f.label.at(x, y) = kDrainLabel;
       } else if (perimeter) {
         f.label.at(x, y) = kFirstPerimeterLabel + int64_t(gy) * gw + gx;
@@ -72,7 +89,7 @@ TileFlood floodTile(const FillInput& in, const CellRect& t) {
     const int next[4][2] = {{x - 1, y}, {x + 1, y}, {x, y - 1}, {x, y + 1}};
     for (const auto& n : next) {
       if (n[0] < 0 || n[0] >= t.width || n[1] < 0 || n[1] >= t.height) continue;
-      if (!inside.at(t.x + n[0], t.y + n[1])) continue;
+      if (!at.inside(t.x + n[0], t.y + n[1])) continue;
       int64_t& theirs = f.label.at(n[0], n[1]);
       float& nz = f.filled.at(n[0], n[1]);
       if (theirs != 0) {
@@ -89,29 +106,31 @@ TileFlood floodTile(const FillInput& in, const CellRect& t) {
 }
 
 std::vector<SpillEdge> borderEdges(const FillInput& in, const std::vector<CellRect>& tiles) {
-  const Grid<float>& z = *in.elevation;
-  const Grid<uint8_t>& inside = *in.inside;
-  const Grid<uint8_t>& drains = *in.drains;
-  const int w = z.width, h = z.height;
-  Grid<int32_t> tileOf(w, h, -1);
+  const CellRect a = areaOf(in);
+  const At at{in, a};
+  const int64_t gw = gridWidthOf(in);
+  Grid<int32_t> tileOf(a.width, a.height, -1);
   for (size_t k = 0; k < tiles.size(); ++k) {
-    const auto& t = tiles[k];
+    const auto t = tiles[k].intersected(a);
     for (int y = t.y; y < t.y + t.height; ++y) {
-      for (int x = t.x; x < t.x + t.width; ++x) tileOf.at(x, y) = int32_t(k);
+      for (int x = t.x; x < t.x + t.width; ++x) tileOf.data[at.index(x, y)] = int32_t(k);
     }
   }
   auto labelOf = [&](int x, int y) {
-    return drains.at(x, y) ? kDrainLabel : kFirstPerimeterLabel + int64_t(y) * w + x;
+    return at.drains(x, y) ? kDrainLabel : kFirstPerimeterLabel + int64_t(y) * gw + x;
   };
   std::map<std::pair<int64_t, int64_t>, float> joins;
-  for (int y = 0; y < h; ++y) {
-    for (int x = 0; x < w; ++x) {
-      if (!inside.at(x, y)) continue;
-      STRATA_CHECK(tileOf.at(x, y) >= 0) << "fill: the tiles do not cover cell " << x << ", " << y;
-      const int right[2][2] = {{x + 1, y}, {x, y + 1}};
-      for (const auto& n : right) {
-        if (n[0] >= w || n[1] >= h || !inside.at(n[0], n[1]) || tileOf.at(n[0], n[1]) == tileOf.at(x, y)) continue;
-        join(joins, labelOf(x, y), labelOf(n[0], n[1]), std::max(z.at(x, y), z.at(n[0], n[1])));
+  for (int y = a.y; y < a.y + a.height; ++y) {
+    for (int x = a.x; x < a.x + a.width; ++x) {
+      if (!at.inside(x, y)) continue;
+      const int32_t mine = tileOf.data[at.index(x, y)];
+      STRATA_CHECK(mine >= 0) << "fill: the tiles do not cover cell " << x << ", " << y;
+      const int next[2][2] = {{x + 1, y}, {x, y + 1}};
+      for (const auto& n : next) {
+        if (n[0] >= a.x + a.width || n[1] >= a.y + a.height || !at.inside(n[0], n[1]) ||
+            tileOf.data[at.index(n[0], n[1])] == mine)
+          continue;
+        join(joins, labelOf(x, y), labelOf(n[0], n[1]), std::max(at.z(x, y), at.z(n[0], n[1])));
       }
     }
   }
@@ -149,10 +168,11 @@ std::vector<std::pair<int64_t, float>> spillLevels(const std::vector<SpillEdge>&
 
 Grid<float> finishTile(const FillInput& in, const TileFlood& f, const std::vector<std::pair<int64_t, float>>& spill) {
   const CellRect& t = f.tile;
+  const At at{in, areaOf(in)};
   Grid<float> out(t.width, t.height);
   for (int y = 0; y < t.height; ++y) {
     for (int x = 0; x < t.width; ++x) {
-      const float own = in.elevation->at(t.x + x, t.y + y);
+      const float own = at.z(t.x + x, t.y + y);
       const int64_t label = f.label.at(x, y);
       auto it = std::lower_bound(spill.begin(), spill.end(), std::pair<int64_t, float>{label, -1e38f},
                                  [](const auto& a, const auto& b) { return a.first < b.first; });

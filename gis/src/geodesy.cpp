@@ -243,27 +243,35 @@ Result<std::array<double, 2>> metresPerCrsUnit(const Georef& georef, double col,
 }
 
 Result<Grid<double>> cellAreasM2(const Georef& georef) {
+  return cellAreasM2(georef, {0, 0, georef.width, georef.height});
+}
+
+Result<Grid<double>> cellAreasM2(const Georef& georef, const CellRect& w) {
   if (georef.width <= 0 || georef.height <= 0) return fail("cell areas: empty grid");
-  Grid<double> areas(georef.width, georef.height, std::nan(""));
+  if (w.empty() || w.x < 0 || w.y < 0 || w.x + w.width > georef.width || w.y + w.height > georef.height) {
+    return fail("cell areas: the window is not inside the grid");
+  }
+  Grid<double> areas(w.width, w.height, std::nan(""));
   const GeoTransform& t = georef.transform;
   if (georef.geographic && t.isNorthUp()) {
     // Closed form (eq. A), one value per row.
-    for (int row = 0; row < georef.height; ++row) {
-      const double lat0 = poleSnap(t.y(0, row)), lat1 = poleSnap(t.y(0, row + 1));
+    for (int row = 0; row < w.height; ++row) {
+      const double lat0 = poleSnap(t.y(0, w.y + row)), lat1 = poleSnap(t.y(0, w.y + row + 1));
       if (std::abs(lat0) > 90 || std::abs(lat1) > 90) continue;
       const double a = ellipsoidalQuadAreaM2(lat0, lat1, t.c[1], georef.body);
-      for (int col = 0; col < georef.width; ++col) areas.at(col, row) = a;
+      for (int col = 0; col < w.width; ++col) areas.at(col, row) = a;
     }
     return areas;
   }
   // Any other grid: corners to lon/lat on the CRS's own datum, then the ring integral
   // A = b^2 |sum over edges (f_i + f_j) / 2 * dlon_ij| (eq. B), exact along parallels and meridians.
-  const int cw = georef.width + 1, ch = georef.height + 1;
+  // (Corners of the window, from the whole grid's transform: a window's areas are the whole's.)
+  const int cw = w.width + 1, ch = w.height + 1;
   std::vector<double> lon(size_t(cw) * ch), lat(size_t(cw) * ch);
   for (int r = 0; r < ch; ++r) {
     for (int c = 0; c < cw; ++c) {
-      lon[size_t(r) * cw + c] = t.x(c, r);
-      lat[size_t(r) * cw + c] = t.y(c, r);
+      lon[size_t(r) * cw + c] = t.x(w.x + c, w.y + r);
+      lat[size_t(r) * cw + c] = t.y(w.x + c, w.y + r);
     }
   }
   if (!georef.geographic) {
@@ -277,8 +285,9 @@ Result<Grid<double>> cellAreasM2(const Georef& georef) {
         for (int c = 0; c < cw; ++c) {
           const size_t i = size_t(r) * cw + c;
           if (!std::isnan(lon[i])) continue;
-          const double pc = c + (cx - c) * 1e-9 / std::max(1.0, std::abs(cx - c)),
-                       pr = r + (cy - r) * 1e-9 / std::max(1.0, std::abs(cy - r));
+          const double gc = w.x + c, gr = w.y + r;
+          const double pc = gc + (cx - gc) * 1e-9 / std::max(1.0, std::abs(cx - gc)),
+                       pr = gr + (cy - gr) * 1e-9 / std::max(1.0, std::abs(cy - gr));
           double x = t.x(pc, pr), y = t.y(pc, pr);
           if (ct.transform(1, &x, &y)) {
             lon[i] = x;
@@ -296,8 +305,8 @@ Result<Grid<double>> cellAreasM2(const Georef& georef) {
     f[i] = std::abs(la) <= 90 ? authalicF(la, e) : std::nan("");
   }
   constexpr double kRad = kDegToRad;
-  for (int row = 0; row < georef.height; ++row) {
-    for (int col = 0; col < georef.width; ++col) {
+  for (int row = 0; row < w.height; ++row) {
+    for (int col = 0; col < w.width; ++col) {
       const size_t idx[4] = {size_t(row) * cw + col, size_t(row) * cw + col + 1, size_t(row + 1) * cw + col + 1,
                              size_t(row + 1) * cw + col};
       double sum = 0;

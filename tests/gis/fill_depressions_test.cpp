@@ -112,6 +112,48 @@ TEST(FillDepressions, EveryTilingEqualsOnePriorityFlood) {
     for (size_t i = 0; i < z.size(); ++i) differ += filled.data[i] == reference.data[i] ? 0 : 1;
     EXPECT_EQ(differ, 0u) << name << ": " << tiles.size() << " tiles";
   }
+
+  // As MPI ranks do it: each holds only its rows (and the row below, for the border's joins),
+  // floods them, and only the joins travel; the spill levels come back.
+  const std::vector<int> cuts = {0, 37, 38, 90, 151, h};
+  std::vector<CellRect> strips;
+  for (size_t k = 0; k + 1 < cuts.size(); ++k) strips.push_back({0, cuts[k], w, cuts[k + 1] - cuts[k]});
+  struct Held {
+    Grid<float> z;
+    Grid<uint8_t> inside, drains;
+    FillInput in;
+    TileFlood flood;
+  };
+  std::vector<Held> held(strips.size());
+  std::vector<SpillEdge> joins;
+  for (size_t k = 0; k < strips.size(); ++k) {
+    const CellRect area{0, strips[k].y, w, std::min(h - strips[k].y, strips[k].height + 1)};
+    auto& m = held[k];
+    m.z = Grid<float>(w, area.height);
+    m.inside = Grid<uint8_t>(w, area.height);
+    m.drains = Grid<uint8_t>(w, area.height);
+    for (int y = 0; y < area.height; ++y) {
+      for (int x = 0; x < w; ++x) {
+        m.z.at(x, y) = z.at(x, area.y + y);
+        m.inside.at(x, y) = inside.at(x, area.y + y);
+        m.drains.at(x, y) = drains.at(x, area.y + y);
+      }
+    }
+    m.in = {&m.z, &m.inside, &m.drains, area, w};
+    m.flood = floodTile(m.in, strips[k]);
+    const auto border = borderEdges(m.in, strips);
+    joins.insert(joins.end(), border.begin(), border.end());
+    joins.insert(joins.end(), m.flood.edges.begin(), m.flood.edges.end());
+  }
+  const auto spill = spillLevels(joins);
+  size_t differ = 0;
+  for (size_t k = 0; k < strips.size(); ++k) {
+    const Grid<float> part = finishTile(held[k].in, held[k].flood, spill);
+    for (int y = 0; y < strips[k].height; ++y) {
+      for (int x = 0; x < w; ++x) differ += part.at(x, y) == reference.at(x, strips[k].y + y) ? 0 : 1;
+    }
+  }
+  EXPECT_EQ(differ, 0u) << "rows held apart";
 }
 
 // A pit whose only outlet lies in the next tile, over a saddle in a third: filled to the saddle.

@@ -234,6 +234,27 @@ TEST(CellAreas, WebMercatorGridSumsToItsLonLatExtent) {
   EXPECT_NEAR(areas->at(256, 256) / (side * side) - 1, 0, 0.01);
 }
 
+// A window's areas are the whole grid's bits there (what a rank that builds only some rows of a
+// region computes), on a projected grid (corners through PROJ) and a geographic one.
+TEST(CellAreas, AWindowHasTheWholeGridsBits) {
+  for (const char* dem : {"grand_canyon/grandcanyon_srtm_3857.tif", "grand_canyon/grand_canyon_512.tif"}) {
+    auto info = probeDem(test::dataFile(dem));
+    ASSERT_TRUE(info.ok()) << info.message();
+    const Georef& g = info->georef;
+    auto whole = cellAreasM2(g);
+    ASSERT_TRUE(whole.ok()) << whole.message();
+    for (const CellRect w : {CellRect{256, 0, 1, 512}, CellRect{3, 101, 77, 45}, CellRect{0, 511, 512, 1}}) {
+      auto part = cellAreasM2(g, w);
+      ASSERT_TRUE(part.ok()) << part.message();
+      for (int y = 0; y < w.height; ++y) {
+        for (int x = 0; x < w.width; ++x)
+          ASSERT_EQ(part->at(x, y), whole->at(w.x + x, w.y + y)) << dem << " " << x << "," << y;
+      }
+    }
+    EXPECT_FALSE(cellAreasM2(g, CellRect{500, 0, 13, 1}).ok());  // past the east edge
+  }
+}
+
 TEST(CellAreas, UtmCellsMatchGeodesicPolygons) {
   Georef g;
   g.crsWkt = "EPSG:32612";

@@ -20,11 +20,7 @@ using detail::HaloPiece;
 namespace {
 
 // Block solvers' coordinates are their extent's: global cell (x, y) is (x - e.x, y - e.y).
-CellRect intersect(const CellRect& a, const CellRect& b) {
-  const int x0 = std::max(a.x, b.x), x1 = std::min(a.x + a.width, b.x + b.width);
-  const int y0 = std::max(a.y, b.y), y1 = std::min(a.y + a.height, b.y + b.height);
-  return x0 < x1 && y0 < y1 ? CellRect{x0, y0, x1 - x0, y1 - y0} : CellRect{0, 0, 0, 0};
-}
+CellRect intersect(const CellRect& a, const CellRect& b) { return a.intersected(b); }
 bool inside(const CellRect& r, int x, int y) { return x >= r.x && y >= r.y && x < r.x + r.width && y < r.y + r.height; }
 
 bool allZeroBits(const float* v, size_t n) {

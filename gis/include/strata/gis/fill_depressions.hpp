@@ -18,11 +18,15 @@
 namespace strata::gis {
 
 /// What a depression fill works on: elevations, which cells belong to the region (others are
-/// walls, never crossed) and which drain (open edges, holes: the floods start there).
+/// walls, never crossed) and which drain (open edges, holes: the floods start there). The grids
+/// hold the cells of `area` of a grid `gridWidth` cells wide (by default the whole grid): a
+/// process that holds only some rows of the grid (and floods only tiles inside them) gives those.
 struct FillInput {
   const Grid<float>* elevation = nullptr;
   const Grid<uint8_t>* inside = nullptr;
   const Grid<uint8_t>* drains = nullptr;
+  CellRect area{};    ///< empty: the whole grid, the grids' own size
+  int gridWidth = 0;  ///< 0: the grids' width
 };
 
 /// A join of two labels at the level water crosses between them.
@@ -31,12 +35,12 @@ struct SpillEdge {
   float level = 0;
 };
 
-/// Label of the draining cells' flood; a tile's perimeter cell c (row-major index in the grid)
+/// Label of the draining cells' flood; a tile's perimeter cell c (row-major index in the whole grid)
 /// seeds label kFirstPerimeterLabel + c; 0: not reached.
 inline constexpr int64_t kDrainLabel = 1;
 inline constexpr int64_t kFirstPerimeterLabel = 2;
 
-/// One tile flooded on its own (phase 1).
+/// One tile (inside the input's area) flooded on its own (phase 1).
 struct TileFlood {
   CellRect tile;
   Grid<float> filled;            ///< the tile's elevations raised within the tile
@@ -45,9 +49,9 @@ struct TileFlood {
 };
 TileFlood floodTile(const FillInput& in, const CellRect& tile);
 
-/// Joins across the borders of `tiles` (which partition the grid): 4-neighbours in two tiles, both
-/// of the region, at the higher of their elevations (perimeter cells seed their own labels, so
-/// this needs no tile's flood).
+/// Joins across the borders of `tiles` (which partition the grid) between cells of the input's
+/// area: 4-neighbours in two tiles, both of the region, at the higher of their elevations
+/// (perimeter cells seed their own labels, so this needs no tile's flood).
 std::vector<SpillEdge> borderEdges(const FillInput& in, const std::vector<CellRect>& tiles);
 
 /// The spill level of every label reached from kDrainLabel over `edges` (phase 2), as sorted

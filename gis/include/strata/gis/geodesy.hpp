@@ -78,6 +78,8 @@ double ellipsoidalQuadAreaM2(double lat0Deg, double lat1Deg, double lonSpanDeg, 
 /// area integrated on the ellipsoid's authalic sphere (docs/gis.md). NaN where a corner cannot
 /// be transformed. Fails when the Georef has no usable CRS.
 Result<Grid<double>> cellAreasM2(const Georef& georef);
+/// The areas of the cells of `window` (inside the grid), the same bits as the whole grid's there.
+Result<Grid<double>> cellAreasM2(const Georef& georef, const CellRect& window);
 
 /// A coordinate transformation between two CRSs (GDAL/PROJ), x = easting/longitude first.
 class CrsTransform {

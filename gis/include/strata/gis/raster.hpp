@@ -53,6 +53,12 @@ struct CellRect {
     const int x1 = std::max(x + width, o.x + o.width), y1 = std::max(y + height, o.y + o.height);
     return {x0, y0, x1 - x0, y1 - y0};
   }
+  /// The cells in both (empty when they do not overlap).
+  CellRect intersected(const CellRect& o) const {
+    const int x0 = std::max(x, o.x), y0 = std::max(y, o.y);
+    const int x1 = std::min(x + width, o.x + o.width), y1 = std::min(y + height, o.y + o.height);
+    return x1 > x0 && y1 > y0 ? CellRect{x0, y0, x1 - x0, y1 - y0} : CellRect{};
+  }
   bool operator==(const CellRect&) const = default;
 };
 
