@@ -9,7 +9,11 @@
 #include <strata/core/bytes.hpp>
 #include <strata/core/interrupt.hpp>
 #include <strata/gis/dem_io.hpp>
+#include <strata/gis/fill_depressions.hpp>
 #include <strata/sim/distributed_solver.hpp>
+
+#include "domain_rows.hpp"
+#include "pieces.hpp"
 
 namespace strata::scenario::detail {
 namespace fs = std::filesystem;
@@ -107,6 +111,37 @@ bool Ranks::all(bool value) const { return minMax(value ? 1 : 0).first == 1; }
 
 void Ranks::sum(std::vector<sim::ExactSum>& sums) const {
   if (distributed_) sim::allreduceExact(sums.data(), int(sums.size()), MPI_COMM_WORLD);
+}
+
+void Ranks::min(std::vector<double>& values) const {
+  if (distributed_) MPI_Allreduce(MPI_IN_PLACE, values.data(), int(values.size()), MPI_DOUBLE, MPI_MIN, MPI_COMM_WORLD);
+}
+
+void Ranks::max(std::vector<double>& values) const {
+  if (distributed_) MPI_Allreduce(MPI_IN_PLACE, values.data(), int(values.size()), MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+}
+
+std::vector<std::string> Ranks::gatherToLead(const std::string& bytes) const {
+  if (!distributed_) return {bytes};
+  STRATA_CHECK(bytes.size() < size_t(INT_MAX)) << "a rank's part of a gather exceeds 2 GB";
+  int n = int(bytes.size());
+  std::vector<int> counts(static_cast<size_t>(size_)), offsets(static_cast<size_t>(size_));
+  MPI_Gather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, MPI_COMM_WORLD);
+  std::string all;
+  if (lead()) {
+    size_t total = 0;
+    for (int r = 0; r < size_; ++r) {
+      offsets[size_t(r)] = int(total);
+      total += size_t(counts[size_t(r)]);
+    }
+    STRATA_CHECK(total < size_t(INT_MAX)) << "a gather to rank 0 exceeds 2 GB";
+    all.resize(total);
+  }
+  MPI_Gatherv(bytes.data(), n, MPI_CHAR, all.data(), counts.data(), offsets.data(), MPI_CHAR, 0, MPI_COMM_WORLD);
+  std::vector<std::string> out;
+  if (!lead()) return out;
+  for (int r = 0; r < size_; ++r) out.push_back(all.substr(size_t(offsets[size_t(r)]), size_t(counts[size_t(r)])));
+  return out;
 }
 
 std::vector<double> Ranks::allGather(const std::vector<double>& values) const {
@@ -228,33 +263,183 @@ std::vector<std::string> modelInputFiles(int layers) {
   return files;
 }
 
-Status writeModelInput(const fs::path& runDir, const ScenarioDomain& d) {
-  const int layers = int(d.input.layersM.size());
+Status writeModelInput(const Ranks& ranks, const fs::path& runDir, const gis::Georef& georef, const ScenarioDomain& d,
+                       int layers, bool water, bool rain) {
   if (layers > kMaxInputLayers) {
     return fail(std::to_string(layers) + " layers: a run over MPI ranks takes at most " +
                 std::to_string(kMaxInputLayers));
   }
   std::error_code ec;
-  fs::create_directories(runDir / "input", ec);
-  if (ec) return fail((runDir / "input").string() + ": cannot create: " + ec.message());
-  auto write = [&](const std::string& file, const gis::Grid<float>& values, const std::string& what) -> Status {
+  if (ranks.lead()) fs::create_directories(runDir / "input", ec);
+  STRATA_TRY_STATUS(
+      ranks.agree(ec ? fail((runDir / "input").string() + ": cannot create: " + ec.message()) : Status{}));
+  const bool mine = d.input.baseM.size() > 0;
+  auto write = [&](const std::string& file, const gis::Grid<float>* values, const std::string& what) -> Status {
     gis::WriteOptions o;
     o.metadata = {{"STRATA_MODEL_INPUT", what}};
-    return gis::writeGeoTiff((runDir / file).string(), gis::Raster{d.bed.georef, values}, o);
+    std::vector<gis::GridWindow> windows;
+    if (mine) windows.push_back({0, d.firstRow, *values});
+    return writeRaster(ranks, runDir / file, georef, o, windows);
   };
-  STRATA_TRY_STATUS(write("input/base.tif", d.input.baseM, "base elevation (m), conditioned, walls included"));
-  if (d.input.waterDepthM.size() > 0)
-    STRATA_TRY_STATUS(write("input/water.tif", d.input.waterDepthM, "initial depth (m)"));
-  if (d.input.rainMmPerHour.size() > 0) {
-    STRATA_TRY_STATUS(write("input/rain.tif", d.input.rainMmPerHour, "rain (mm/h)"));
-  }
+  STRATA_TRY_STATUS(write("input/base.tif", &d.input.baseM, "base elevation (m), conditioned, walls included"));
+  if (water) STRATA_TRY_STATUS(write("input/water.tif", &d.input.waterDepthM, "initial depth (m)"));
+  if (rain) STRATA_TRY_STATUS(write("input/rain.tif", &d.input.rainMmPerHour, "rain (mm/h)"));
   for (int k = 0; k < layers; ++k) {
-    STRATA_TRY_STATUS(write("input/layer_" + std::to_string(k + 1) + ".tif", d.input.layersM[size_t(k)],
-                            "thickness (m) of " + d.input.materials[size_t(k)].name));
+    const std::string material = d.input.materials.empty() ? std::string() : d.input.materials[size_t(k)].name;
+    STRATA_TRY_STATUS(write("input/layer_" + std::to_string(k + 1) + ".tif",
+                            mine ? &d.input.layersM[size_t(k)] : nullptr, "thickness (m) of " + material));
   }
   return {};
 }
 
+namespace {
+
+// The first `rows` rows of a rows' build (the row below, read for fill_depressions, dropped).
+void keepRows(ScenarioDomain& d, int rows) {
+  auto crop = [rows](auto& g) {
+    if (g.height > rows) {
+      g.data.resize(size_t(rows) * size_t(g.width));
+      g.height = rows;
+    }
+  };
+  crop(d.bed.values);
+  d.bed.georef.height = rows;
+  crop(d.inside);
+  crop(d.voids);
+  crop(d.cellAreaM2);
+  crop(d.input.baseM);
+  for (auto& l : d.input.layersM) crop(l);
+  crop(d.input.rainMmPerHour);
+  crop(d.input.waterDepthM);
+  d.input.rowDxM.resize(std::min(d.input.rowDxM.size(), size_t(rows)));
+}
+
+// fill_depressions over the ranks' rows, each a tile (gis::fillDepressions' phases): `d` holds
+// the rank's rows and the row below.
+Status fillOverRanks(const RowBuilder& b, const Ranks& ranks, const std::vector<gis::CellRect>& tiles, int own,
+                     ScenarioDomain& d) {
+  const auto drains = b.drains(d);
+  bool anyDrain = false;
+  for (size_t i = 0; i < size_t(own) * size_t(drains.width); ++i) anyDrain |= drains.data[i] != 0;
+  if (!ranks.minMax(anyDrain ? 1 : 0).second) return b.refuseNothingDrains();
+  const gis::FillInput in{&d.input.baseM,
+                          &d.inside,
+                          &drains,
+                          {0, d.firstRow, d.input.baseM.width, d.input.baseM.height},
+                          d.input.baseM.width};
+  const gis::TileFlood flood = gis::floodTile(in, tiles[size_t(ranks.rank())]);
+  auto edges = gis::borderEdges(in, tiles);
+  edges.insert(edges.end(), flood.edges.begin(), flood.edges.end());
+  // The labels' graph to the lead, their spill levels back.
+  ByteWriter w;
+  w.vec(edges);
+  const auto parts = ranks.gatherToLead(w.out);
+  std::string solved;
+  if (ranks.lead()) {
+    std::vector<gis::SpillEdge> all;
+    for (const auto& part : parts) {
+      ByteReader r{part};
+      std::vector<gis::SpillEdge> some;
+      r.vec(some);
+      all.insert(all.end(), some.begin(), some.end());
+    }
+    std::vector<int64_t> labels;
+    std::vector<float> levels;
+    for (const auto& [label, level] : gis::spillLevels(all)) labels.push_back(label), levels.push_back(level);
+    ByteWriter out;
+    out.vec(labels);
+    out.vec(levels);
+    solved = std::move(out.out);
+  }
+  solved = ranks.fromLead(std::move(solved));
+  ByteReader r{solved};
+  std::vector<int64_t> labels;
+  std::vector<float> levels;
+  r.vec(labels);
+  r.vec(levels);
+  if (!r.ok || labels.size() != levels.size())
+    return fail("fill_depressions: the spill levels sent by rank 0 are damaged");
+  std::vector<std::pair<int64_t, float>> spill;
+  spill.reserve(labels.size());
+  for (size_t i = 0; i < labels.size(); ++i) spill.push_back({labels[i], levels[i]});
+  b.raiseTo(gis::finishTile(in, flood, spill), own, d);
+  return {};
+}
+
+}  // namespace
+
+Result<ScenarioDomain> buildByRows(const RowBuilder& b, const Scenario& s, const Ranks& ranks, const fs::path& runDir,
+                                   bool elevation) {
+  ScenarioDomain shape = b.shape();
+  const gis::Georef grid = shape.bed.georef;
+  const int w = grid.width, h = grid.height, n = ranks.size();
+  auto firstRowOf = [&](int k) { return int((long long)h * k / n); };
+  std::vector<gis::CellRect> tiles;
+  for (int k = 0; k < n; ++k) tiles.push_back({0, firstRowOf(k), w, firstRowOf(k + 1) - firstRowOf(k)});
+  const int y0 = firstRowOf(ranks.rank()), own = firstRowOf(ranks.rank() + 1) - y0;
+  STRATA_CHECK(own > 0) << "buildByRows needs a row per rank";
+  // The row below too, for fill_depressions' joins across the border with the next rank's rows.
+  const int end = s.terrain.fillDepressions ? std::min(h, y0 + own + 1) : y0 + own;
+  float lowest = 0;
+  auto built = b.rows(y0, end, &lowest);
+  STRATA_TRY_STATUS(ranks.agree(statusOf(built)));
+  ScenarioDomain d = std::move(built).value();
+
+  // What needs every row, over this rank's own rows: voids, the lowest bed (the datum), the area,
+  // loose material.
+  const size_t cells = size_t(own) * size_t(w);
+  std::vector<sim::ExactSum> sums(2);  // voids, area
+  std::vector<double> low{1e300};
+  bool loose = false;
+  for (size_t i = 0; i < cells; ++i) {
+    if (d.voids.data[i]) sums[0].add(1);
+    if (!d.inside.data[i]) continue;
+    sums[1].add(d.cellAreaM2.data[i]);
+    low[0] = std::min(low[0], double(d.bed.values.data[i]));
+    for (const auto& l : d.input.layersM) loose |= l.data[i] > 0;
+  }
+  ranks.sum(sums);
+  ranks.min(low);
+  if (sums[0].value() > 0) return b.refuseVoids((long long)sums[0].value());
+  if (s.erosion.enabled && !ranks.minMax(loose ? 1 : 0).second) return b.refuseNoLooseMaterial();
+  shape.input.datumM = std::floor(low[0]);
+  shape.totalAreaM2 = sums[1].value();
+  d.input.datumM = shape.input.datumM;
+
+  if (s.terrain.fillDepressions) {
+    STRATA_TRY_STATUS(fillOverRanks(b, ranks, tiles, own, d));
+    std::vector<sim::ExactSum> filled(2);  // cells, volume
+    filled[0].add(d.filled.cells);
+    filled[1].add(d.filled.volumeM3);
+    ranks.sum(filled);
+    std::vector<double> deepest{d.filled.maxM};
+    ranks.max(deepest);
+    shape.filled.cells = int(filled[0].value());
+    shape.filled.volumeM3 = filled[1].value();
+    shape.filled.maxM = deepest[0];
+  }
+  keepRows(d, own);
+
+  // The levels' stages against their lowest bed, and the bed's range, over all rows.
+  std::vector<double> levelBeds = b.lowestLevelBeds(d);
+  ranks.min(levelBeds);
+  STRATA_TRY_STATUS(b.checkLevelStages(levelBeds));
+  const auto range = b.bedRange(d, own);
+  std::vector<double> lo{range[0]}, hi{range[1]};
+  ranks.min(lo);
+  ranks.max(hi);
+  shape.bedRangeM = {float(lo[0]), float(hi[0])};
+
+  // Every rank writes its rows of the model input (and of the elevation map).
+  STRATA_TRY_STATUS(writeModelInput(ranks, runDir, grid, d, int(shape.input.materials.size()), false,
+                                    shape.input.rainMmPerHour.size() > 0));
+  if (elevation) {
+    std::error_code ec;
+    if (ranks.lead()) fs::create_directories(runDir / "maps", ec);
+    STRATA_TRY_STATUS(writeRaster(ranks, runDir / "maps" / "elevation.tif", grid, {}, {{0, y0, d.bed.values}}));
+  }
+  return shape;
+}
 sim::RegionSource modelInputSource(const fs::path& runDir, const ScenarioDomain& shape) {
   sim::RegionSource region;
   region.width = shape.bed.georef.width;

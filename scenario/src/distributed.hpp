@@ -47,6 +47,11 @@ class Ranks {
   void sum(std::vector<sim::ExactSum>& sums) const;
   /// Collective: every rank's `values` (the same count on each), in rank order, on every rank.
   std::vector<double> allGather(const std::vector<double>& values) const;
+  /// Collective: each of `values` the smallest (largest) over the ranks, in place.
+  void min(std::vector<double>& values) const;
+  void max(std::vector<double>& values) const;
+  /// Collective: every rank's `bytes`, in rank order, on the lead (nothing elsewhere).
+  std::vector<std::string> gatherToLead(const std::string& bytes) const;
 
  private:
   bool distributed_ = false;
@@ -67,9 +72,23 @@ std::vector<std::string> modelInputFiles(int layers);
 /// Layers a distributed run can have (one model input file each).
 inline constexpr int kMaxInputLayers = 64;
 
-/// Writes the domain's model input (base, layers, initial water and rain raster when present) as
-/// float32 GeoTIFFs in the region's CRS into `runDir`/input (the lead, before the ranks read).
-Status writeModelInput(const std::filesystem::path& runDir, const ScenarioDomain& d);
+/// Collective: writes the model input (base, layers, initial water and rain raster when present)
+/// as float32 GeoTIFFs in the region's CRS (`georef`, the whole region's) into `runDir`/input:
+/// each rank its rows of the region, `d` (its grids' rows from d.firstRow; none: a rank with no
+/// rows, e.g. all but the lead when the lead built the whole domain). `layers`, `water` and
+/// `rain`: which files the region has (the same on every rank).
+Status writeModelInput(const Ranks& ranks, const std::filesystem::path& runDir, const gis::Georef& georef,
+                       const ScenarioDomain& d, int layers, bool water, bool rain);
+
+class RowBuilder;
+/// Collective: the domain built rows by rows over the ranks (domain_rows.hpp): rank r builds rows
+/// [r h / N, (r + 1) h / N) from its own windows of the DEM, the ranks combine the datum, the
+/// totals and the checks, fill_depressions runs tile by tile (each rank's rows a tile; the
+/// labels' graph is gathered to the lead, solved there and sent back), and every rank writes its
+/// rows of the model input and, with `elevation`, of maps/elevation.tif. Returns the domain's
+/// shape with the report's numbers, the same on every rank. Needs at least one row per rank.
+Result<ScenarioDomain> buildByRows(const RowBuilder& builder, const Scenario& s, const Ranks& ranks,
+                                   const std::filesystem::path& runDir, bool elevation);
 
 /// The region read window by window from those files (`shape` from decodeDomainShape or the
 /// lead's domain): what each rank builds its blocks from.

@@ -16,8 +16,11 @@
 #include <strata/gis/fill_nodata.hpp>
 #include <strata/gis/geodesy.hpp>
 #include <strata/gis/mosaic.hpp>
+#include <strata/sim/exact_sum.hpp>
 #include <strata/terrain/material.hpp>
 #include <strata/terrain/tile_store.hpp>
+
+#include "domain_rows.hpp"
 
 namespace strata::scenario {
 namespace {
@@ -139,6 +142,16 @@ class TerrainSource {
   /// "DEM <path>" or "store <path>", for messages.
   std::string name() const { return kind() + " " + path_; }
   std::vector<Material> materials() const { return store_ ? store_->desc().materials : terrain::defaultMaterials(); }
+  /// The materials of the store's layers, bottom first (none for DEMs).
+  std::vector<Material> layerMaterials() const {
+    std::vector<Material> out;
+    for (int f : layerFields_) {
+      out.push_back(
+          store_->desc()
+              .materials[size_t(findMaterial(store_->desc().materials, store_->desc().fields[size_t(f)].material))]);
+    }
+    return out;
+  }
 
   /// The bed elevation of `w` (base-grid cells), at the source's own resolution.
   Result<gis::Raster> readBed(const gis::CellRect& w) const {
@@ -333,14 +346,17 @@ Result<RegionFrame> regionWindow(const Scenario& s, const TerrainSource& source,
 // `ranks` MPI ranks the lead, the heaviest, first builds the whole domain and writes it as the
 // model input; during the run every rank holds a 1/ranks share (its blocks' halos add ~10% at
 // the default block sizes) of the solver, checkpoint and read-back, and the lead the pictures'.
-double bytesPerCell(int layers, int ranks) {
+// Built by rows (RowBuilder), every rank builds a 1/ranks share of the domain (and lets it go
+// before the run), and the lead holds no whole grid but the pictures'.
+double bytesPerCell(int layers, int ranks, bool byRows, bool pictures) {
   const double solver = 4.0 * (9 * 4 + 8 + 5 + layers);
   const double checkpoint = 2 * 4.0 * (4 + 4 + 4 + 8 + 4 + layers);
   const double readBack = 16 + 4 + 16 + 1 + 4.0 * (3 + layers) + 4 + 8.0 * layers;
   const double domain = 4 + 1 + 8 + 4 + 4.0 * layers + 4 + 4;
-  const double pictures = 4 + 4 + 4 + 16;
-  if (ranks <= 1) return solver + checkpoint + readBack + domain + pictures;
-  return std::max(domain, (solver + checkpoint + readBack) * 1.1 / ranks + pictures);
+  const double pictureBytes = pictures ? 4 + 4 + 4 + 16 : 0;
+  if (ranks <= 1) return solver + checkpoint + readBack + domain + pictureBytes;
+  const double run = (solver + checkpoint + readBack) * 1.1 / ranks + pictureBytes;
+  return std::max(byRows ? domain * 1.1 / ranks : domain, run);
 }
 
 // The key a message about the region's size names: cell_size when given, else the region, else
@@ -365,7 +381,8 @@ gis::Georef windowGeoref(const gis::Georef& full, const gis::CellRect& w) {
 // double, so no count overflows), at least 4 x 4 cells, and a run on it must fit in the memory
 // this process can have (`budget` bytes; 0: what the machine has available), its share of a run
 // over `ranks` MPI ranks.
-Status planGrid(const Scenario& s, const TerrainSource& source, RegionFrame& frame, uint64_t budget, int ranks) {
+Status planGrid(const Scenario& s, const TerrainSource& source, RegionFrame& frame, uint64_t budget, int ranks,
+                bool byRows, bool pictures) {
   const gis::Georef g0 = windowGeoref(source.georef(), frame.window);
   double width = g0.width, height = g0.height;
   if (s.region.cellSizeM > 0) {
@@ -395,7 +412,8 @@ Status planGrid(const Scenario& s, const TerrainSource& source, RegionFrame& fra
   const int layers = std::max<int>(1, source.layerCount() + int(s.terrain.layers.size()));
   const double cells = width * height, nativeCells = double(g0.width) * g0.height;
   // The window as read (and GDAL's copy while it resamples) comes on top.
-  const double bytes = cells * bytesPerCell(layers, ranks) + (s.region.cellSizeM > 0 ? 8 * nativeCells : 0);
+  const double native = s.region.cellSizeM > 0 ? 8 * nativeCells / (byRows ? ranks : 1) : 0;
+  const double bytes = cells * bytesPerCell(layers, ranks, byRows, pictures) + native;
   const double available = budget > 0 ? double(budget) : double(availableMemoryBytes());
   const bool tooWide = width > std::numeric_limits<int>::max() / 2 || height > std::numeric_limits<int>::max() / 2;
   if (tooWide || (available > 0 && bytes > available)) {
@@ -414,67 +432,161 @@ Status planGrid(const Scenario& s, const TerrainSource& source, RegionFrame& fra
   return {};
 }
 
+// What every build of the region starts from, read from no cell: the source, where the region
+// lies on it, the region's grid (the bed's georeference), its per-row cell sizes and the layers'
+// materials.
+struct Plan {
+  TerrainSource source;
+  PixelMapper mapper;
+  RegionFrame frame;
+  gis::Georef grid;
+  std::vector<double> rowDxM;  ///< per row: dx such that dx * dy is the row's cell area at the middle column
+  double dyM = 0;
+  std::vector<Material> materials;  ///< the store's layers, or bare rock, then the scenario's
+};
+
+// The layers' materials, bottom first: the store's, else bare rock when the scenario adds none,
+// then the scenario's [[terrain.layer]]s.
+Result<std::vector<Material>> layerMaterials(const Scenario& s, const TerrainSource& source) {
+  const auto table = source.materials();
+  std::vector<Material> out = source.layerMaterials();
+  if (out.empty() && s.terrain.layers.empty()) out.push_back(table[size_t(findMaterial(table, "rock"))]);
+  for (size_t l = 0; l < s.terrain.layers.size(); ++l) {
+    const auto& spec = s.terrain.layers[l];
+    const int m = findMaterial(table, spec.material);
+    if (m < 0) {
+      std::string names;
+      for (const auto& mat : table) names += (names.empty() ? "" : ", ") + mat.name;
+      return fail(s.at("terrain.layer[" + std::to_string(l) + "].material") + "unknown material \"" + spec.material +
+                  "\" (" + names + ")");
+    }
+    out.push_back(table[size_t(m)]);
+  }
+  return out;
+}
+
+// Steps 1 and 2, and the grid: the region's window of the source, the grid planned against
+// memory, its georeference (the window's, resampled to region.cell_size) and cell sizes.
+Result<Plan> planRegion(const Scenario& s, uint64_t budget, int ranks, bool byRows, bool pictures) {
+  STRATA_TRY(auto source, TerrainSource::open(s));
+  STRATA_TRY(auto mapper, PixelMapper::create(source.georef()));
+  STRATA_TRY(auto frame, regionWindow(s, source, mapper));
+  STRATA_TRY_STATUS(planGrid(s, source, frame, budget, ranks, byRows, pictures));
+  const gis::Georef g0 = windowGeoref(source.georef(), frame.window);
+  gis::Georef grid = g0;
+  if (s.region.cellSizeM > 0) {
+    grid.width = frame.width;
+    grid.height = frame.height;
+    grid.transform.c[1] = g0.transform.c[1] * g0.width / grid.width;
+    grid.transform.c[5] = g0.transform.c[5] * g0.height / grid.height;
+  }
+  STRATA_TRY(auto materials, layerMaterials(s, source));
+  // The cell sizes of the middle column (gis::cellAreasM2 of a window has the whole grid's bits).
+  STRATA_TRY(auto top, gis::pixelToLonLat(grid, grid.width * 0.5, 0));
+  STRATA_TRY(auto bottom, gis::pixelToLonLat(grid, grid.width * 0.5, grid.height));
+  const double dy = gis::geodesicDistanceM(top, bottom, grid.body) / grid.height;
+  STRATA_TRY(auto middle, gis::cellAreasM2(grid, {grid.width / 2, 0, 1, grid.height}));
+  std::vector<double> rowDx(size_t(grid.height));
+  for (int y = 0; y < grid.height; ++y) rowDx[size_t(y)] = middle.at(0, y) / dy;
+  return Plan{std::move(source),   std::move(mapper), std::move(frame), std::move(grid), std::move(rowDx), dy,
+              std::move(materials)};
+}
+
+// The georeference of rows [y0, y1) of a grid.
+gis::Georef rowsGeoref(const gis::Georef& grid, int y0, int y1) {
+  return windowGeoref(grid, {0, y0, grid.width, y1 - y0});
+}
+
 // Step 3b: the bed's cells without data ([terrain] voids). Every mode but "refuse" fills their bed
 // from the cells around them (GDAL's fill-nodata): "walls" then masks them out (maskRegion) and
 // "holes" drains them (placeVoidHoles).
-Status handleVoids(const Scenario& s, const TerrainSource& source, ScenarioDomain& d) {
-  const int w = d.bed.georef.width, h = d.bed.georef.height;
-  d.voids = gis::Grid<uint8_t>(w, h, 0);
+Error refuseVoids(const Scenario& s, const TerrainSource& source, long long count) {
+  (void)s;
+  return fail(source.path() + ": the region has " + std::to_string(count) +
+              " cells without data (nodata); choose a region the " + source.kind() +
+              " covers, or set [terrain] voids = \"fill\", \"walls\" or \"holes\"");
+}
+
+// The voids of the bed read (d.voids, d.voidCells).
+void findVoids(ScenarioDomain& d) {
+  d.voids = gis::Grid<uint8_t>(d.bed.values.width, d.bed.values.height, 0);
+  d.voidCells = 0;
   for (size_t i = 0; i < d.bed.values.size(); ++i) {
     if (gis::isNoData(d.bed.values.data[i])) d.voids.data[i] = 1, d.voidCells += 1;
   }
+}
+
+Status handleVoids(const Scenario& s, const TerrainSource& source, ScenarioDomain& d) {
+  findVoids(d);
   if (d.voidCells == 0) return {};
   using V = decltype(s.terrain)::Voids;
-  if (s.terrain.voids == V::kRefuse) {
-    return fail(source.path() + ": the region has " + std::to_string(d.voidCells) +
-                " cells without data (nodata); choose a region the " + source.kind() +
-                " covers, or set [terrain] voids = \"fill\", \"walls\" or \"holes\"");
-  }
+  if (s.terrain.voids == V::kRefuse) return refuseVoids(s, source, d.voidCells);
   auto filled = gis::fillVoids(d.bed.values);
   if (!filled) return fail(source.path() + ": " + filled.message());
   return {};
 }
 
-// Step 3: the bed over the window, resampled to region.cell_size (coarser cells take the lowest
-// of the cells they cover: averaging raises a canyon's narrow floor towards its rim and dams the
-// river, docs/scenario.md), mosaicked when the scenario lists several DEMs; and the store's
-// layers on the same grid.
-Status readBed(const Scenario& s, const TerrainSource& source, const RegionFrame& frame, ScenarioDomain& d,
+// Step 3: the bed of rows [y0, y1) of the region's grid (all of them for the whole region),
+// resampled to region.cell_size (coarser cells take the lowest of the cells they cover: averaging
+// raises a canyon's narrow floor towards its rim and dams the river, docs/scenario.md),
+// mosaicked when the scenario lists several DEMs; and the store's layers on the same grid. Any
+// rows have the bits the whole grid has there (gis::MosaicReader reads windows of its grid as the
+// grid has them; a native window is the DEM's own cells), but a store resampled to cell_size,
+// which is resampled whole (wholeBuildStep).
+Status readBed(const Scenario& s, const Plan& plan, int y0, int y1, ScenarioDomain& d,
                std::vector<StoredLayer>& storeLayers) {
-  STRATA_TRY(d.bed, source.readBed(frame.window));
-  STRATA_TRY(storeLayers, source.readLayers(frame.window));
-  if (s.region.cellSizeM > 0) {
-    const auto& g0 = d.bed.georef;
-    gis::Georef target = g0;
-    target.width = frame.width;
-    target.height = frame.height;
-    target.transform.c[1] = g0.transform.c[1] * g0.width / target.width;
-    target.transform.c[5] = g0.transform.c[5] * g0.height / target.height;
+  const auto& source = plan.source;
+  const auto& frame = plan.frame;
+  const gis::Georef& grid = plan.grid;
+  const bool resample = s.region.cellSizeM > 0, mosaic = s.terrain.dems.size() > 1;
+  d.firstRow = y0;
+  if (!resample || source.kind() == "store") {
+    const gis::CellRect native =
+        resample ? frame.window : gis::CellRect{frame.window.x, frame.window.y + y0, frame.window.width, y1 - y0};
+    STRATA_TRY(d.bed, source.readBed(native));
+    STRATA_TRY(storeLayers, source.readLayers(native));
+  }
+  if (resample && source.kind() == "store") {
+    STRATA_CHECK(y0 == 0 && y1 == grid.height) << "a store resampled to cell_size is built whole";
     gis::MosaicInput in = source.resampleInput(d.bed);
     in.resampling = std::min(frame.scaleX, frame.scaleY) < 1 ? gis::Resampling::Minimum : gis::Resampling::Bilinear;
-    STRATA_TRY(d.bed, gis::warpToGrid(in, target));
+    STRATA_TRY(d.bed, gis::warpToGrid(in, grid));
     // Stored layer thicknesses are averaged (bilinear): their volume is what matters, not a channel.
     for (auto& layer : storeLayers) {
-      STRATA_TRY(layer.thickness, gis::warpToGrid({"", std::move(layer.thickness)}, target));
+      STRATA_TRY(layer.thickness, gis::warpToGrid({"", std::move(layer.thickness)}, grid));
     }
+    return {};
   }
-  if (s.terrain.dems.size() > 1) {
-    std::vector<gis::MosaicInput> inputs;
+  if (!resample && !mosaic) return {};
+  std::vector<gis::MosaicInput> inputs;
+  if (mosaic) {
     for (const auto& p : s.terrain.dems) {
-      gis::MosaicInput in = source.resampleInput(d.bed, p);
+      gis::MosaicInput in = source.resampleInput({}, p);
       in.mode = gis::BlendMode::Replace;
       in.resampling = gis::Resampling::MinimumIfCoarser;  // the lowest-elevation rule, as above
       inputs.push_back(std::move(in));
     }
-    STRATA_TRY(auto layer, gis::buildMosaic("bedrock", d.bed.georef, inputs));
-    d.bed = std::move(layer.raster);
+  } else {
+    gis::MosaicInput in = source.resampleInput({});
+    in.resampling = std::min(frame.scaleX, frame.scaleY) < 1 ? gis::Resampling::Minimum : gis::Resampling::Bilinear;
+    inputs.push_back(std::move(in));
   }
-  return handleVoids(s, source, d);
+  STRATA_TRY(auto reader, gis::MosaicReader::open(std::move(inputs), grid));
+  d.bed.georef = rowsGeoref(grid, y0, y1);
+  STRATA_TRY(d.bed.values, reader.read({0, y0, grid.width, y1 - y0}));
+  return {};
 }
 
-// Step 4: the region mask: a polygon's outside becomes a wall.
+// The rows [y0, y0 + height) of a raster warped onto the region's grid (a rain or layer raster):
+// the whole warp's bits there.
+Result<gis::Grid<float>> readRows(const std::string& path, const gis::Georef& grid, int y0, int height) {
+  STRATA_TRY(auto reader, gis::MosaicReader::open({gis::MosaicInput{path}}, grid));
+  return reader.read({0, y0, grid.width, height});
+}
+
+// Step 4: the region mask: a polygon's outside becomes a wall (the mask of rows from firstRow).
 void maskRegion(const Scenario& s, const RegionFrame& frame, ScenarioDomain& d) {
-  const int w = d.bed.georef.width, h = d.bed.georef.height;
+  const int w = d.bed.values.width, h = d.bed.values.height;
   d.inside = gis::Grid<uint8_t>(w, h, 1);
   if (s.terrain.voids == decltype(s.terrain)::Voids::kWalls) {
     for (size_t i = 0; i < d.inside.size(); ++i) d.inside.data[i] = d.voids.data[i] ? 0 : 1;
@@ -483,20 +595,23 @@ void maskRegion(const Scenario& s, const RegionFrame& frame, ScenarioDomain& d) 
   const auto poly = frame.toRegion(frame.polygonPx);
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
-      if (!insidePolygon(poly, x + 0.5, y + 0.5)) d.inside.at(x, y) = 0;
+      if (!insidePolygon(poly, x + 0.5, d.firstRow + y + 0.5)) d.inside.at(x, y) = 0;
     }
   }
 }
 
-// Step 5: geodesic cell sizes and the region's area.
-Status measureRegion(ScenarioDomain& d) {
-  STRATA_TRY(auto sizes, measureCells(d.bed.georef));
-  d.cellAreaM2 = std::move(sizes.cellAreaM2);
-  d.input.dyM = sizes.dyM;
-  d.input.rowDxM = std::move(sizes.rowDxM);
+// Step 5: geodesic cell sizes (the plan's per-row sizes; each cell's area, with the whole grid's
+// bits) and the area of the region's cells (an exact sum: the same over any rows).
+Status measureRegion(const Plan& plan, ScenarioDomain& d) {
+  const int h = d.bed.values.height;
+  STRATA_TRY(d.cellAreaM2, gis::cellAreasM2(plan.grid, {0, d.firstRow, plan.grid.width, h}));
+  d.input.dyM = plan.dyM;
+  d.input.rowDxM.assign(plan.rowDxM.begin() + d.firstRow, plan.rowDxM.begin() + d.firstRow + h);
+  sim::ExactSum area;
   for (size_t i = 0; i < d.inside.size(); ++i) {
-    if (d.inside.data[i]) d.totalAreaM2 += d.cellAreaM2.data[i];
+    if (d.inside.data[i]) area.add(d.cellAreaM2.data[i]);
   }
+  d.totalAreaM2 = area.value();
   return {};
 }
 
@@ -550,128 +665,149 @@ void settleAtRest(const Scenario& s, ScenarioDomain& d) {
   }
 }
 
-// Step 6: base and layers. The datum is the region's lowest point, so float32 keeps millimetres;
-// cells outside a polygon become walls.
-Status stackLayers(const Scenario& s, const TerrainSource& source, std::vector<StoredLayer>& storeLayers,
-                   ScenarioDomain& d) {
-  const gis::Georef& g = d.bed.georef;
-  const int w = g.width, h = g.height;
+// Step 6: base and layers (of the rows read). Cells outside a polygon become walls. Returns the
+// lowest bed of the region's cells: the datum is the region's lowest point (floored), so float32
+// keeps millimetres.
+Result<float> stackLayers(const Scenario& s, const Plan& plan, std::vector<StoredLayer>& storeLayers,
+                          ScenarioDomain& d) {
+  const int w = d.bed.values.width, h = d.bed.values.height;
   float lo = 1e30f;
   for (size_t i = 0; i < d.bed.values.size(); ++i) {
     if (d.inside.data[i]) lo = std::min(lo, d.bed.values.data[i]);
   }
-  d.input.datumM = std::floor(double(lo));
   d.input.baseM = d.bed.values;
   for (size_t i = 0; i < d.input.baseM.size(); ++i) {
     if (!d.inside.data[i]) d.input.baseM.data[i] = kWallElevationM;
   }
-  const auto table = source.materials();
+  d.input.materials = plan.materials;
   for (auto& layer : storeLayers) {
     gis::Grid<float> thickness = std::move(layer.thickness.values);
     for (auto& v : thickness.data) v = gis::isNoData(v) ? 0.0f : std::max(0.0f, v);
     d.input.layersM.push_back(std::move(thickness));
-    d.input.materials.push_back(table[size_t(layer.material)]);
   }
-  if (d.input.layersM.empty() && s.terrain.layers.empty()) {
-    // Bare rock: one layer of zero thickness so erosion has a material to read.
-    d.input.layersM.push_back(gis::Grid<float>(w, h, 0.0f));
-    d.input.materials.push_back(table[size_t(findMaterial(table, "rock"))]);
-  }
-  for (size_t l = 0; l < s.terrain.layers.size(); ++l) {
-    const auto& spec = s.terrain.layers[l];
-    const int m = findMaterial(table, spec.material);
-    if (m < 0) {
-      std::string names;
-      for (const auto& mat : table) names += (names.empty() ? "" : ", ") + mat.name;
-      return fail(s.at("terrain.layer[" + std::to_string(l) + "].material") + "unknown material \"" + spec.material +
-                  "\" (" + names + ")");
-    }
+  // Bare rock: one layer of zero thickness so erosion has a material to read.
+  if (d.input.layersM.empty() && s.terrain.layers.empty()) d.input.layersM.push_back(gis::Grid<float>(w, h, 0.0f));
+  for (const auto& spec : s.terrain.layers) {
     gis::Grid<float> thickness(w, h, float(spec.thicknessM));
     if (!spec.raster.empty()) {
-      STRATA_TRY(auto r, gis::warpToGrid({spec.raster, std::nullopt}, g));
+      STRATA_TRY(auto r, readRows(spec.raster, plan.grid, d.firstRow, h));
       for (size_t i = 0; i < thickness.size(); ++i) {
-        const float v = r.values.data[i];
+        const float v = r.data[i];
         thickness.data[i] = gis::isNoData(v) ? 0.0f : std::max(0.0f, v);
       }
     }
     d.input.layersM.push_back(std::move(thickness));
-    d.input.materials.push_back(table[size_t(m)]);
   }
-  settleAtRest(s, d);
-  return {};
+  return lo;
 }
+
+// Which cells of the region's grid are the region's: the mask (a whole build), or the polygon
+// alone (rows built apart, where no void makes a wall: wholeBuildStep).
+struct RegionCells {
+  int width = 0, height = 0;
+  const gis::Grid<uint8_t>* mask = nullptr;
+  std::vector<std::array<double, 2>> polygon;  ///< region cells; empty: every cell
+  bool inside(int x, int y) const {
+    return mask ? mask->at(x, y) != 0 : polygon.empty() || insidePolygon(polygon, x + 0.5, y + 0.5);
+  }
+};
 
 // The region cells of a line's points, which must lie inside the region (`what` names it).
 Result<std::vector<std::pair<int, int>>> lineCells(const Scenario& s, const Place& place,
                                                    const std::vector<std::array<double, 2>>& px,
-                                                   const ScenarioDomain& d, const std::string& what) {
-  const int w = d.inside.width, h = d.inside.height;
+                                                   const RegionCells& region, const std::string& what) {
+  const int w = region.width, h = region.height;
   for (const auto& pt : px) {
     if (!(pt[0] >= 0 && pt[1] >= 0 && pt[0] < w && pt[1] < h) ||
-        !d.inside.at(int(std::floor(pt[0])), int(std::floor(pt[1])))) {
+        !region.inside(int(std::floor(pt[0])), int(std::floor(pt[1])))) {
       return placeError(s, place, what + " is outside the region");
     }
   }
   auto cells = cellsAlong(px, w, h);
-  std::erase_if(cells, [&](auto c) { return !d.inside.at(c.first, c.second); });
+  std::erase_if(cells, [&](auto c) { return !region.inside(c.first, c.second); });
   return cells;
 }
 
-// The region cells whose centres lie inside a polygon.
-std::vector<std::pair<int, int>> polygonCells(const std::vector<std::array<double, 2>>& px, const ScenarioDomain& d) {
+// The region cells whose centres lie inside a polygon (only its bounding box is scanned).
+std::vector<std::pair<int, int>> polygonCells(const std::vector<std::array<double, 2>>& px, const RegionCells& region) {
+  double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300;
+  for (const auto& p : px) {
+    x0 = std::min(x0, p[0]), x1 = std::max(x1, p[0]);
+    y0 = std::min(y0, p[1]), y1 = std::max(y1, p[1]);
+  }
   std::vector<std::pair<int, int>> cells;
-  for (int y = 0; y < d.inside.height; ++y) {
-    for (int x = 0; x < d.inside.width; ++x) {
-      if (d.inside.at(x, y) && insidePolygon(px, x + 0.5, y + 0.5)) cells.push_back({x, y});
+  if (!(x1 >= 0 && y1 >= 0 && x0 <= region.width && y0 <= region.height)) return cells;  // outside (or NaN)
+  const int cx0 = std::max(0, int(std::floor(x0))), cy0 = std::max(0, int(std::floor(y0)));
+  const int cx1 = std::min(region.width, int(std::ceil(x1)) + 1), cy1 = std::min(region.height, int(std::ceil(y1)) + 1);
+  for (int y = cy0; y < cy1; ++y) {
+    for (int x = cx0; x < cx1; ++x) {
+      if (region.inside(x, y) && insidePolygon(px, x + 0.5, y + 0.5)) cells.push_back({x, y});
     }
   }
   return cells;
 }
 
 // Step 8: inflows on the cells of their point or line.
-Status placeInflows(const Scenario& s, const PixelMapper& mapper, const RegionFrame& frame, ScenarioDomain& d) {
+Status placeInflows(const Scenario& s, const Plan& plan, const RegionCells& region, ScenarioDomain& d) {
   for (const auto& in : s.water.inflows) {
-    STRATA_TRY(auto demPx, mapper.pixels(s, in.place));
-    STRATA_TRY(auto cells, lineCells(s, in.place, frame.toRegion(demPx), d, "the source \"" + in.name + "\""));
+    STRATA_TRY(auto demPx, plan.mapper.pixels(s, in.place));
+    STRATA_TRY(auto cells,
+               lineCells(s, in.place, plan.frame.toRegion(demPx), region, "the source \"" + in.name + "\""));
     d.sources.push_back(sim::Source{std::move(cells), in.hydrograph});
     d.sourceNames.push_back(in.name);
   }
   return {};
 }
 
-// Step 9: fixed levels on the cells of a line or a polygon, with a stage that rises above the bed
-// of at least one of them.
-Status placeLevels(const Scenario& s, const PixelMapper& mapper, const RegionFrame& frame, ScenarioDomain& d) {
-  for (size_t i = 0; i < s.water.levels.size(); ++i) {
-    const auto& lv = s.water.levels[i];
-    STRATA_TRY(auto demPx, mapper.pixels(s, lv.place));
-    const auto px = frame.toRegion(demPx);
+// Step 9: fixed levels on the cells of a line or a polygon.
+Status placeLevels(const Scenario& s, const Plan& plan, const RegionCells& region, ScenarioDomain& d) {
+  for (const auto& lv : s.water.levels) {
+    STRATA_TRY(auto demPx, plan.mapper.pixels(s, lv.place));
+    const auto px = plan.frame.toRegion(demPx);
     sim::LevelBoundary level{{}, lv.stage};
     if (lv.polygon) {
-      level.cells = polygonCells(px, d);
+      level.cells = polygonCells(px, region);
       if (level.cells.empty()) {
         return placeError(s, lv.place, "the level \"" + lv.name + "\" covers no cell of the region");
       }
     } else {
-      STRATA_TRY(level.cells, lineCells(s, lv.place, px, d, "the level \"" + lv.name + "\""));
+      STRATA_TRY(level.cells, lineCells(s, lv.place, px, region, "the level \"" + lv.name + "\""));
     }
-    double lowestBed = 1e300, highestStage = -1e300;
-    for (auto [x, y] : level.cells) {
-      double b = d.input.baseM.at(x, y);
-      for (const auto& l : d.input.layersM) b += l.at(x, y);
-      lowestBed = std::min(lowestBed, b);
+    d.levels.push_back(std::move(level));
+    d.levelNames.push_back(lv.name);
+  }
+  return {};
+}
+
+// The lowest bed (base and layers) of each of the scenario's levels over the cells of `d`'s rows
+// (1e300 for a level with none there).
+std::vector<double> lowestLevelBeds(const Scenario& s, const ScenarioDomain& shape, const ScenarioDomain& d) {
+  std::vector<double> lowest(s.water.levels.size(), 1e300);
+  const int h = d.input.baseM.height;
+  for (size_t i = 0; i < lowest.size(); ++i) {
+    for (auto [x, y] : shape.levels[i].cells) {
+      if (y < d.firstRow || y >= d.firstRow + h) continue;
+      double b = d.input.baseM.at(x, y - d.firstRow);
+      for (const auto& l : d.input.layersM) b += l.at(x, y - d.firstRow);
+      lowest[i] = std::min(lowest[i], b);
     }
-    for (const auto& st : lv.stage.samples()) highestStage = std::max(highestStage, st[1]);
-    if (highestStage <= lowestBed) {
+  }
+  return lowest;
+}
+
+// Each level's stage must rise above the bed of at least one of its cells.
+Status checkLevelStages(const Scenario& s, const std::vector<double>& lowestBed) {
+  for (size_t i = 0; i < s.water.levels.size(); ++i) {
+    double highestStage = -1e300;
+    for (const auto& st : s.water.levels[i].stage.samples()) highestStage = std::max(highestStage, st[1]);
+    if (highestStage <= lowestBed[i]) {
       char msg[200];
       std::snprintf(msg, sizeof msg,
                     "the stage (at most %.2f m) never rises above the bed of the level's cells (lowest %.2f m): "
                     "it would hold no water",
-                    highestStage, lowestBed);
+                    highestStage, lowestBed[i]);
       return fail(s.at("water.level[" + std::to_string(i) + "].stage") + msg);
     }
-    d.levels.push_back(std::move(level));
-    d.levelNames.push_back(lv.name);
   }
   return {};
 }
@@ -693,11 +829,12 @@ void placeVoidHoles(const Scenario& s, ScenarioDomain& d) {
   d.levelNames.push_back("voids (holes)");
 }
 
-// Step 10: rain, uniform for a span of time or as a raster of multipliers for the whole run.
-Status placeRain(const Scenario& s, ScenarioDomain& d) {
+// Step 10: rain, uniform for a span of time or as a raster of multipliers for the whole run (the
+// raster's rows of `d`).
+Status placeRain(const Scenario& s, const Plan& plan, ScenarioDomain& d) {
   if (!s.water.rain) return {};
-  const gis::Georef& g = d.bed.georef;
-  d.rainMmPerHour = s.water.rain->rateMPerS * 3.6e6;
+  const double rate = s.water.rain->rateMPerS * 3.6e6;
+  d.rainMmPerHour = rate;
   d.rainStartS = s.water.rain->startS;
   d.rainEndS = s.water.rain->endS < 0 ? s.durationS : s.water.rain->endS;
   if (s.water.rain->raster.empty()) return {};
@@ -705,23 +842,25 @@ Status placeRain(const Scenario& s, ScenarioDomain& d) {
     return fail(s.at("water.rain.raster") +
                 "a rain raster falls for the whole run; start and end apply to a uniform rate only");
   }
-  STRATA_TRY(auto r, gis::warpToGrid({s.water.rain->raster, std::nullopt}, g));
-  d.input.rainMmPerHour = gis::Grid<float>(g.width, g.height, 0.0f);
-  for (size_t i = 0; i < r.values.size(); ++i) {
-    const float v = r.values.data[i];
-    d.input.rainMmPerHour.data[i] = gis::isNoData(v) ? 0.0f : float(std::max(0.0f, v) * d.rainMmPerHour);
-  }
   d.rainMmPerHour = 0;  // the raster carries the rate
+  const int h = d.bed.values.height;
+  if (h == 0) return {};  // a shape: no rows
+  STRATA_TRY(auto r, readRows(s.water.rain->raster, plan.grid, d.firstRow, h));
+  d.input.rainMmPerHour = gis::Grid<float>(plan.grid.width, h, 0.0f);
+  for (size_t i = 0; i < r.size(); ++i) {
+    const float v = r.data[i];
+    d.input.rainMmPerHour.data[i] = gis::isNoData(v) ? 0.0f : float(std::max(0.0f, v) * rate);
+  }
   return {};
 }
 
 // Step 11: dam breaks: water standing up to the given surface inside each polygon.
-Status placeDamBreaks(const Scenario& s, const PixelMapper& mapper, const RegionFrame& frame, ScenarioDomain& d) {
-  const int w = d.bed.georef.width, h = d.bed.georef.height;
+Status placeDamBreaks(const Scenario& s, const Plan& plan, const RegionCells& region, ScenarioDomain& d) {
+  const int w = d.bed.values.width, h = d.bed.values.height;
   for (size_t i = 0; i < s.water.damBreaks.size(); ++i) {
     const auto& db = s.water.damBreaks[i];
-    STRATA_TRY(auto demPx, mapper.pixels(s, db.polygon));
-    const auto cells = polygonCells(frame.toRegion(demPx), d);
+    STRATA_TRY(auto demPx, plan.mapper.pixels(s, db.polygon));
+    const auto cells = polygonCells(plan.frame.toRegion(demPx), region);
     if (cells.empty()) return placeError(s, db.polygon, "the dam-break polygon covers no cell of the region");
     if (d.input.waterDepthM.size() == 0) d.input.waterDepthM = gis::Grid<float>(w, h, 0.0f);
     float lowestBed = std::numeric_limits<float>::max();
@@ -740,21 +879,26 @@ Status placeDamBreaks(const Scenario& s, const PixelMapper& mapper, const Region
     }
   }
   if (d.input.waterDepthM.size() > 0) {
+    sim::ExactSum volume;
     for (int y = 0; y < h; ++y) {
-      for (int x = 0; x < w; ++x) d.damBreakVolumeM3 += double(d.input.waterDepthM.at(x, y)) * d.cellAreaM2.at(x, y);
+      for (int x = 0; x < w; ++x) volume.add(double(d.input.waterDepthM.at(x, y)) * d.cellAreaM2.at(x, y));
     }
+    d.damBreakVolumeM3 = volume.value();
   }
   return {};
 }
 
 // Erosion moves loose material: on bare bedrock (no layer, or layers of no thickness over the
 // region) it would run and change nothing, so it is refused.
-Status requireLooseMaterial(const Scenario& s, const ScenarioDomain& d) {
+bool hasLooseMaterial(const ScenarioDomain& d) {
   for (const auto& layer : d.input.layersM) {
     for (size_t i = 0; i < layer.size(); ++i) {
-      if (d.inside.data[i] && layer.data[i] > 0) return {};
+      if (d.inside.data[i] && layer.data[i] > 0) return true;
     }
   }
+  return false;
+}
+Error refuseNoLooseMaterial(const Scenario& s) {
   return fail(s.at("terrain") +
               "erosion needs loose material, and the terrain has none over the region (add a [[terrain.layer]] with "
               "a material and a thickness, docs/scenario.md)");
@@ -875,42 +1019,72 @@ Status breachInflowPaths(const Scenario& s, ScenarioDomain& d) {
   return {};
 }
 
-// [terrain] fill_depressions: every cell not draining to an open edge is raised to the level at
-// which it would spill (priority flood from the open edges, Barnes et al. 2014; gis::fillDepressions,
-// which also runs tile by tile), so that no water is lost filling the pits a coarse DEM has where
-// the real ground has none. Cells outside a polygon region are walls and are not crossed.
-Status fillDepressions(const Scenario& s, ScenarioDomain& d) {
-  if (!s.terrain.fillDepressions) return {};
-  const int w = d.bed.georef.width, h = d.bed.georef.height;
+// Where fill_depressions' floods start: the region's cells on an open edge, and voids that are
+// holes (the rows of `d`, of a region `height` rows high).
+gis::Grid<uint8_t> drainCells(const Scenario& s, const ScenarioDomain& d, int height) {
+  const int w = d.inside.width, h = d.inside.height;
   const auto& open = s.model.boundaries;  // W E S N
-  auto& z = d.input.baseM;
   gis::Grid<uint8_t> drains(w, h, 0);
-  bool any = false;
   for (int y = 0; y < h; ++y) {
+    const int gy = d.firstRow + y;
     for (int x = 0; x < w; ++x) {
       const size_t c = size_t(y) * size_t(w) + size_t(x);
       const bool edge = (x == 0 && open[0] == Boundary::Open) || (x == w - 1 && open[1] == Boundary::Open) ||
-                        (y == h - 1 && open[2] == Boundary::Open) || (y == 0 && open[3] == Boundary::Open);
+                        (gy == height - 1 && open[2] == Boundary::Open) || (gy == 0 && open[3] == Boundary::Open);
       const bool hole = s.terrain.voids == decltype(s.terrain)::Voids::kHoles && d.voids.data[c];
-      drains.data[c] = edge || hole ? 1 : 0;
-      any |= (edge || hole) && d.inside.data[c];
+      drains.data[c] = (edge || hole) && d.inside.data[c] ? 1 : 0;
     }
   }
-  if (!any) {
-    return fail(s.at("terrain.fill_depressions") +
-                "no edge is open (model.boundary) and no void is a hole: nothing drains");
-  }
-  const gis::Grid<float> filled = gis::fillDepressions({&z, &d.inside, &drains}, {{0, 0, w, h}});
-  for (size_t c = 0; c < z.size(); ++c) {
-    if (!(filled.data[c] > z.data[c])) continue;
-    const double raised = double(filled.data[c]) - double(z.data[c]);
+  return drains;
+}
+Error refuseNothingDrains(const Scenario& s) {
+  return fail(s.at("terrain.fill_depressions") +
+              "no edge is open (model.boundary) and no void is a hole: nothing drains");
+}
+
+// Raises the cells of `d` (its first `rows` rows) to `filled` where that is higher, counting what
+// was raised.
+void raiseTo(const gis::Grid<float>& filled, int rows, ScenarioDomain& d) {
+  sim::ExactSum volume;
+  const size_t n = size_t(rows) * size_t(d.input.baseM.width);
+  for (size_t c = 0; c < n; ++c) {
+    if (!(filled.data[c] > d.input.baseM.data[c])) continue;
+    const double raised = double(filled.data[c]) - double(d.input.baseM.data[c]);
     d.filled.cells += 1;
     d.filled.maxM = std::max(d.filled.maxM, raised);
-    d.filled.volumeM3 += raised * d.cellAreaM2.data[c];
-    z.data[c] = filled.data[c];
+    volume.add(raised * d.cellAreaM2.data[c]);
+    d.input.baseM.data[c] = filled.data[c];
     d.bed.values.data[c] = filled.data[c];
   }
+  d.filled.volumeM3 = volume.value();
+}
+
+// [terrain] fill_depressions: every cell not draining to an open edge is raised to the level at
+// which it would spill (priority flood from the open edges, Barnes et al. 2014; gis::fillDepressions,
+// which also runs tile by tile over MPI ranks), so that no water is lost filling the pits a coarse
+// DEM has where the real ground has none. Cells outside a polygon region are walls and are not
+// crossed.
+Status fillDepressions(const Scenario& s, ScenarioDomain& d) {
+  if (!s.terrain.fillDepressions) return {};
+  const int w = d.inside.width, h = d.inside.height;
+  const auto drains = drainCells(s, d, h);
+  if (std::none_of(drains.data.begin(), drains.data.end(), [](uint8_t v) { return v != 0; })) {
+    return refuseNothingDrains(s);
+  }
+  raiseTo(gis::fillDepressions({&d.input.baseM, &d.inside, &drains}, {{0, 0, w, h}}), h, d);
   return {};
+}
+
+// The lowest and highest bed of the region's cells of `d`'s first `rows` rows.
+std::array<float, 2> bedRange(const ScenarioDomain& d, int rows) {
+  std::array<float, 2> r{std::numeric_limits<float>::max(), std::numeric_limits<float>::lowest()};
+  const size_t n = size_t(rows) * size_t(d.bed.values.width);
+  for (size_t i = 0; i < n; ++i) {
+    if (!d.inside.data[i]) continue;
+    r[0] = std::min(r[0], d.bed.values.data[i]);
+    r[1] = std::max(r[1], d.bed.values.data[i]);
+  }
+  return r;
 }
 
 }  // namespace
@@ -952,33 +1126,118 @@ sim::SimParams modelParams(const Scenario& s) {
 }
 
 Result<ScenarioDomain> buildDomain(const Scenario& s, uint64_t memoryBudgetBytes, int ranks) {
-  STRATA_TRY(auto source, TerrainSource::open(s));
-  STRATA_TRY(auto mapper, PixelMapper::create(source.georef()));
-  STRATA_TRY(auto frame, regionWindow(s, source, mapper));
-  STRATA_TRY_STATUS(planGrid(s, source, frame, memoryBudgetBytes, ranks));
+  STRATA_TRY(auto plan, planRegion(s, memoryBudgetBytes, ranks, false, true));
+  const int h = plan.grid.height;
   ScenarioDomain d;
   std::vector<StoredLayer> storeLayers;
-  STRATA_TRY_STATUS(readBed(s, source, frame, d, storeLayers));
-  maskRegion(s, frame, d);
-  STRATA_TRY_STATUS(measureRegion(d));
-  STRATA_TRY_STATUS(stackLayers(s, source, storeLayers, d));
-  if (s.erosion.enabled) STRATA_TRY_STATUS(requireLooseMaterial(s, d));
+  STRATA_TRY_STATUS(readBed(s, plan, 0, h, d, storeLayers));
+  STRATA_TRY_STATUS(handleVoids(s, plan.source, d));
+  maskRegion(s, plan.frame, d);
+  STRATA_TRY_STATUS(measureRegion(plan, d));
+  STRATA_TRY(const float lowest, stackLayers(s, plan, storeLayers, d));
+  d.input.datumM = std::floor(double(lowest));
+  settleAtRest(s, d);
+  if (s.erosion.enabled && !hasLooseMaterial(d)) return refuseNoLooseMaterial(s);
   d.params = modelParams(s);
   STRATA_TRY_STATUS(checkModelParams(s, d.params));
-  STRATA_TRY_STATUS(placeInflows(s, mapper, frame, d));
+  const RegionCells region{plan.grid.width, h, &d.inside, {}};
+  STRATA_TRY_STATUS(placeInflows(s, plan, region, d));
   STRATA_TRY_STATUS(breachInflowPaths(s, d));
   STRATA_TRY_STATUS(fillDepressions(s, d));
-  STRATA_TRY_STATUS(placeLevels(s, mapper, frame, d));
+  STRATA_TRY_STATUS(placeLevels(s, plan, region, d));
+  STRATA_TRY_STATUS(checkLevelStages(s, lowestLevelBeds(s, d, d)));
   placeVoidHoles(s, d);
-  STRATA_TRY_STATUS(placeRain(s, d));
-  STRATA_TRY_STATUS(placeDamBreaks(s, mapper, frame, d));
-  d.bedRangeM = {std::numeric_limits<float>::max(), std::numeric_limits<float>::lowest()};
-  for (size_t i = 0; i < d.bed.values.size(); ++i) {
-    if (!d.inside.data[i]) continue;
-    d.bedRangeM[0] = std::min(d.bedRangeM[0], d.bed.values.data[i]);
-    d.bedRangeM[1] = std::max(d.bedRangeM[1], d.bed.values.data[i]);
-  }
+  STRATA_TRY_STATUS(placeRain(s, plan, d));
+  STRATA_TRY_STATUS(placeDamBreaks(s, plan, region, d));
+  d.bedRangeM = bedRange(d, h);
   return d;
 }
+
+// ---- Built rows by rows -------------------------------------------------------------------------
+
+namespace detail {
+
+std::string wholeBuildStep(const Scenario& s) {
+  if (s.terrain.breachInflows) return "terrain.breach_inflows";
+  for (size_t l = 0; l < s.terrain.layers.size(); ++l) {
+    if (s.terrain.layers[l].atRest) return "terrain.layer[" + std::to_string(l) + "].at_rest";
+  }
+  if (s.terrain.voids != decltype(s.terrain)::Voids::kRefuse) return "terrain.voids";
+  if (!s.terrain.store.empty() && s.region.cellSizeM > 0) return "region.cell_size";
+  if (!s.water.damBreaks.empty()) return "water.dam_break";
+  return {};
+}
+
+struct RowBuilder::Impl {
+  const Scenario& s;
+  Plan plan;
+  ScenarioDomain shape;
+};
+
+RowBuilder::RowBuilder(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+RowBuilder::RowBuilder(RowBuilder&&) noexcept = default;
+RowBuilder::~RowBuilder() = default;
+
+Result<RowBuilder> RowBuilder::plan(const Scenario& s, uint64_t memoryBudgetBytes, int ranks, bool pictures) {
+  const std::string step = wholeBuildStep(s);
+  STRATA_CHECK(step.empty()) << step << " needs the whole region: RowBuilder cannot build it";
+  STRATA_TRY(auto plan, planRegion(s, memoryBudgetBytes, ranks, true, pictures));
+  ScenarioDomain shape;
+  shape.bed.georef = plan.grid;
+  shape.input.rowDxM = plan.rowDxM;
+  shape.input.dyM = plan.dyM;
+  shape.input.materials = plan.materials;
+  shape.params = modelParams(s);
+  STRATA_TRY_STATUS(checkModelParams(s, shape.params));
+  const RegionCells region{
+      plan.grid.width, plan.grid.height, nullptr,
+      plan.frame.polygonPx.empty() ? std::vector<std::array<double, 2>>{} : plan.frame.toRegion(plan.frame.polygonPx)};
+  STRATA_TRY_STATUS(placeInflows(s, plan, region, shape));
+  STRATA_TRY_STATUS(placeLevels(s, plan, region, shape));
+  STRATA_TRY_STATUS(placeRain(s, plan, shape));
+  // A one-cell marker, as decodeDomainShape leaves: the rows have a rain raster.
+  if (s.water.rain && !s.water.rain->raster.empty()) shape.input.rainMmPerHour = gis::Grid<float>(1, 1, 0.0f);
+  return RowBuilder(std::make_unique<Impl>(Impl{s, std::move(plan), std::move(shape)}));
+}
+
+const ScenarioDomain& RowBuilder::shape() const { return impl_->shape; }
+
+Result<ScenarioDomain> RowBuilder::rows(int y0, int y1, float* lowestBed) const {
+  const Scenario& s = impl_->s;
+  const Plan& plan = impl_->plan;
+  ScenarioDomain d;
+  std::vector<StoredLayer> storeLayers;
+  STRATA_TRY_STATUS(readBed(s, plan, y0, y1, d, storeLayers));
+  findVoids(d);
+  maskRegion(s, plan.frame, d);
+  STRATA_TRY_STATUS(measureRegion(plan, d));
+  STRATA_TRY(*lowestBed, stackLayers(s, plan, storeLayers, d));
+  STRATA_TRY_STATUS(placeRain(s, plan, d));
+  return d;
+}
+
+Error RowBuilder::refuseVoids(long long count) const {
+  return scenario::refuseVoids(impl_->s, impl_->plan.source, count);
+}
+bool RowBuilder::hasLooseMaterial(const ScenarioDomain& d) const { return scenario::hasLooseMaterial(d); }
+Error RowBuilder::refuseNoLooseMaterial() const { return scenario::refuseNoLooseMaterial(impl_->s); }
+gis::Grid<uint8_t> RowBuilder::drains(const ScenarioDomain& d) const {
+  return drainCells(impl_->s, d, impl_->plan.grid.height);
+}
+Error RowBuilder::refuseNothingDrains() const { return scenario::refuseNothingDrains(impl_->s); }
+void RowBuilder::raiseTo(const gis::Grid<float>& filled, int rows, ScenarioDomain& d) const {
+  scenario::raiseTo(filled, rows, d);
+}
+std::vector<double> RowBuilder::lowestLevelBeds(const ScenarioDomain& d) const {
+  return scenario::lowestLevelBeds(impl_->s, impl_->shape, d);
+}
+Status RowBuilder::checkLevelStages(const std::vector<double>& lowestBed) const {
+  return scenario::checkLevelStages(impl_->s, lowestBed);
+}
+std::array<float, 2> RowBuilder::bedRange(const ScenarioDomain& d, int rows) const {
+  return scenario::bedRange(d, rows);
+}
+
+}  // namespace detail
 
 }  // namespace strata::scenario

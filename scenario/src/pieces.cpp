@@ -35,18 +35,13 @@ Result<std::vector<Piece>> readPieces(const sim::Solver& solver, const InputWind
   return pieces;
 }
 
-Status writeMapFile(const Ranks& ranks, const fs::path& file, const gis::Georef& georef,
-                    const gis::WriteOptions& options, const std::vector<Piece>& pieces,
-                    const std::function<gis::Grid<float>(const Piece&)>& values) {
+Status writeRaster(const Ranks& ranks, const fs::path& file, const gis::Georef& georef,
+                   const gis::WriteOptions& options, const std::vector<gis::GridWindow>& windows) {
   const std::string tmp = ranks.fromLead(ranks.lead() ? temporaryPathFor(file).string() : std::string());
   STRATA_TRY_STATUS(ranks.agree(ranks.lead() ? gis::createGeoTiff(tmp, georef, options) : Status{}));
   for (int r = 0; r < ranks.size(); ++r) {
     Status status;
-    if (r == ranks.rank()) {
-      std::vector<gis::GridWindow> windows;
-      for (const auto& p : pieces) windows.push_back({p.rect.x, p.rect.y, values(p)});
-      status = gis::writeGeoTiffWindows(tmp, windows, options.nodata);
-    }
+    if (r == ranks.rank() && !windows.empty()) status = gis::writeGeoTiffWindows(tmp, windows, options.nodata);
     status = ranks.agree(status);
     if (!status.ok()) {
       if (ranks.lead()) fs::remove(tmp);
@@ -54,6 +49,14 @@ Status writeMapFile(const Ranks& ranks, const fs::path& file, const gis::Georef&
     }
   }
   return ranks.agree(ranks.lead() ? commitTemporary(tmp, file) : Status{});
+}
+
+Status writeMapFile(const Ranks& ranks, const fs::path& file, const gis::Georef& georef,
+                    const gis::WriteOptions& options, const std::vector<Piece>& pieces,
+                    const std::function<gis::Grid<float>(const Piece&)>& values) {
+  std::vector<gis::GridWindow> windows;
+  for (const auto& p : pieces) windows.push_back({p.rect.x, p.rect.y, values(p)});
+  return writeRaster(ranks, file, georef, options, windows);
 }
 
 bool beats(const Extreme& a, const Extreme& b) {

@@ -40,9 +40,14 @@ using InputWindow = std::function<Result<sim::SimInput>(const gis::CellRect&)>;
 Result<std::vector<Piece>> readPieces(const sim::Solver& solver, const InputWindow& input, bool erosion);
 
 /// Collective: writes the GeoTIFF `file` (`georef` and `options` used by the lead only) from every
-/// rank's pieces, `values` giving a piece's grid (NaN: no data). The lead creates a temporary
-/// beside `file`, the ranks write their pieces into it in turn (rank order: GDAL has one writer
-/// at a time), and the lead renames it into place: a reader never sees a partial map.
+/// rank's `windows` (cells of the grid). The lead creates a temporary beside `file`, the ranks
+/// write their windows into it in turn (rank order: GDAL has one writer at a time), and the lead
+/// renames it into place: a reader never sees a partial raster.
+Status writeRaster(const Ranks& ranks, const std::filesystem::path& file, const gis::Georef& georef,
+                   const gis::WriteOptions& options, const std::vector<gis::GridWindow>& windows);
+
+/// Collective: writes the GeoTIFF `file` (`georef` and `options` used by the lead only) from every
+/// rank's pieces, `values` giving a piece's grid (NaN: no data), through writeRaster.
 Status writeMapFile(const Ranks& ranks, const std::filesystem::path& file, const gis::Georef& georef,
                     const gis::WriteOptions& options, const std::vector<Piece>& pieces,
                     const std::function<gis::Grid<float>(const Piece&)>& values);

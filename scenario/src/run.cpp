@@ -27,6 +27,7 @@
 
 #include "checkpoint.hpp"
 #include "distributed.hpp"
+#include "domain_rows.hpp"
 #include "pieces.hpp"
 
 namespace strata::scenario {
@@ -740,23 +741,25 @@ Result<RunSummary> runScenario(const Scenario& s, const RunOptions& opt) {
     return fail(s.at("time.output_interval") + msg);
   }
   const int intervals = int(intervalCount);
-  // The domain: built by the lead (the only rank that holds its grids), the shape sent to the
-  // others once the run folder is taken and the model input written for them to read.
+  // The domain. In one process: built whole. Over MPI ranks: built rows by rows, each rank its
+  // own from its windows of the DEM (domain_rows.hpp), unless a step needs the whole region at
+  // once (wholeBuildStep) or there are fewer rows than ranks: then the lead builds it whole. Either
+  // way the model input is written into input/ before the run folder's solver reads its blocks
+  // from it, and every rank runs on the domain's shape.
   ScenarioDomain domain;
   Status status;
-  if (ranks.lead()) {
+  std::optional<detail::RowBuilder> byRows;
+  if (ranks.distributed() && detail::wholeBuildStep(s).empty()) {
+    auto planned = detail::RowBuilder::plan(s, opt.memoryBudgetBytes, ranks.size(), opt.pictures);
+    STRATA_TRY_STATUS(ranks.agree(statusOf(planned)));
+    if (planned->shape().bed.georef.height >= ranks.size()) byRows.emplace(std::move(planned).value());
+  }
+  if (!byRows && ranks.lead()) {
     auto built = buildDomain(s, opt.memoryBudgetBytes, ranks.size());
     if (built) domain = std::move(built).value();
     status = statusOf(built);
   }
   STRATA_TRY_STATUS(ranks.agree(status));
-  const std::string name = displayName(s.name);
-  if (ranks.lead()) {
-    const auto& g = domain.bed.georef;
-    log::info(opt.command) << name << ": " << g.width << " x " << g.height << " cells, " << domain.totalAreaM2 / 1e6
-                           << " km^2, " << domain.sources.size() << " inflow(s), " << domain.levels.size()
-                           << " fixed level(s), " << formatDuration(s.durationS) << " simulated";
-  }
 
   std::optional<FileLock> lock;  // held by the lead for the whole run
   if (ranks.lead()) {
@@ -768,21 +771,43 @@ Result<RunSummary> runScenario(const Scenario& s, const RunOptions& opt) {
       fs::create_directories(opt.outDir / "maps", ec);
       if (ec) status = fail(opt.outDir.string() + ": cannot create the run folder: " + ec.message());
     }
-    if (status.ok() && ranks.distributed()) status = detail::writeModelInput(opt.outDir, domain);
   }
   STRATA_TRY_STATUS(ranks.agree(status));
   const std::string scenarioText = ranks.fromLead(ranks.lead() ? slurp(s.file) : std::string());
-  if (ranks.distributed()) {
-    // Every rank, the lead too, runs on the domain's shape and reads its blocks from input/: the
-    // lead lets go of the domain's grids but for the bed, which pictures and the elevation map
-    // need.
+  if (byRows) {
+    // Pictures and plots draw the bed, which the lead reads back from the elevation map.
+    const bool bed = opt.pictures || opt.plots;
+    STRATA_TRY(domain, detail::buildByRows(*byRows, s, ranks, opt.outDir, bed));
+    status = {};
+    if (ranks.lead() && bed) {
+      auto elevation = gis::readDem((opt.outDir / "maps" / "elevation.tif").string());
+      if (elevation) domain.bed.values = std::move(elevation->values);
+      status = statusOf(elevation);
+    }
+    STRATA_TRY_STATUS(ranks.agree(status));
+  } else if (ranks.distributed()) {
+    // The lead's domain: its shape to every rank, its cells into input/. Every rank, the lead too,
+    // then runs on the shape and reads its blocks from input/: the lead lets go of the domain's
+    // grids but for the bed, which pictures and the elevation map need.
     const std::string shape = ranks.fromLead(ranks.lead() ? detail::encodeDomainShape(domain) : std::string());
+    auto decoded = detail::decodeDomainShape(shape);
+    STRATA_TRY_STATUS(ranks.agree(statusOf(decoded)));
+    const ScenarioDomain& sh = *decoded;
+    STRATA_TRY_STATUS(detail::writeModelInput(ranks, opt.outDir, sh.bed.georef, domain, int(sh.input.materials.size()),
+                                              sh.input.waterDepthM.size() > 0, sh.input.rainMmPerHour.size() > 0));
     gis::Grid<float> bed;
     if (ranks.lead() && (opt.pictures || opt.plots)) bed = std::move(domain.bed.values);
-    auto decoded = detail::decodeDomainShape(shape);
-    if (decoded) domain = std::move(decoded).value();
+    domain = std::move(decoded).value();
     domain.bed.values = std::move(bed);
-    STRATA_TRY_STATUS(ranks.agree(statusOf(decoded)));
+  }
+  const std::string name = displayName(s.name);
+  if (ranks.lead()) {
+    const auto& g = domain.bed.georef;
+    log::info(opt.command) << name << ": " << g.width << " x " << g.height << " cells, " << domain.totalAreaM2 / 1e6
+                           << " km^2, " << domain.sources.size() << " inflow(s), " << domain.levels.size()
+                           << " fixed level(s), " << formatDuration(s.durationS) << " simulated"
+                           << (byRows ? ", built by the " + std::to_string(ranks.size()) + " ranks row by row"
+                                      : std::string());
   }
   const CheckpointOwner owner{opt.command, fnv1a(scenarioText)};
   const fs::path checkpointPath =

@@ -18,6 +18,9 @@
 namespace strata::scenario {
 
 struct ScenarioDomain {
+  /// The grids hold rows [firstRow, firstRow + their height) of the region: all of it but where a
+  /// rank of a run over MPI builds its own rows (scenario/src/domain_rows.hpp).
+  int firstRow = 0;
   gis::Raster bed;                   ///< the region's bedrock elevation (m); georef of the region
   gis::Grid<uint8_t> inside;         ///< 1 for cells of the region, 0 outside a polygon region (walls)
   gis::Grid<double> cellAreaM2;      ///< geodesic area of each cell (m^2)

@@ -1,0 +1,62 @@
+#pragma once
+// The domain built rows by rows: every MPI rank of a run builds its own rows of the model input,
+// reading only its rows' windows of the DEM (docs/distributed.md, "Built by the ranks"). Each
+// rows' build has the bits the whole build (buildDomain) has there; what needs every row (the
+// datum, the totals, fill_depressions tile by tile, the checks on levels, voids and loose
+// material) the caller combines over the ranks (detail::buildByRows).
+
+#include <array>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <strata/core/result.hpp>
+#include <strata/scenario/domain.hpp>
+
+namespace strata::scenario::detail {
+
+/// The scenario key of a step that needs the whole region at once, or empty when the domain can
+/// be built rows by rows: breach_inflows (a path search over the region), an at_rest layer
+/// (settles until nothing changes), voids to fill (GDAL fills them from their surroundings), a
+/// tile store resampled to cell_size (resampled whole), dam breaks (not built by rows yet).
+/// fill_depressions can: tile by tile (gis::fillDepressions).
+std::string wholeBuildStep(const Scenario& s);
+
+class RowBuilder {
+ public:
+  /// Plans the build (reads no cell; every rank makes the same): the region's grid, per-row cell
+  /// sizes, materials, the model, inflows and levels on cells, the rain. The memory check is a
+  /// rank's share of a run over `ranks` (with the pictures' gather on the lead when `pictures`).
+  /// `s` must outlive the builder, and wholeBuildStep(s) be empty.
+  static Result<RowBuilder> plan(const Scenario& s, uint64_t memoryBudgetBytes, int ranks, bool pictures);
+  RowBuilder(RowBuilder&&) noexcept;
+  ~RowBuilder();
+
+  /// The domain without cells: bed.georef the region's grid, per-row cell sizes, materials, the
+  /// model, sources, levels, the rain (a 1 x 1 rainMmPerHour marker for a raster).
+  const ScenarioDomain& shape() const;
+  /// Rows [y0, y1) of the region (firstRow y0): bed, voids (not filled), mask, cell areas and
+  /// their total, base (walls), layers, the rain raster; `lowestBed` the lowest bed of the
+  /// region's cells there (the datum is the lowest over all rows, floored). No datum, nothing
+  /// filled, no check that needs every row.
+  Result<ScenarioDomain> rows(int y0, int y1, float* lowestBed) const;
+
+  // What buildDomain does over the whole region, for the caller to do over the rows.
+  Error refuseVoids(long long count) const;
+  bool hasLooseMaterial(const ScenarioDomain& rows) const;
+  Error refuseNoLooseMaterial() const;
+  gis::Grid<uint8_t> drains(const ScenarioDomain& rows) const;  ///< fill_depressions' open-edge cells
+  Error refuseNothingDrains() const;
+  /// Raises the first `count` rows of `rows` to `filled` where higher, counting it in rows.filled.
+  void raiseTo(const gis::Grid<float>& filled, int count, ScenarioDomain& rows) const;
+  std::vector<double> lowestLevelBeds(const ScenarioDomain& rows) const;
+  Status checkLevelStages(const std::vector<double>& lowestBed) const;
+  std::array<float, 2> bedRange(const ScenarioDomain& rows, int count) const;
+
+ private:
+  struct Impl;
+  explicit RowBuilder(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace strata::scenario::detail
