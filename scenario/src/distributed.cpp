@@ -317,7 +317,7 @@ void keepRows(ScenarioDomain& d, int rows) {
 // fill_depressions over the ranks' rows, each a tile (gis::fillDepressions' phases): `d` holds
 // the rank's rows and the row below.
 Status fillOverRanks(const RowBuilder& b, const Ranks& ranks, const std::vector<gis::CellRect>& tiles, int own,
-                     ScenarioDomain& d) {
+                     ScenarioDomain& d, sim::ExactSum& volume) {
   const auto drains = b.drains(d);
   bool anyDrain = false;
   for (size_t i = 0; i < size_t(own) * size_t(drains.width); ++i) anyDrain |= drains.data[i] != 0;
@@ -362,7 +362,7 @@ Status fillOverRanks(const RowBuilder& b, const Ranks& ranks, const std::vector<
   std::vector<std::pair<int64_t, float>> spill;
   spill.reserve(labels.size());
   for (size_t i = 0; i < labels.size(); ++i) spill.push_back({labels[i], levels[i]});
-  b.raiseTo(gis::finishTile(in, flood, spill), own, d);
+  volume = b.raiseTo(gis::finishTile(in, flood, spill), own, d);
   return {};
 }
 
@@ -407,10 +407,9 @@ Result<ScenarioDomain> buildByRows(const RowBuilder& b, const Scenario& s, const
   d.input.datumM = shape.input.datumM;
 
   if (s.terrain.fillDepressions) {
-    STRATA_TRY_STATUS(fillOverRanks(b, ranks, tiles, own, d));
     std::vector<sim::ExactSum> filled(2);  // cells, volume
+    STRATA_TRY_STATUS(fillOverRanks(b, ranks, tiles, own, d, filled[1]));
     filled[0].add(d.filled.cells);
-    filled[1].add(d.filled.volumeM3);
     ranks.sum(filled);
     std::vector<double> deepest{d.filled.maxM};
     ranks.max(deepest);
@@ -424,6 +423,15 @@ Result<ScenarioDomain> buildByRows(const RowBuilder& b, const Scenario& s, const
   std::vector<double> levelBeds = b.lowestLevelBeds(d);
   ranks.min(levelBeds);
   STRATA_TRY_STATUS(b.checkLevelStages(levelBeds));
+  std::vector<double> damBeds = b.placeDamBreaks(d);
+  ranks.min(damBeds);
+  STRATA_TRY_STATUS(b.checkDamBreaks(damBeds));
+  std::vector<sim::ExactSum> damVolume(1);  // over the cells: the same sum as one process's
+  for (size_t i = 0; i < d.input.waterDepthM.size(); ++i) {
+    damVolume[0].add(double(d.input.waterDepthM.data[i]) * d.cellAreaM2.data[i]);
+  }
+  ranks.sum(damVolume);
+  shape.damBreakVolumeM3 = damVolume[0].value();
   const auto range = b.bedRange(d, own);
   std::vector<double> lo{range[0]}, hi{range[1]};
   ranks.min(lo);
@@ -431,8 +439,8 @@ Result<ScenarioDomain> buildByRows(const RowBuilder& b, const Scenario& s, const
   shape.bedRangeM = {float(lo[0]), float(hi[0])};
 
   // Every rank writes its rows of the model input (and of the elevation map).
-  STRATA_TRY_STATUS(writeModelInput(ranks, runDir, grid, d, int(shape.input.materials.size()), false,
-                                    shape.input.rainMmPerHour.size() > 0));
+  STRATA_TRY_STATUS(writeModelInput(ranks, runDir, grid, d, int(shape.input.materials.size()),
+                                    shape.input.waterDepthM.size() > 0, shape.input.rainMmPerHour.size() > 0));
   if (elevation) {
     std::error_code ec;
     if (ranks.lead()) fs::create_directories(runDir / "maps", ec);

@@ -854,36 +854,56 @@ Status placeRain(const Scenario& s, const Plan& plan, ScenarioDomain& d) {
   return {};
 }
 
-// Step 11: dam breaks: water standing up to the given surface inside each polygon.
-Status placeDamBreaks(const Scenario& s, const Plan& plan, const RegionCells& region, ScenarioDomain& d) {
-  const int w = d.bed.values.width, h = d.bed.values.height;
-  for (size_t i = 0; i < s.water.damBreaks.size(); ++i) {
-    const auto& db = s.water.damBreaks[i];
+// Step 11: dam breaks: water standing up to the given surface inside each polygon. The cells of
+// each polygon (some, or it is refused)...
+using CellList = std::vector<std::pair<int, int>>;
+Result<std::vector<CellList>> damBreakCells(const Scenario& s, const Plan& plan, const RegionCells& region) {
+  std::vector<CellList> out;
+  for (const auto& db : s.water.damBreaks) {
     STRATA_TRY(auto demPx, plan.mapper.pixels(s, db.polygon));
-    const auto cells = polygonCells(plan.frame.toRegion(demPx), region);
-    if (cells.empty()) return placeError(s, db.polygon, "the dam-break polygon covers no cell of the region");
-    if (d.input.waterDepthM.size() == 0) d.input.waterDepthM = gis::Grid<float>(w, h, 0.0f);
-    float lowestBed = std::numeric_limits<float>::max();
-    for (auto [x, y] : cells) {
-      lowestBed = std::min(lowestBed, d.bed.values.at(x, y));
-      const float depth = std::max(0.0f, float(db.surfaceElevationM) - d.bed.values.at(x, y));
+    out.push_back(polygonCells(plan.frame.toRegion(demPx), region));
+    if (out.back().empty()) return placeError(s, db.polygon, "the dam-break polygon covers no cell of the region");
+  }
+  return out;
+}
+
+// ... the initial depth on the rows of `d` (and the volume there), returning each dam's lowest bed
+// over those rows (1e300 where it has no cell) ...
+std::vector<double> placeDamBreaks(const Scenario& s, const std::vector<CellList>& cells, ScenarioDomain& d) {
+  const int w = d.bed.values.width, h = d.bed.values.height;
+  std::vector<double> lowest(cells.size(), 1e300);
+  if (cells.empty()) return lowest;
+  d.input.waterDepthM = gis::Grid<float>(w, h, 0.0f);
+  for (size_t i = 0; i < cells.size(); ++i) {
+    const float surface = float(s.water.damBreaks[i].surfaceElevationM);
+    for (auto [x, gy] : cells[i]) {
+      const int y = gy - d.firstRow;
+      if (y < 0 || y >= h) continue;
+      lowest[i] = std::min(lowest[i], double(d.bed.values.at(x, y)));
+      const float depth = std::max(0.0f, surface - d.bed.values.at(x, y));
       d.input.waterDepthM.at(x, y) = std::max(d.input.waterDepthM.at(x, y), depth);
     }
-    if (!(db.surfaceElevationM > lowestBed)) {
+  }
+  sim::ExactSum volume;
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) volume.add(double(d.input.waterDepthM.at(x, y)) * d.cellAreaM2.at(x, y));
+  }
+  d.damBreakVolumeM3 = volume.value();
+  return lowest;
+}
+
+// ... and each surface must stand above the lowest bed of its polygon.
+Status checkDamBreaks(const Scenario& s, const std::vector<double>& lowestBed) {
+  for (size_t i = 0; i < s.water.damBreaks.size(); ++i) {
+    const auto& db = s.water.damBreaks[i];
+    if (!(db.surfaceElevationM > lowestBed[i])) {
       char msg[200];
       std::snprintf(msg, sizeof msg,
                     "the surface (%.2f m) is below the bed of every cell of the polygon (lowest %.2f m): "
                     "the dam would hold no water",
-                    db.surfaceElevationM, double(lowestBed));
+                    db.surfaceElevationM, lowestBed[i]);
       return fail(s.at("water.dam_break[" + std::to_string(i) + "].surface") + msg);
     }
-  }
-  if (d.input.waterDepthM.size() > 0) {
-    sim::ExactSum volume;
-    for (int y = 0; y < h; ++y) {
-      for (int x = 0; x < w; ++x) volume.add(double(d.input.waterDepthM.at(x, y)) * d.cellAreaM2.at(x, y));
-    }
-    d.damBreakVolumeM3 = volume.value();
   }
   return {};
 }
@@ -1044,7 +1064,7 @@ Error refuseNothingDrains(const Scenario& s) {
 
 // Raises the cells of `d` (its first `rows` rows) to `filled` where that is higher, counting what
 // was raised.
-void raiseTo(const gis::Grid<float>& filled, int rows, ScenarioDomain& d) {
+sim::ExactSum raiseTo(const gis::Grid<float>& filled, int rows, ScenarioDomain& d) {
   sim::ExactSum volume;
   const size_t n = size_t(rows) * size_t(d.input.baseM.width);
   for (size_t c = 0; c < n; ++c) {
@@ -1057,6 +1077,7 @@ void raiseTo(const gis::Grid<float>& filled, int rows, ScenarioDomain& d) {
     d.bed.values.data[c] = filled.data[c];
   }
   d.filled.volumeM3 = volume.value();
+  return volume;
 }
 
 // [terrain] fill_depressions: every cell not draining to an open edge is raised to the level at
@@ -1148,7 +1169,8 @@ Result<ScenarioDomain> buildDomain(const Scenario& s, uint64_t memoryBudgetBytes
   STRATA_TRY_STATUS(checkLevelStages(s, lowestLevelBeds(s, d, d)));
   placeVoidHoles(s, d);
   STRATA_TRY_STATUS(placeRain(s, plan, d));
-  STRATA_TRY_STATUS(placeDamBreaks(s, plan, region, d));
+  STRATA_TRY(const auto dams, damBreakCells(s, plan, region));
+  STRATA_TRY_STATUS(checkDamBreaks(s, placeDamBreaks(s, dams, d)));
   d.bedRangeM = bedRange(d, h);
   return d;
 }
@@ -1164,7 +1186,6 @@ std::string wholeBuildStep(const Scenario& s) {
   }
   if (s.terrain.voids != decltype(s.terrain)::Voids::kRefuse) return "terrain.voids";
   if (!s.terrain.store.empty() && s.region.cellSizeM > 0) return "region.cell_size";
-  if (!s.water.damBreaks.empty()) return "water.dam_break";
   return {};
 }
 
@@ -1172,6 +1193,7 @@ struct RowBuilder::Impl {
   const Scenario& s;
   Plan plan;
   ScenarioDomain shape;
+  std::vector<CellList> damCells;
 };
 
 RowBuilder::RowBuilder(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -1195,9 +1217,11 @@ Result<RowBuilder> RowBuilder::plan(const Scenario& s, uint64_t memoryBudgetByte
   STRATA_TRY_STATUS(placeInflows(s, plan, region, shape));
   STRATA_TRY_STATUS(placeLevels(s, plan, region, shape));
   STRATA_TRY_STATUS(placeRain(s, plan, shape));
-  // A one-cell marker, as decodeDomainShape leaves: the rows have a rain raster.
+  STRATA_TRY(auto dams, damBreakCells(s, plan, region));
+  // One-cell markers, as decodeDomainShape leaves: the rows have a rain raster, initial water.
   if (s.water.rain && !s.water.rain->raster.empty()) shape.input.rainMmPerHour = gis::Grid<float>(1, 1, 0.0f);
-  return RowBuilder(std::make_unique<Impl>(Impl{s, std::move(plan), std::move(shape)}));
+  if (!dams.empty()) shape.input.waterDepthM = gis::Grid<float>(1, 1, 0.0f);
+  return RowBuilder(std::make_unique<Impl>(Impl{s, std::move(plan), std::move(shape), std::move(dams)}));
 }
 
 const ScenarioDomain& RowBuilder::shape() const { return impl_->shape; }
@@ -1225,14 +1249,20 @@ gis::Grid<uint8_t> RowBuilder::drains(const ScenarioDomain& d) const {
   return drainCells(impl_->s, d, impl_->plan.grid.height);
 }
 Error RowBuilder::refuseNothingDrains() const { return scenario::refuseNothingDrains(impl_->s); }
-void RowBuilder::raiseTo(const gis::Grid<float>& filled, int rows, ScenarioDomain& d) const {
-  scenario::raiseTo(filled, rows, d);
+sim::ExactSum RowBuilder::raiseTo(const gis::Grid<float>& filled, int rows, ScenarioDomain& d) const {
+  return scenario::raiseTo(filled, rows, d);
 }
 std::vector<double> RowBuilder::lowestLevelBeds(const ScenarioDomain& d) const {
   return scenario::lowestLevelBeds(impl_->s, impl_->shape, d);
 }
 Status RowBuilder::checkLevelStages(const std::vector<double>& lowestBed) const {
   return scenario::checkLevelStages(impl_->s, lowestBed);
+}
+std::vector<double> RowBuilder::placeDamBreaks(ScenarioDomain& d) const {
+  return scenario::placeDamBreaks(impl_->s, impl_->damCells, d);
+}
+Status RowBuilder::checkDamBreaks(const std::vector<double>& lowestBed) const {
+  return scenario::checkDamBreaks(impl_->s, lowestBed);
 }
 std::array<float, 2> RowBuilder::bedRange(const ScenarioDomain& d, int rows) const {
   return scenario::bedRange(d, rows);

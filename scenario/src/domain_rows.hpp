@@ -12,13 +12,14 @@
 
 #include <strata/core/result.hpp>
 #include <strata/scenario/domain.hpp>
+#include <strata/sim/exact_sum.hpp>
 
 namespace strata::scenario::detail {
 
 /// The scenario key of a step that needs the whole region at once, or empty when the domain can
 /// be built rows by rows: breach_inflows (a path search over the region), an at_rest layer
 /// (settles until nothing changes), voids to fill (GDAL fills them from their surroundings), a
-/// tile store resampled to cell_size (resampled whole), dam breaks (not built by rows yet).
+/// tile store resampled to cell_size (resampled whole).
 /// fill_depressions can: tile by tile (gis::fillDepressions).
 std::string wholeBuildStep(const Scenario& s);
 
@@ -33,7 +34,8 @@ class RowBuilder {
   ~RowBuilder();
 
   /// The domain without cells: bed.georef the region's grid, per-row cell sizes, materials, the
-  /// model, sources, levels, the rain (a 1 x 1 rainMmPerHour marker for a raster).
+  /// model, sources, levels, the rain (1 x 1 markers: rainMmPerHour for a rain raster,
+  /// waterDepthM for dam breaks).
   const ScenarioDomain& shape() const;
   /// Rows [y0, y1) of the region (firstRow y0): bed, voids (not filled), mask, cell areas and
   /// their total, base (walls), layers, the rain raster; `lowestBed` the lowest bed of the
@@ -47,10 +49,15 @@ class RowBuilder {
   Error refuseNoLooseMaterial() const;
   gis::Grid<uint8_t> drains(const ScenarioDomain& rows) const;  ///< fill_depressions' open-edge cells
   Error refuseNothingDrains() const;
-  /// Raises the first `count` rows of `rows` to `filled` where higher, counting it in rows.filled.
-  void raiseTo(const gis::Grid<float>& filled, int count, ScenarioDomain& rows) const;
+  /// Raises the first `count` rows of `rows` to `filled` where higher, counting it in rows.filled;
+  /// returns the volume raised (an exact sum, to add over the ranks).
+  sim::ExactSum raiseTo(const gis::Grid<float>& filled, int count, ScenarioDomain& rows) const;
   std::vector<double> lowestLevelBeds(const ScenarioDomain& rows) const;
   Status checkLevelStages(const std::vector<double>& lowestBed) const;
+  /// The dam breaks' initial water on the rows (and its volume in rows.damBreakVolumeM3); each
+  /// dam's lowest bed there.
+  std::vector<double> placeDamBreaks(ScenarioDomain& rows) const;
+  Status checkDamBreaks(const std::vector<double>& lowestBed) const;
   std::array<float, 2> bedRange(const ScenarioDomain& rows, int count) const;
 
  private:

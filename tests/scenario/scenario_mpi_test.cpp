@@ -149,54 +149,69 @@ TEST(ScenarioMpi, AFloodOverTheRanksEqualsOneProcess) {
 
 // Without breach_inflows the ranks build the domain themselves, row by row, each from its own
 // windows of the DEM (domain_rows.hpp): a polygon region, fill_depressions tile by tile over the
-// ranks' rows, a fixed level, a spin-up and rain. Maps, series and report as one process's.
+// ranks' rows and rain, with a fixed level and a spin-up, or with a dam break (which a spin-up
+// would release early). Maps, series, report and model input as one process's.
 TEST(ScenarioMpi, ADomainBuiltByTheRanksRowByRowEqualsOneProcess) {
-  const auto dir = sharedDir("rows");
-  std::string text = floodText();
-  text.erase(text.find("breach_inflows = true\n"), 22);
-  const auto bbox = text.find("bbox_lonlat");
-  text.replace(bbox, text.find('\n', bbox) - bbox,
+  std::string base = floodText();
+  base.erase(base.find("breach_inflows = true\n"), 22);
+  const auto bbox = base.find("bbox_lonlat");
+  base.replace(bbox, base.find('\n', bbox) - bbox,
                "polygon_lonlat = [[-112.25, 36.02], [-112.001, 36.02], [-112.001, 36.18], [-112.25, 36.12]]");
-  text +=
+  const std::string level =
+      base +
       "[[water.level]]\nname = \"river stage\"\nline_lonlat = [[-112.0225, 36.063], [-112.0225, 36.08]]\n"
       "stage = [[0, 880]]\nstage_units = [\"min\", \"m\"]\n";
-  const Scenario s = load(dir, "rows.toml", text);
-  ASSERT_EQ(detail::wholeBuildStep(s), "");  // built by the ranks
-  if (worldRank() == 0) {
-    auto one = runScenario(s, options(dir / "one", "flood"));
-    ASSERT_TRUE(one) << one.message();
+  std::string dam = base;
+  dam.erase(dam.find("spin_up = \"10 min\"\n"), 19);
+  dam +=
+      "[[water.dam_break]]\npolygon_lonlat = [[-112.1, 36.05], [-112.02, 36.05], [-112.02, 36.1], "
+      "[-112.1, 36.1]]\nsurface = \"950 m\"\n";
+  for (const auto& [name, text] : {std::pair{"level", level}, std::pair{"dam", dam}}) {
+    SCOPED_TRACE(name);
+    const auto dir = sharedDir(std::string("rows-") + name);
+    const Scenario s = load(dir, "rows.toml", text);
+    ASSERT_EQ(detail::wholeBuildStep(s), "");  // built by the ranks
+    if (worldRank() == 0) {
+      auto one = runScenario(s, options(dir / "one", "flood"));
+      ASSERT_TRUE(one) << one.message();
+    }
+    auto o = options(dir / "ranks", "flood");
+    o.distributed = true;
+    auto run = runScenario(s, o);
+    ASSERT_TRUE(run) << run.message();
+    EXPECT_TRUE(run->completed);
+    MPI_Barrier(MPI_COMM_WORLD);
+    if (worldRank() != 0) continue;
+    expectSameRun(dir / "one", dir / "ranks",
+                  {"max_depth", "max_speed", "arrival_time", "inundation_duration", "final_depth"},
+                  std::string(name) + " built by rows on " + std::to_string(worldSize()) + " ranks");
+    auto reportOf = [](const fs::path& folder) {
+      std::ifstream report(folder / "report.md");
+      const std::string t((std::istreambuf_iterator<char>(report)), std::istreambuf_iterator<char>());
+      const auto from = t.find("## Scenario"), to = t.find("## Files");
+      return from == std::string::npos || to == std::string::npos ? std::string() : t.substr(from, to - from);
+    };
+    const std::string alone = reportOf(dir / "one");
+    EXPECT_NE(alone.find("depressions filled"), std::string::npos) << alone;
+    EXPECT_EQ(reportOf(dir / "ranks"), alone);
+    // The model input the ranks wrote is the one process's domain.
+    auto domain = buildDomain(s);
+    ASSERT_TRUE(domain) << domain.message();
+    auto written = gis::readDem((dir / "ranks" / "input" / "base.tif").string());
+    ASSERT_TRUE(written) << written.message();
+    EXPECT_EQ(written->values.data, domain->input.baseM.data);
+    int walls = 0;
+    for (uint8_t in : domain->inside.data) walls += in ? 0 : 1;
+    EXPECT_GT(walls, 100);  // the polygon cut the bounding box
+    EXPECT_GT(domain->filled.cells, 0);
+    if (std::string(name) == "dam") {
+      auto water = gis::readDem((dir / "ranks" / "input" / "water.tif").string(), allowEmpty());
+      ASSERT_TRUE(water) << water.message();
+      EXPECT_EQ(water->values.data, domain->input.waterDepthM.data);
+      EXPECT_GT(domain->damBreakVolumeM3, 1e6);
+    }
+    fs::remove_all(dir);
   }
-  auto o = options(dir / "ranks", "flood");
-  o.distributed = true;
-  auto run = runScenario(s, o);
-  ASSERT_TRUE(run) << run.message();
-  EXPECT_TRUE(run->completed);
-  MPI_Barrier(MPI_COMM_WORLD);
-  if (worldRank() != 0) return;
-  EXPECT_TRUE(fs::exists(dir / "ranks" / "input" / "base.tif"));
-  expectSameRun(dir / "one", dir / "ranks",
-                {"max_depth", "max_speed", "arrival_time", "inundation_duration", "final_depth"},
-                "built by rows on " + std::to_string(worldSize()) + " ranks");
-  auto reportOf = [](const fs::path& folder) {
-    std::ifstream report(folder / "report.md");
-    const std::string t((std::istreambuf_iterator<char>(report)), std::istreambuf_iterator<char>());
-    const auto from = t.find("## Scenario"), to = t.find("## Files");
-    return from == std::string::npos || to == std::string::npos ? std::string() : t.substr(from, to - from);
-  };
-  const std::string alone = reportOf(dir / "one");
-  EXPECT_NE(alone.find("depressions filled"), std::string::npos) << alone;
-  EXPECT_EQ(reportOf(dir / "ranks"), alone);
-  // The model input the ranks wrote is the one process's domain.
-  auto domain = buildDomain(s);
-  ASSERT_TRUE(domain) << domain.message();
-  auto base = gis::readDem((dir / "ranks" / "input" / "base.tif").string());
-  ASSERT_TRUE(base) << base.message();
-  EXPECT_EQ(base->values.data, domain->input.baseM.data);
-  int walls = 0;
-  for (uint8_t in : domain->inside.data) walls += in ? 0 : 1;
-  EXPECT_GT(walls, 100);  // the polygon cut the bounding box
-  EXPECT_GT(domain->filled.cells, 0);
-  fs::remove_all(dir);
 }
 
 TEST(ScenarioMpi, AnErosionRunOverTheRanksEqualsOneProcess) {
