@@ -17,6 +17,7 @@ namespace {
 struct FloodArgs {
   std::string scenario, outDir, backend;
   bool resume = false, overwrite = false, noPictures = false, noPlots = false;
+  int pictureCells = scenario::RunOptions{}.pictureCells;
 };
 
 void addRunCommand(CLI::App& app, const char* name, const char* help, bool erosion) {
@@ -32,6 +33,11 @@ void addRunCommand(CLI::App& app, const char* name, const char* help, bool erosi
                   "auto (GL on a hardware GPU, else the CPU), cpu or gpu; overrides [model] backend");
   cmd->add_flag("--no-pictures", args->noPictures, "Do not render pictures");
   cmd->add_flag("--no-plots", args->noPlots, "Do not draw plots");
+  cmd->add_option("--picture-cells", args->pictureCells,
+                  "Pictures of a larger region are drawn from every k-th cell, k bringing it within this many "
+                  "cells a side")
+      ->check(CLI::Range(16, 16384))
+      ->capture_default_str();
   cmd->callback([args, name, erosion] {
     const auto& mpi = mpiLaunch();
     // One line per failure, from rank 0 only (every rank fails alike).
@@ -63,6 +69,7 @@ void addRunCommand(CLI::App& app, const char* name, const char* help, bool erosi
     opt.overwrite = args->overwrite;
     opt.pictures = !args->noPictures && scenario->outputs.pictures;
     opt.plots = !args->noPlots && scenario->outputs.plots;
+    opt.pictureCells = args->pictureCells;
     opt.distributed = mpi.active;
     auto run = scenario::runScenario(*scenario, opt);
     if (!run) failWith(run.message(), 1);

@@ -1,4 +1,5 @@
 #include <strata/scenario/domain.hpp>
+#include <strata/scenario/run.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -341,22 +342,28 @@ Result<RegionFrame> regionWindow(const Scenario& s, const TerrainSource& source,
 // per layer), the checkpoint (the saved state, and its encoding beside it), what the outputs read
 // back at each interval (detail::readPieces: the state block, depth, flood statistics, mask, the
 // model input's window, in erosion runs suspended sediment and the layers now and at the start),
-// the domain (bed, mask, area in double, base, layers, water, rain) and what pictures hold (the
-// bed, and the depth gathered with, in erosion runs, the surface and top four layers). Over
+// and the domain (bed, mask, area in double, base, layers, water, rain). Over
 // `ranks` MPI ranks the lead, the heaviest, first builds the whole domain and writes it as the
 // model input; during the run every rank holds a 1/ranks share (its blocks' halos add ~10% at
-// the default block sizes) of the solver, checkpoint and read-back, and the lead the pictures'.
-// Built by rows (RowBuilder), every rank builds a 1/ranks share of the domain (and lets it go
-// before the run), and the lead holds no whole grid but the pictures'.
-double bytesPerCell(int layers, int ranks, bool byRows, bool pictures) {
+// the default block sizes) of the solver, checkpoint and read-back. Built by rows (RowBuilder),
+// every rank builds a 1/ranks share of the domain (and lets it go before the run): no rank holds
+// a whole grid. Pictures add a bounded amount on the lead (pictureBytes).
+double bytesPerCell(int layers, int ranks, bool byRows) {
   const double solver = 4.0 * (9 * 4 + 8 + 5 + layers);
   const double checkpoint = 2 * 4.0 * (4 + 4 + 4 + 8 + 4 + layers);
   const double readBack = 16 + 4 + 16 + 1 + 4.0 * (3 + layers) + 4 + 8.0 * layers;
   const double domain = 4 + 1 + 8 + 4 + 4.0 * layers + 4 + 4;
-  const double pictureBytes = pictures ? 4 + 4 + 4 + 16 : 0;
-  if (ranks <= 1) return solver + checkpoint + readBack + domain + pictureBytes;
-  const double run = (solver + checkpoint + readBack) * 1.1 / ranks + pictureBytes;
+  if (ranks <= 1) return solver + checkpoint + readBack + domain;
+  const double run = (solver + checkpoint + readBack) * 1.1 / ranks;
   return std::max(byRows ? domain * 1.1 / ranks : domain, run);
+}
+
+// What pictures hold on the lead: the bed drawn and the state gathered for it (depth; in erosion
+// runs the surface and the top four layers), at most RunOptions::pictureCells (by default 4096)
+// a side (detail::pictureStride).
+double pictureBytes(double width, double height) {
+  const double stride = std::max(1.0, std::ceil(std::max(width, height) / RunOptions{}.pictureCells));
+  return (4 + 4 + 4 + 16) * std::ceil(width / stride) * std::ceil(height / stride);
 }
 
 // The key a message about the region's size names: cell_size when given, else the region, else
@@ -413,7 +420,8 @@ Status planGrid(const Scenario& s, const TerrainSource& source, RegionFrame& fra
   const double cells = width * height, nativeCells = double(g0.width) * g0.height;
   // The window as read (and GDAL's copy while it resamples) comes on top.
   const double native = s.region.cellSizeM > 0 ? 8 * nativeCells / (byRows ? ranks : 1) : 0;
-  const double bytes = cells * bytesPerCell(layers, ranks, byRows, pictures) + native;
+  const double bytes =
+      cells * bytesPerCell(layers, ranks, byRows) + native + (pictures ? pictureBytes(width, height) : 0);
   const double available = budget > 0 ? double(budget) : double(availableMemoryBytes());
   const bool tooWide = width > std::numeric_limits<int>::max() / 2 || height > std::numeric_limits<int>::max() / 2;
   if (tooWide || (available > 0 && bytes > available)) {

@@ -1,5 +1,6 @@
 #include "pieces.hpp"
 
+#include <strata/core/bytes.hpp>
 #include <strata/core/files.hpp>
 #include <strata/scenario/domain.hpp>
 
@@ -29,6 +30,7 @@ Result<std::vector<Piece>> readPieces(const sim::Solver& solver, const InputWind
         p.layers.push_back(std::move(g));
       }
       p.initialLayers = std::move(in.layersM);
+      p.bed = solver.readLocalBed(r);
     }
     pieces.push_back(std::move(p));
   }
@@ -57,6 +59,67 @@ Status writeMapFile(const Ranks& ranks, const fs::path& file, const gis::Georef&
   std::vector<gis::GridWindow> windows;
   for (const auto& p : pieces) windows.push_back({p.rect.x, p.rect.y, values(p)});
   return writeRaster(ranks, file, georef, options, windows);
+}
+
+int pictureStride(int width, int height, int cells) {
+  cells = std::max(cells, 2);
+  return std::max(1, (std::max(width, height) + cells - 1) / cells);
+}
+
+gis::Grid<float> gatherStrided(const Ranks& ranks, const std::vector<Piece>& pieces, int stride, int width, int height,
+                               const std::function<float(const Piece&, size_t)>& value) {
+  const int sw = (width + stride - 1) / stride, sh = (height + stride - 1) / stride;
+  std::vector<uint64_t> at;  // in the strided grid
+  std::vector<float> values;
+  for (const auto& p : pieces) {
+    const auto& r = p.rect;
+    for (int y = r.y + (stride - r.y % stride) % stride; y < r.y + r.height; y += stride) {
+      for (int x = r.x + (stride - r.x % stride) % stride; x < r.x + r.width; x += stride) {
+        at.push_back(uint64_t(y / stride) * uint64_t(sw) + uint64_t(x / stride));
+        values.push_back(value(p, size_t(y - r.y) * size_t(r.width) + size_t(x - r.x)));
+      }
+    }
+  }
+  ByteWriter w;
+  w.vec(at);
+  w.vec(values);
+  const auto parts = ranks.gatherToLead(w.out);
+  if (!ranks.lead()) return {};
+  gis::Grid<float> out(sw, sh, gis::kNoData);
+  for (const auto& part : parts) {
+    ByteReader r{part};
+    r.vec(at);
+    r.vec(values);
+    STRATA_CHECK(r.ok && at.size() == values.size()) << "a rank's picture cells came damaged";
+    for (size_t i = 0; i < at.size(); ++i) out.data[at[i]] = values[i];
+  }
+  return out;
+}
+
+Result<gis::Raster> readStrided(const fs::path& path, int stride) {
+  STRATA_TRY(auto info, gis::probeDem(path.string()));
+  const gis::Georef& g = info.georef;
+  gis::Raster out;
+  out.georef = g;
+  out.georef.width = (g.width + stride - 1) / stride;
+  out.georef.height = (g.height + stride - 1) / stride;
+  // Cell i of the result is cell k i of the raster: its centre where that cell's centre is.
+  out.georef.transform.c[0] -= 0.5 * (stride - 1) * g.transform.c[1];
+  out.georef.transform.c[3] -= 0.5 * (stride - 1) * g.transform.c[5];
+  out.georef.transform.c[1] *= stride;
+  out.georef.transform.c[5] *= stride;
+  out.values = gis::Grid<float>(out.georef.width, out.georef.height);
+  const int band = std::max(stride, 256 / stride * stride);  // rows read at a time
+  for (int y0 = 0; y0 < g.height; y0 += band) {
+    gis::ReadOptions o;
+    o.window = gis::CellRect{0, y0, g.width, std::min(band, g.height - y0)};
+    o.allowAllNoData = true;
+    STRATA_TRY(auto rows, gis::readDem(path.string(), o));
+    for (int y = 0; y < o.window->height; y += stride) {
+      for (int x = 0; x < g.width; x += stride) out.values.at(x / stride, (y0 + y) / stride) = rows.values.at(x, y);
+    }
+  }
+  return out;
 }
 
 bool beats(const Extreme& a, const Extreme& b) {

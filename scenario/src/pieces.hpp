@@ -25,9 +25,9 @@ struct Piece {
   gis::Grid<uint8_t> inside;  ///< 1 for the region's cells, 0 for walls (a polygon's outside, voids as walls)
   gis::Grid<float> depth;     ///< water depth (m)
   sim::FloodStats flood;
-  /// Erosion runs only: suspended sediment (m of material) and the layers now and at the start
-  /// (thicknesses, bottom first).
-  gis::Grid<float> suspended;
+  /// Erosion runs only: suspended sediment (m of material), the bed now (above the datum) and the
+  /// layers now and at the start (thicknesses, bottom first).
+  gis::Grid<float> suspended, bed;
   std::vector<gis::Grid<float>> layers, initialLayers;
 };
 
@@ -51,6 +51,20 @@ Status writeRaster(const Ranks& ranks, const std::filesystem::path& file, const 
 Status writeMapFile(const Ranks& ranks, const std::filesystem::path& file, const gis::Georef& georef,
                     const gis::WriteOptions& options, const std::vector<Piece>& pieces,
                     const std::function<gis::Grid<float>(const Piece&)>& values);
+
+/// Pictures of a region over `cells` cells a side (RunOptions::pictureCells) are drawn from every
+/// k-th cell of each row and column, k the smallest that brings it within.
+int pictureStride(int width, int height, int cells);
+
+/// Collective: on the lead, the grid of every `stride`-th cell of each row and column of a
+/// `width` x `height` region (cells (k stride, j stride)), `value(piece, index in the piece)`
+/// from the ranks' pieces that hold them; empty elsewhere.
+gis::Grid<float> gatherStrided(const Ranks& ranks, const std::vector<Piece>& pieces, int stride, int width, int height,
+                               const std::function<float(const Piece&, size_t)>& value);
+
+/// The GeoTIFF at `path` at every `stride`-th cell of each row and column (read a band of rows at
+/// a time: never the whole raster), with its georeference scaled to match.
+Result<gis::Raster> readStrided(const std::filesystem::path& path, int stride);
 
 /// A largest value and its cell (the first in row-major order among equals), with a value of that
 /// cell that goes with it.

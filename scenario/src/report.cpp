@@ -54,9 +54,8 @@ Status runPlotScript(const std::string& script, const std::vector<std::string>& 
 
 }  // namespace
 
-Result<std::vector<std::string>> writePlots(const fs::path& runDir, const gis::Raster& bed, bool completed) {
+Result<std::vector<std::string>> writePlots(const fs::path& runDir, bool completed) {
   (void)completed;
-  STRATA_TRY_STATUS(gis::writeGeoTiff((runDir / "maps" / "elevation.tif").string(), bed));
   std::error_code ec;
   fs::create_directories(runDir / "plots", ec);
   STRATA_TRY_STATUS(runPlotScript("plot_series.py", {(runDir / "series.csv").string(), (runDir / "plots").string()}));

@@ -126,18 +126,20 @@ Result<FileLock> takeRunFolder(const RunOptions& opt) {
 }
 
 // What runs the simulation: a GL context when the GL backend or the pictures need one, and the
-// solver. `auto` takes the GL backend on a hardware GPU and the CPU backend when the only GL is
-// a software rasteriser (llvmpipe is slower than the CPU backend) or there is none. Over MPI
-// ranks: every rank's blocks run on its own GPU (one per local rank) for GL, `auto` takes GL only
-// when every rank has a hardware GPU, and only the lead needs a context for pictures.
+// solver (startContext, then startSolver). `auto` takes the GL backend on a hardware GPU and the CPU backend when the
+// only GL is a software rasteriser (llvmpipe is slower than the CPU backend) or there is none. Over MPI ranks: every
+// rank's blocks run on its own GPU (one per local rank) for GL, `auto` takes GL only when every rank has a hardware
+// GPU, and only the lead needs a context for pictures.
 struct Engine {
   std::optional<gl::HeadlessContext> context;
   std::unique_ptr<sim::Solver> solver;
   sim::DistributedSolver* distributed = nullptr;  ///< the solver, when it runs over MPI ranks
+  bool gpu = false;                               ///< the solver's passes run on the GPU
 };
 
-Result<Engine> startEngine(Backend backend, const ScenarioDomain& d, bool pictures, const Ranks& ranks,
-                           const fs::path& runDir) {
+// The GL context, made before anything is built or written, so that a run that cannot have one
+// fails leaving the run folder as it was; and whether the blocks run on the GPU.
+Result<Engine> startContext(Backend backend, bool pictures, const Ranks& ranks) {
   Engine e;
   Status contextStatus;
   gl::HeadlessOptions glOptions;
@@ -155,7 +157,12 @@ Result<Engine> startEngine(Backend backend, const ScenarioDomain& d, bool pictur
   }
   STRATA_TRY_STATUS(ranks.agree(contextStatus));
   const bool hardware = e.context && !e.context->info().isSoftware();
-  const bool gpu = backend == Backend::kGpu || (backend == Backend::kAuto && ranks.all(hardware));
+  e.gpu = backend == Backend::kGpu || (backend == Backend::kAuto && ranks.all(hardware));
+  return e;
+}
+
+// The solver over the domain (over MPI ranks: each rank its blocks, read from the model input).
+Status startSolver(Engine& e, const ScenarioDomain& d, const Ranks& ranks, const fs::path& runDir) {
   if (ranks.distributed()) {
     sim::DistributedOptions o;
     o.comm = MPI_COMM_WORLD;
@@ -165,11 +172,11 @@ Result<Engine> startEngine(Backend backend, const ScenarioDomain& d, bool pictur
     // deal by work.
     if (ranks.size() == 1) o.blocksPerRank = 1;
     STRATA_TRY(auto s, sim::DistributedSolver::create(detail::modelInputSource(runDir, d), d.params, o,
-                                                      gpu ? sim::glSolverFactory() : sim::cpuSolverFactory()));
+                                                      e.gpu ? sim::glSolverFactory() : sim::cpuSolverFactory()));
     auto solver = std::make_unique<sim::DistributedSolver>(std::move(s));
     e.distributed = solver.get();
     e.solver = std::move(solver);
-  } else if (gpu) {
+  } else if (e.gpu) {
     STRATA_TRY(auto s, sim::GlSolver::create(d.input, d.params));
     e.solver = std::make_unique<sim::GlSolver>(std::move(s));
   } else {
@@ -178,7 +185,7 @@ Result<Engine> startEngine(Backend backend, const ScenarioDomain& d, bool pictur
   }
   for (const auto& src : d.sources) STRATA_TRY_STATUS(e.solver->addSource(src));
   for (const auto& level : d.levels) STRATA_TRY_STATUS(e.solver->addLevel(level));
-  return e;
+  return {};
 }
 
 // What a picture shows of the solver's state: read on every rank (the reads are collective over
@@ -195,8 +202,12 @@ class Pictures {
  public:
   /// `erosion`: draw the solver's current surface and its layers (in their materials' colours),
   /// not the initial bed. Water is drawn only where it is deeper than `wetThresholdM`.
-  static Result<Pictures> create(const ScenarioDomain& d, bool erosion, double wetThresholdM) {
+  /// `bed`: the region's bed at every `stride`-th cell (detail::readStrided of the elevation map);
+  /// the state drawn comes at the same cells (detail::gatherStrided).
+  static Result<Pictures> create(const ScenarioDomain& d, const gis::Raster& bed, int stride, bool erosion,
+                                 double wetThresholdM) {
     Pictures p;
+    p.stride_ = stride;
     p.erosion_ = erosion;
     p.wetThresholdM_ = float(wetThresholdM);
     p.datumM_ = d.input.datumM;
@@ -205,18 +216,18 @@ class Pictures {
       const auto& c = d.input.materials[k].colour;
       p.shading_.layerColours[slot] = glm::vec3(c[0], c[1], c[2]);
     }
-    const auto& g = d.bed.georef;
-    STRATA_TRY(p.scene_, render::TerrainScene::create(d.bed));
+    const auto& g = bed.georef;
+    STRATA_TRY(p.scene_, render::TerrainScene::create(bed));
     STRATA_TRY(p.ring_, render::RingRenderer::create({.circles = 160}));
     STRATA_TRY(p.target_, render::OffscreenTarget::create(kWidth, kHeight));
     const double cx = 0.5 * g.width, cy = 0.5 * g.height;
     double tx = cx, ty = cy;
     if (!d.sources.empty()) {
-      tx = d.sources.front().cells.front().first + 0.5;
-      ty = d.sources.front().cells.front().second + 0.5;
+      tx = (d.sources.front().cells.front().first + 0.5) / stride;
+      ty = (d.sources.front().cells.front().second + 0.5) / stride;
     }
     // Cell (column, row) offsets in metres: east, north.
-    const double dxM = d.input.rowDxM[d.input.rowDxM.size() / 2], dyM = d.input.dyM;
+    const double dxM = d.input.rowDxM[d.input.rowDxM.size() / 2] * stride, dyM = d.input.dyM * stride;
     double east = (cx - tx) * dxM, north = (ty - cy) * dyM;
     if (std::hypot(east, north) < 1) north = 1;  // no inflow: look north from the centre
     const double camX = std::clamp(tx - 0.15 * (cx - tx), 0.5, g.width - 0.5);
@@ -270,6 +281,8 @@ class Pictures {
   }
   /// The ramp's ends of the max-depth picture (m).
   std::array<double, 2> maxDepthRange() const { return maxDepthRange_; }
+  int stride() const { return stride_; }
+  const gis::Georef& georef() const { return scene_.georef(); }
 
  private:
   Status write(const fs::path& file) {
@@ -280,6 +293,7 @@ class Pictures {
   }
 
   static constexpr int kWidth = 960, kHeight = 540;
+  int stride_ = 1;
   bool erosion_ = false;
   std::array<double, 2> maxDepthRange_{0, 0};
   float wetThresholdM_ = 0;
@@ -327,16 +341,29 @@ class Run {
   /// The solver when it runs over MPI ranks (else null).
   sim::DistributedSolver* distributed() { return e_.distributed; }
 
-  /// The state a picture shows (collective).
-  PictureState pictureState(gis::Grid<float> depthM) {
+  /// The state a picture shows at every `stride`-th cell (collective: gathered to the lead).
+  PictureState pictureState(const std::vector<detail::Piece>& pieces, int stride) {
+    const int w = e_.solver->grid().width, h = e_.solver->grid().height;
     PictureState p;
-    p.depthM = std::move(depthM);
+    p.depthM = detail::gatherStrided(ranks_, pieces, stride, w, h,
+                                     [](const detail::Piece& q, size_t i) { return q.depth.data[i]; });
     if (s_.erosion.enabled) {
-      p.surfaceM = solver().readBed();
-      p.layers = solver().readLayers();
-      if (p.layers.size() > 4) p.layers.erase(p.layers.begin(), p.layers.end() - 4);
+      p.surfaceM = detail::gatherStrided(ranks_, pieces, stride, w, h,
+                                         [](const detail::Piece& q, size_t i) { return q.bed.data[i]; });
+      const int L = int(d_.input.materials.size());
+      for (int k = std::max(0, L - 4); k < L; ++k) {
+        p.layers.push_back(detail::gatherStrided(ranks_, pieces, stride, w, h, [k](const detail::Piece& q, size_t i) {
+          return q.layers[size_t(k)].data[i];
+        }));
+      }
     }
     return p;
+  }
+
+  /// The largest depth each cell had, at every `stride`-th cell (collective: on the lead).
+  gis::Grid<float> maxDepthStrided(const std::vector<detail::Piece>& pieces, int stride) {
+    return detail::gatherStrided(ranks_, pieces, stride, e_.solver->grid().width, e_.solver->grid().height,
+                                 [](const detail::Piece& q, size_t i) { return q.flood.maxDepthM.data[i]; });
   }
 
   // Uniform rain while it falls, [start, end).
@@ -746,6 +773,7 @@ Result<RunSummary> runScenario(const Scenario& s, const RunOptions& opt) {
   // once (wholeBuildStep) or there are fewer rows than ranks: then the lead builds it whole. Either
   // way the model input is written into input/ before the run folder's solver reads its blocks
   // from it, and every rank runs on the domain's shape.
+  STRATA_TRY(auto engine, startContext(opt.backend.value_or(s.model.backend), opt.pictures, ranks));
   ScenarioDomain domain;
   Status status;
   std::optional<detail::RowBuilder> byRows;
@@ -774,31 +802,29 @@ Result<RunSummary> runScenario(const Scenario& s, const RunOptions& opt) {
   }
   STRATA_TRY_STATUS(ranks.agree(status));
   const std::string scenarioText = ranks.fromLead(ranks.lead() ? slurp(s.file) : std::string());
+  // Pictures and plots draw the bed: the elevation map, written once the domain is built.
+  const bool elevation = opt.pictures || opt.plots;
   if (byRows) {
-    // Pictures and plots draw the bed, which the lead reads back from the elevation map.
-    const bool bed = opt.pictures || opt.plots;
-    STRATA_TRY(domain, detail::buildByRows(*byRows, s, ranks, opt.outDir, bed));
-    status = {};
-    if (ranks.lead() && bed) {
-      auto elevation = gis::readDem((opt.outDir / "maps" / "elevation.tif").string());
-      if (elevation) domain.bed.values = std::move(elevation->values);
-      status = statusOf(elevation);
+    STRATA_TRY(domain, detail::buildByRows(*byRows, s, ranks, opt.outDir, elevation));
+  } else {
+    if (elevation) {
+      std::vector<gis::GridWindow> whole;
+      if (ranks.lead()) whole.push_back({0, 0, domain.bed.values});
+      STRATA_TRY_STATUS(
+          detail::writeRaster(ranks, opt.outDir / "maps" / "elevation.tif", domain.bed.georef, {}, whole));
     }
-    STRATA_TRY_STATUS(ranks.agree(status));
-  } else if (ranks.distributed()) {
-    // The lead's domain: its shape to every rank, its cells into input/. Every rank, the lead too,
-    // then runs on the shape and reads its blocks from input/: the lead lets go of the domain's
-    // grids but for the bed, which pictures and the elevation map need.
-    const std::string shape = ranks.fromLead(ranks.lead() ? detail::encodeDomainShape(domain) : std::string());
-    auto decoded = detail::decodeDomainShape(shape);
-    STRATA_TRY_STATUS(ranks.agree(statusOf(decoded)));
-    const ScenarioDomain& sh = *decoded;
-    STRATA_TRY_STATUS(detail::writeModelInput(ranks, opt.outDir, sh.bed.georef, domain, int(sh.input.materials.size()),
-                                              sh.input.waterDepthM.size() > 0, sh.input.rainMmPerHour.size() > 0));
-    gis::Grid<float> bed;
-    if (ranks.lead() && (opt.pictures || opt.plots)) bed = std::move(domain.bed.values);
-    domain = std::move(decoded).value();
-    domain.bed.values = std::move(bed);
+    if (ranks.distributed()) {
+      // The lead's domain: its shape to every rank, its cells into input/. Every rank, the lead
+      // too, then runs on the shape and reads its blocks from input/.
+      const std::string shape = ranks.fromLead(ranks.lead() ? detail::encodeDomainShape(domain) : std::string());
+      auto decoded = detail::decodeDomainShape(shape);
+      STRATA_TRY_STATUS(ranks.agree(statusOf(decoded)));
+      const ScenarioDomain& sh = *decoded;
+      STRATA_TRY_STATUS(detail::writeModelInput(ranks, opt.outDir, sh.bed.georef, domain,
+                                                int(sh.input.materials.size()), sh.input.waterDepthM.size() > 0,
+                                                sh.input.rainMmPerHour.size() > 0));
+      domain = std::move(decoded).value();
+    }
   }
   const std::string name = displayName(s.name);
   if (ranks.lead()) {
@@ -813,7 +839,7 @@ Result<RunSummary> runScenario(const Scenario& s, const RunOptions& opt) {
   const fs::path checkpointPath =
       opt.outDir / (ranks.distributed() ? detail::rankCheckpointFile(ranks.rank(), ranks.size()) : "checkpoint.bin");
 
-  STRATA_TRY(auto engine, startEngine(opt.backend.value_or(s.model.backend), domain, opt.pictures, ranks, opt.outDir));
+  STRATA_TRY_STATUS(startSolver(engine, domain, ranks, opt.outDir));
   engine.solver->enableFloodStats(float(s.outputs.wetThresholdM));
   Run run(s, opt, ranks, std::move(domain), std::move(engine));
   log::info(opt.command) << "running on " << run.backendName();
@@ -824,22 +850,31 @@ Result<RunSummary> runScenario(const Scenario& s, const RunOptions& opt) {
     STRATA_TRY(spinUp, run.spinUp(s.spinUpS, s.spinUpTolerance, name));
   }
 
-  // Pictures: the state read on every rank, drawn by the lead.
+  // Pictures: the state read on every rank at every `stride`-th cell, drawn by the lead.
   std::optional<Pictures> pictures;
-  auto drawPicture = [&](gis::Grid<float> depth, const char* file) -> Status {
-    auto state = run.pictureState(std::move(depth));
+  const int stride = detail::pictureStride(run.solver().grid().width, run.solver().grid().height, opt.pictureCells);
+  auto drawPicture = [&](const std::vector<detail::Piece>& pieces, const char* file) -> Status {
+    auto state = run.pictureState(pieces, stride);
     return ranks.agree(pictures ? pictures->draw(std::move(state), opt.outDir / "pictures" / file) : Status{});
   };
   if (opt.pictures) {
     if (ranks.lead()) {
       std::error_code ec;
       fs::create_directories(opt.outDir / "pictures", ec);
-      auto p = Pictures::create(run.domain(), s.erosion.enabled, s.outputs.wetThresholdM);
-      if (p) pictures.emplace(std::move(p).value());
-      status = statusOf(p);
+      auto bed = detail::readStrided(opt.outDir / "maps" / "elevation.tif", stride);
+      status = statusOf(bed);
+      if (bed) {
+        auto p = Pictures::create(run.domain(), *bed, stride, s.erosion.enabled, s.outputs.wetThresholdM);
+        if (p) pictures.emplace(std::move(p).value());
+        status = statusOf(p);
+      }
     }
     STRATA_TRY_STATUS(ranks.agree(status));
-    if (!opt.resume) STRATA_TRY_STATUS(drawPicture(run.solver().readWaterDepth(), "before.png"));
+    if (!opt.resume) {
+      auto pieces = run.pieces();
+      STRATA_TRY_STATUS(ranks.agree(statusOf(pieces)));
+      STRATA_TRY_STATUS(drawPicture(*pieces, "before.png"));
+    }
   }
 
   RunSummary summary;
@@ -913,14 +948,13 @@ Result<RunSummary> runScenario(const Scenario& s, const RunOptions& opt) {
       const bool peak = std::all_of(summary.series.begin(), summary.series.end(),
                                     [&](const SeriesRow& r) { return r.waterM3 <= row.waterM3; });
       const bool last = interval == intervals;
-      const auto depth = peak || last ? run.solver().readWaterDepth() : gis::Grid<float>();
-      if (peak) STRATA_TRY_STATUS(drawPicture(depth, "peak.png"));
+      if (peak) STRATA_TRY_STATUS(drawPicture(*pieces, "peak.png"));
       if (last) {
-        STRATA_TRY_STATUS(drawPicture(depth, "after.png"));
-        const auto maxDepth = run.solver().readFloodStats().maxDepthM;
-        STRATA_TRY_STATUS(ranks.agree(pictures ? pictures->drawMaxDepth(maxDepth, run.domain().bed.georef,
-                                                                        opt.outDir / "pictures" / "max_depth.png")
-                                               : Status{}));
+        STRATA_TRY_STATUS(drawPicture(*pieces, "after.png"));
+        const auto maxDepth = run.maxDepthStrided(*pieces, stride);
+        STRATA_TRY_STATUS(ranks.agree(
+            pictures ? pictures->drawMaxDepth(maxDepth, pictures->georef(), opt.outDir / "pictures" / "max_depth.png")
+                     : Status{}));
       }
     }
     status = run.writeMaps(*pieces);
@@ -987,7 +1021,7 @@ Result<RunSummary> runScenario(const Scenario& s, const RunOptions& opt) {
   const FloodSummary flood = run.floodSummary(*finalPieces);
   if (!ranks.lead()) return summary;  // the lead writes the plots and the report
   if (opt.plots) {
-    STRATA_TRY(auto plots, writePlots(opt.outDir, run.domain().bed, summary.completed));
+    STRATA_TRY(auto plots, writePlots(opt.outDir, summary.completed));
     summary.files.insert(summary.files.end(), plots.begin(), plots.end());
   }
   STRATA_TRY_STATUS(writeReport(

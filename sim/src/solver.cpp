@@ -276,15 +276,20 @@ FloodStats Solver::readLocalFloodStats(const gis::CellRect& rect) const {
   return cropFloodStats(all, rect);
 }
 
+gis::Grid<float> Solver::readLocalBed(const gis::CellRect& rect) const {
+  const gis::Grid<float> all = readBed();
+  if (rect.x == 0 && rect.y == 0 && rect.width == grid_.width && rect.height == grid_.height) return all;
+  return cropGrid(all, rect);
+}
+
+gis::Grid<float> cropGrid(const gis::Grid<float>& g, const gis::CellRect& r) {
+  gis::Grid<float> out(r.width, r.height);
+  for (int y = 0; y < r.height; ++y) std::copy_n(&g.at(r.x, r.y + y), size_t(r.width), &out.at(0, y));
+  return out;
+}
+
 FloodStats cropFloodStats(const FloodStats& f, const gis::CellRect& r) {
-  auto crop = [&](const gis::Grid<float>& g) {
-    gis::Grid<float> out(r.width, r.height);
-    for (int y = 0; y < r.height; ++y) {
-      std::copy_n(&g.at(r.x, r.y + y), size_t(r.width), &out.at(0, y));
-    }
-    return out;
-  };
-  return {crop(f.maxDepthM), crop(f.maxSpeedMS), crop(f.arrivalS), crop(f.wetDurationS)};
+  return {cropGrid(f.maxDepthM, r), cropGrid(f.maxSpeedMS, r), cropGrid(f.arrivalS, r), cropGrid(f.wetDurationS, r)};
 }
 
 // The same per-cell update as the backends' own (e.g. sim/shaders/flood_stats.comp), on the host.

@@ -344,8 +344,8 @@ TEST(SimDistributed, ReadersAndWriteBlockAreCollective) {
 }
 
 // What each rank holds, read without a gather (what a scenario's maps are written from): the
-// ranks' local rectangles cover every cell once, and their state and flood statistics are the
-// one-process solver's, bit for bit.
+// ranks' local rectangles cover every cell once, and their state, flood statistics and bed are
+// the one-process solver's, bit for bit.
 TEST(SimDistributed, LocalReadsCoverTheGridOnceAndEqualOneProcess) {
   const auto scene = floodScene();
   auto sim = DistributedSolver::create(scene.input, scene.params, {}, cpuSolverFactory());
@@ -376,6 +376,7 @@ TEST(SimDistributed, LocalReadsCoverTheGridOnceAndEqualOneProcess) {
     EXPECT_TRUE(sameBits(f.maxSpeedMS.data, g.maxSpeedMS.data));
     EXPECT_TRUE(sameBits(f.arrivalS.data, g.arrivalS.data));
     EXPECT_TRUE(sameBits(f.wetDurationS.data, g.wetDurationS.data));
+    EXPECT_TRUE(sameBits(sim->readLocalBed(r).data, cropGrid(ref->readBed(), r).data));
   }
   MPI_Allreduce(MPI_IN_PLACE, covered.data(), int(covered.size()), MPI_INT, MPI_SUM, MPI_COMM_WORLD);
   EXPECT_TRUE(std::all_of(covered.begin(), covered.end(), [](int c) { return c == 1; }));

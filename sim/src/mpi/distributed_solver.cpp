@@ -621,6 +621,11 @@ FloodStats DistributedSolver::readLocalFloodStats(const CellRect& rect) const {
   return cropFloodStats(b.solver->readFloodStats(), b.local(rect));
 }
 
+gis::Grid<float> DistributedSolver::readLocalBed(const CellRect& rect) const {
+  const auto& b = impl_->holding(rect);
+  return cropGrid(b.solver->readBed(), b.local(rect));
+}
+
 void DistributedSolver::forEachPart(const std::function<void(Solver&)>& f) {
   for (auto& b : impl_->blocks) f(*b.solver);
 }

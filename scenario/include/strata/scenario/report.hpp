@@ -37,10 +37,11 @@ struct ReportInput {
   std::string maxDepthLegend = {};         ///< what the max-depth picture's colours mean
 };
 
-/// plots/*.png: the time series (scenario/plots/plot_series.py) and the maps over a hillshade
-/// (scenario/plots/plot_maps.py), with Debian's matplotlib. Returns the files written (relative).
-Result<std::vector<std::string>> writePlots(const std::filesystem::path& runDir, const gis::Raster& bed,
-                                            bool completed);
+/// plots/*.png: the time series (scenario/plots/plot_series.py) and the maps over a hillshade of
+/// maps/elevation.tif (scenario/plots/plot_maps.py; the run writes the elevation map once the
+/// domain is built), with Debian's matplotlib. Returns the files written (relative), the
+/// elevation map first.
+Result<std::vector<std::string>> writePlots(const std::filesystem::path& runDir, bool completed);
 
 /// report.md.
 Status writeReport(const std::filesystem::path& runDir, const ReportInput& input);

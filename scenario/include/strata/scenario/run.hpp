@@ -32,15 +32,20 @@ struct RunOptions {
   /// Refuse grids whose run needs more memory than this (bytes; 0: what the machine has available).
   uint64_t memoryBudgetBytes = 0;
   bool pictures = true;  ///< render before / peak / after pictures
-  bool plots = true;     ///< PNG plots of the time series (matplotlib)
+  /// Pictures of a region over this many cells a side are drawn from every k-th cell of each row
+  /// and column (the smallest k that brings it within), so that the rendered bed and the state
+  /// gathered for it stay bounded whatever the region.
+  int pictureCells = 4096;
+  bool plots = true;  ///< PNG plots of the time series (matplotlib)
   /// Stop after this many output intervals (tests of interrupt-and-resume); -1 = run to the end.
   int stopAfterIntervals = -1;
   /// Run over the ranks of MPI_COMM_WORLD (`mpirun -np N strata flood`; docs/distributed.md,
   /// "Scenario runs"): MPI is initialised by the caller, and every rank calls runScenario with the
-  /// same scenario and options. Rank 0 builds the domain and writes the shared files (the model
-  /// input in input/, maps, series, pictures, report); each rank reads its blocks' windows of the
-  /// input and writes its own part of each checkpoint (checkpoint.R-of-N.bin); a run is resumed
-  /// on the same number of ranks. Failures are the same on every rank.
+  /// same scenario and options. The ranks build the domain row by row (or rank 0 builds it whole
+  /// when a step needs the whole region) into the model input (input/); each rank reads its
+  /// blocks' windows of it, writes its blocks of the maps and its own part of each checkpoint
+  /// (checkpoint.R-of-N.bin); rank 0 writes the series, pictures, plots and report. A run is
+  /// resumed on the same number of ranks. Failures are the same on every rank.
   bool distributed = false;
 };
 

@@ -119,6 +119,7 @@ class DistributedSolver final : public Solver {
   std::vector<CellRect> localRects() const override;
   CellBlock readLocal(const CellRect& rect, unsigned parts) const override;
   FloodStats readLocalFloodStats(const CellRect& rect) const override;
+  gis::Grid<float> readLocalBed(const CellRect& rect) const override;
   /// The rank of every block (local: every rank holds the same).
   const std::vector<int>& owners() const;
   const DistributedCounters& counters() const;  ///< local

@@ -189,6 +189,8 @@ class Solver {
   virtual CellBlock readLocal(const gis::CellRect& rect, unsigned parts) const;
   /// The flood statistics of a rectangle inside one of localRects().
   virtual FloodStats readLocalFloodStats(const gis::CellRect& rect) const;
+  /// The bed (above datumM()) of a rectangle inside one of localRects().
+  virtual gis::Grid<float> readLocalBed(const gis::CellRect& rect) const;
 
   /// The state to continue from later (a checkpoint).
   SolverState saveState() const;
@@ -321,5 +323,7 @@ std::vector<float> initialFloodStatsCells(size_t cells);
 FloodStats floodStatsFromCells(const std::vector<float>& cells, int width, int height);
 /// The part of `stats` (of a grid) inside `rect` (inside that grid).
 FloodStats cropFloodStats(const FloodStats& stats, const gis::CellRect& rect);
+/// The part of a grid inside `rect` (inside it).
+gis::Grid<float> cropGrid(const gis::Grid<float>& grid, const gis::CellRect& rect);
 
 }  // namespace strata::sim
