@@ -32,15 +32,25 @@ STYLE = {
 }
 
 
+# A figure is ~1000 pixels wide: a larger map is read at every k-th cell (GDAL's nearest), so
+# that a region of any size plots in bounded memory and time.
+MAX_CELLS = 2048
+
+
 def read(path):
     ds = gdal.Open(str(path))
     band = ds.GetRasterBand(1)
-    a = band.ReadAsArray().astype(np.float64)
+    k = max(1, -(-max(ds.RasterXSize, ds.RasterYSize) // MAX_CELLS))
+    bx, by = -(-ds.RasterXSize // k), -(-ds.RasterYSize // k)
+    a = band.ReadAsArray(buf_xsize=bx, buf_ysize=by,
+                         resample_alg=gdal.GRIORA_NearestNeighbour).astype(np.float64)
     nodata = band.GetNoDataValue()
     if nodata is not None:
         a[a == nodata] = np.nan
-    gt = ds.GetGeoTransform()
-    extent = [gt[0], gt[0] + gt[1] * ds.RasterXSize, gt[3] + gt[5] * ds.RasterYSize, gt[3]]
+    gt = list(ds.GetGeoTransform())
+    gt[1] *= ds.RasterXSize / bx  # the cells as read (hillshade's slopes)
+    gt[5] *= ds.RasterYSize / by
+    extent = [gt[0], gt[0] + gt[1] * bx, gt[3] + gt[5] * by, gt[3]]
     geographic = ds.GetSpatialRef() is not None and ds.GetSpatialRef().IsGeographic()
     return a, extent, gt, geographic
 
