@@ -368,8 +368,7 @@ Status fillOverRanks(const RowBuilder& b, const Ranks& ranks, const std::vector<
 
 }  // namespace
 
-Result<ScenarioDomain> buildByRows(const RowBuilder& b, const Scenario& s, const Ranks& ranks, const fs::path& runDir,
-                                   bool elevation) {
+Result<RowsBuilt> buildByRows(const RowBuilder& b, const Scenario& s, const Ranks& ranks) {
   ScenarioDomain shape = b.shape();
   const gis::Georef grid = shape.bed.georef;
   const int w = grid.width, h = grid.height, n = ranks.size();
@@ -380,8 +379,7 @@ Result<ScenarioDomain> buildByRows(const RowBuilder& b, const Scenario& s, const
   STRATA_CHECK(own > 0) << "buildByRows needs a row per rank";
   // The row below too, for fill_depressions' joins across the border with the next rank's rows.
   const int end = s.terrain.fillDepressions ? std::min(h, y0 + own + 1) : y0 + own;
-  float lowest = 0;
-  auto built = b.rows(y0, end, &lowest);
+  auto built = b.rows(y0, end);
   STRATA_TRY_STATUS(ranks.agree(statusOf(built)));
   ScenarioDomain d = std::move(built).value();
 
@@ -438,15 +436,16 @@ Result<ScenarioDomain> buildByRows(const RowBuilder& b, const Scenario& s, const
   ranks.max(hi);
   shape.bedRangeM = {float(lo[0]), float(hi[0])};
 
-  // Every rank writes its rows of the model input (and of the elevation map).
-  STRATA_TRY_STATUS(writeModelInput(ranks, runDir, grid, d, int(shape.input.materials.size()),
+  return RowsBuilt{std::move(shape), std::move(d)};
+}
+
+Status writeRows(const Ranks& ranks, const fs::path& runDir, const RowsBuilt& built, bool elevation) {
+  const auto& shape = built.shape;
+  const auto& d = built.rows;
+  STRATA_TRY_STATUS(writeModelInput(ranks, runDir, shape.bed.georef, d, int(shape.input.materials.size()),
                                     shape.input.waterDepthM.size() > 0, shape.input.rainMmPerHour.size() > 0));
-  if (elevation) {
-    std::error_code ec;
-    if (ranks.lead()) fs::create_directories(runDir / "maps", ec);
-    STRATA_TRY_STATUS(writeRaster(ranks, runDir / "maps" / "elevation.tif", grid, {}, {{0, y0, d.bed.values}}));
-  }
-  return shape;
+  if (!elevation) return {};
+  return writeRaster(ranks, runDir / "maps" / "elevation.tif", shape.bed.georef, {}, {{0, d.firstRow, d.bed.values}});
 }
 sim::RegionSource modelInputSource(const fs::path& runDir, const ScenarioDomain& shape) {
   sim::RegionSource region;

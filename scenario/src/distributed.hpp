@@ -81,14 +81,20 @@ Status writeModelInput(const Ranks& ranks, const std::filesystem::path& runDir, 
                        const ScenarioDomain& d, int layers, bool water, bool rain);
 
 class RowBuilder;
+/// A domain built by the ranks: its shape (the same on every rank, with the report's numbers of
+/// the build) and this rank's rows of it.
+struct RowsBuilt {
+  ScenarioDomain shape, rows;
+};
 /// Collective: the domain built rows by rows over the ranks (domain_rows.hpp): rank r builds rows
 /// [r h / N, (r + 1) h / N) from its own windows of the DEM, the ranks combine the datum, the
-/// totals and the checks, fill_depressions runs tile by tile (each rank's rows a tile; the
-/// labels' graph is gathered to the lead, solved there and sent back), and every rank writes its
-/// rows of the model input and, with `elevation`, of maps/elevation.tif. Returns the domain's
-/// shape with the report's numbers, the same on every rank. Needs at least one row per rank.
-Result<ScenarioDomain> buildByRows(const RowBuilder& builder, const Scenario& s, const Ranks& ranks,
-                                   const std::filesystem::path& runDir, bool elevation);
+/// totals and the checks, and fill_depressions runs tile by tile (each rank's rows a tile; the
+/// labels' graph is gathered to the lead, solved there and sent back). Writes nothing (a check
+/// that fails leaves no file). Needs at least one row per rank.
+Result<RowsBuilt> buildByRows(const RowBuilder& builder, const Scenario& s, const Ranks& ranks);
+/// Collective: every rank writes its rows into the model input and, with `elevation`, into
+/// maps/elevation.tif.
+Status writeRows(const Ranks& ranks, const std::filesystem::path& runDir, const RowsBuilt& built, bool elevation);
 
 /// The region read window by window from those files (`shape` from decodeDomainShape or the
 /// lead's domain): what each rank builds its blocks from.

@@ -508,8 +508,7 @@ gis::Georef rowsGeoref(const gis::Georef& grid, int y0, int y1) {
 // Step 3b: the bed's cells without data ([terrain] voids). Every mode but "refuse" fills their bed
 // from the cells around them (GDAL's fill-nodata): "walls" then masks them out (maskRegion) and
 // "holes" drains them (placeVoidHoles).
-Error refuseVoids(const Scenario& s, const TerrainSource& source, long long count) {
-  (void)s;
+Error refuseVoids(const TerrainSource& source, long long count) {
   return fail(source.path() + ": the region has " + std::to_string(count) +
               " cells without data (nodata); choose a region the " + source.kind() +
               " covers, or set [terrain] voids = \"fill\", \"walls\" or \"holes\"");
@@ -528,7 +527,7 @@ Status handleVoids(const Scenario& s, const TerrainSource& source, ScenarioDomai
   findVoids(d);
   if (d.voidCells == 0) return {};
   using V = decltype(s.terrain)::Voids;
-  if (s.terrain.voids == V::kRefuse) return refuseVoids(s, source, d.voidCells);
+  if (s.terrain.voids == V::kRefuse) return refuseVoids(source, d.voidCells);
   auto filled = gis::fillVoids(d.bed.values);
   if (!filled) return fail(source.path() + ": " + filled.message());
   return {};
@@ -1234,7 +1233,7 @@ Result<RowBuilder> RowBuilder::plan(const Scenario& s, uint64_t memoryBudgetByte
 
 const ScenarioDomain& RowBuilder::shape() const { return impl_->shape; }
 
-Result<ScenarioDomain> RowBuilder::rows(int y0, int y1, float* lowestBed) const {
+Result<ScenarioDomain> RowBuilder::rows(int y0, int y1) const {
   const Scenario& s = impl_->s;
   const Plan& plan = impl_->plan;
   ScenarioDomain d;
@@ -1243,14 +1242,12 @@ Result<ScenarioDomain> RowBuilder::rows(int y0, int y1, float* lowestBed) const 
   findVoids(d);
   maskRegion(s, plan.frame, d);
   STRATA_TRY_STATUS(measureRegion(plan, d));
-  STRATA_TRY(*lowestBed, stackLayers(s, plan, storeLayers, d));
+  STRATA_TRY_STATUS(statusOf(stackLayers(s, plan, storeLayers, d)));  // (the caller finds the lowest bed of its rows)
   STRATA_TRY_STATUS(placeRain(s, plan, d));
   return d;
 }
 
-Error RowBuilder::refuseVoids(long long count) const {
-  return scenario::refuseVoids(impl_->s, impl_->plan.source, count);
-}
+Error RowBuilder::refuseVoids(long long count) const { return scenario::refuseVoids(impl_->plan.source, count); }
 bool RowBuilder::hasLooseMaterial(const ScenarioDomain& d) const { return scenario::hasLooseMaterial(d); }
 Error RowBuilder::refuseNoLooseMaterial() const { return scenario::refuseNoLooseMaterial(impl_->s); }
 gis::Grid<uint8_t> RowBuilder::drains(const ScenarioDomain& d) const {

@@ -38,10 +38,9 @@ class RowBuilder {
   /// waterDepthM for dam breaks).
   const ScenarioDomain& shape() const;
   /// Rows [y0, y1) of the region (firstRow y0): bed, voids (not filled), mask, cell areas and
-  /// their total, base (walls), layers, the rain raster; `lowestBed` the lowest bed of the
-  /// region's cells there (the datum is the lowest over all rows, floored). No datum, nothing
-  /// filled, no check that needs every row.
-  Result<ScenarioDomain> rows(int y0, int y1, float* lowestBed) const;
+  /// their total, base (walls), layers, the rain raster. No datum (the lowest bed over all rows,
+  /// floored), nothing filled, no check that needs every row.
+  Result<ScenarioDomain> rows(int y0, int y1) const;
 
   // What buildDomain does over the whole region, for the caller to do over the rows.
   Error refuseVoids(long long count) const;

@@ -782,7 +782,10 @@ Result<RunSummary> runScenario(const Scenario& s, const RunOptions& opt) {
     STRATA_TRY_STATUS(ranks.agree(statusOf(planned)));
     if (planned->shape().bed.georef.height >= ranks.size()) byRows.emplace(std::move(planned).value());
   }
-  if (!byRows && ranks.lead()) {
+  std::optional<detail::RowsBuilt> rows;
+  if (byRows) {
+    STRATA_TRY(rows, detail::buildByRows(*byRows, s, ranks));
+  } else if (ranks.lead()) {
     auto built = buildDomain(s, opt.memoryBudgetBytes, ranks.size());
     if (built) domain = std::move(built).value();
     status = statusOf(built);
@@ -804,8 +807,10 @@ Result<RunSummary> runScenario(const Scenario& s, const RunOptions& opt) {
   const std::string scenarioText = ranks.fromLead(ranks.lead() ? slurp(s.file) : std::string());
   // Pictures and plots draw the bed: the elevation map, written once the domain is built.
   const bool elevation = opt.pictures || opt.plots;
-  if (byRows) {
-    STRATA_TRY(domain, detail::buildByRows(*byRows, s, ranks, opt.outDir, elevation));
+  if (rows) {
+    STRATA_TRY_STATUS(detail::writeRows(ranks, opt.outDir, *rows, elevation));
+    domain = std::move(rows->shape);
+    rows.reset();  // this rank's rows: read back from input/ by its blocks
   } else {
     if (elevation) {
       std::vector<gis::GridWindow> whole;

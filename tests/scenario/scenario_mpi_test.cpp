@@ -212,6 +212,23 @@ TEST(ScenarioMpi, ADomainBuiltByTheRanksRowByRowEqualsOneProcess) {
     }
     fs::remove_all(dir);
   }
+  // A check over every rank's rows that fails (a stage below every bed of its level) fails on
+  // every rank with the one process's message, before the run folder is touched.
+  std::string low = level;
+  low.replace(low.find("stage = [[0, 880]]"), 18, "stage = [[0, 100]]");
+  const auto dir = sharedDir("rows-refused");
+  const Scenario s = load(dir, "rows.toml", low);
+  auto o = options(dir / "ranks", "flood");
+  o.distributed = true;
+  auto refused = runScenario(s, o);
+  ASSERT_FALSE(refused);
+  EXPECT_NE(refused.message().find("rows.toml:" + std::to_string(s.water.levels[0].stageLine) +
+                                   ": key 'water.level[0].stage': the stage (at most 100.00 m) never rises"),
+            std::string::npos)
+      << refused.message();
+  MPI_Barrier(MPI_COMM_WORLD);
+  EXPECT_FALSE(fs::exists(dir / "ranks"));
+  if (worldRank() == 0) fs::remove_all(dir);
 }
 
 TEST(ScenarioMpi, AnErosionRunOverTheRanksEqualsOneProcess) {
