@@ -97,8 +97,8 @@ gis::Grid<float> gatherStrided(const Ranks& ranks, const std::vector<Piece>& pie
 }
 
 Result<gis::Raster> readStrided(const fs::path& path, int stride) {
-  STRATA_TRY(auto info, gis::probeDem(path.string()));
-  const gis::Georef& g = info.georef;
+  STRATA_TRY(auto file, gis::DemFile::open(path.string()));
+  const gis::Georef& g = file.info().georef;
   gis::Raster out;
   out.georef = g;
   out.georef.width = (g.width + stride - 1) / stride;
@@ -111,12 +111,9 @@ Result<gis::Raster> readStrided(const fs::path& path, int stride) {
   out.values = gis::Grid<float>(out.georef.width, out.georef.height);
   const int band = std::max(stride, 256 / stride * stride);  // rows read at a time
   for (int y0 = 0; y0 < g.height; y0 += band) {
-    gis::ReadOptions o;
-    o.window = gis::CellRect{0, y0, g.width, std::min(band, g.height - y0)};
-    o.allowAllNoData = true;
-    STRATA_TRY(auto rows, gis::readDem(path.string(), o));
-    for (int y = 0; y < o.window->height; y += stride) {
-      for (int x = 0; x < g.width; x += stride) out.values.at(x / stride, (y0 + y) / stride) = rows.values.at(x, y);
+    STRATA_TRY(auto rows, file.readPadded({0, y0, g.width, std::min(band, g.height - y0)}));
+    for (int y = 0; y < rows.height; y += stride) {
+      for (int x = 0; x < g.width; x += stride) out.values.at(x / stride, (y0 + y) / stride) = rows.at(x, y);
     }
   }
   return out;
