@@ -12,6 +12,7 @@
 #include <strata/gis/fill_depressions.hpp>
 #include <strata/sim/distributed_solver.hpp>
 
+#include "breach.hpp"
 #include "domain_rows.hpp"
 #include "pieces.hpp"
 
@@ -140,6 +141,25 @@ std::vector<std::string> Ranks::gatherToLead(const std::string& bytes) const {
   MPI_Gatherv(bytes.data(), n, MPI_CHAR, all.data(), counts.data(), offsets.data(), MPI_CHAR, 0, MPI_COMM_WORLD);
   std::vector<std::string> out;
   if (!lead()) return out;
+  for (int r = 0; r < size_; ++r) out.push_back(all.substr(size_t(offsets[size_t(r)]), size_t(counts[size_t(r)])));
+  return out;
+}
+
+std::vector<std::string> Ranks::allGatherBytes(const std::string& bytes) const {
+  if (!distributed_) return {bytes};
+  STRATA_CHECK(bytes.size() < size_t(INT_MAX)) << "a rank's part of a gather exceeds 2 GB";
+  int n = int(bytes.size());
+  std::vector<int> counts(static_cast<size_t>(size_)), offsets(static_cast<size_t>(size_));
+  MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, MPI_COMM_WORLD);
+  size_t total = 0;
+  for (int r = 0; r < size_; ++r) {
+    offsets[size_t(r)] = int(total);
+    total += size_t(counts[size_t(r)]);
+  }
+  STRATA_CHECK(total < size_t(INT_MAX)) << "a gather over the ranks exceeds 2 GB";
+  std::string all(total, '\0');
+  MPI_Allgatherv(bytes.data(), n, MPI_CHAR, all.data(), counts.data(), offsets.data(), MPI_CHAR, MPI_COMM_WORLD);
+  std::vector<std::string> out;
   for (int r = 0; r < size_; ++r) out.push_back(all.substr(size_t(offsets[size_t(r)]), size_t(counts[size_t(r)])));
   return out;
 }
@@ -404,6 +424,10 @@ Result<RowsBuilt> buildByRows(const RowBuilder& b, const Scenario& s, const Rank
   shape.totalAreaM2 = sums[1].value();
   d.input.datumM = shape.input.datumM;
 
+  std::vector<int> rowStarts;
+  for (int k = 0; k <= n; ++k) rowStarts.push_back(firstRowOf(k));
+  STRATA_TRY_STATUS(breachInflowPaths(s, ranks, rowStarts, shape.sources, shape.sourceNames, d));
+  shape.breach = d.breach;
   if (s.terrain.fillDepressions) {
     std::vector<sim::ExactSum> filled(2);  // cells, volume
     STRATA_TRY_STATUS(fillOverRanks(b, ranks, tiles, own, d, filled[1]));

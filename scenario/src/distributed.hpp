@@ -52,6 +52,8 @@ class Ranks {
   void max(std::vector<double>& values) const;
   /// Collective: every rank's `bytes`, in rank order, on the lead (nothing elsewhere).
   std::vector<std::string> gatherToLead(const std::string& bytes) const;
+  /// Collective: every rank's `bytes`, in rank order, on every rank.
+  std::vector<std::string> allGatherBytes(const std::string& bytes) const;
 
  private:
   bool distributed_ = false;

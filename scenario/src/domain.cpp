@@ -7,7 +7,6 @@
 #include <limits>
 #include <map>
 #include <memory>
-#include <queue>
 #include <set>
 
 #include <strata/core/memory.hpp>
@@ -21,6 +20,8 @@
 #include <strata/terrain/material.hpp>
 #include <strata/terrain/tile_store.hpp>
 
+#include "breach.hpp"
+#include "distributed.hpp"
 #include "domain_rows.hpp"
 
 namespace strata::scenario {
@@ -957,95 +958,6 @@ Status checkModelParams(const Scenario& s, const sim::SimParams& p) {
   return fail(s.file.string() + ": the model refuses these parameters (" + m + ")");
 }
 
-// [terrain] breach_inflows. At a canyon's own DEM resolution the river's floor, narrower than a
-// cell, is averaged with the walls: the grid holds dams across the river that the real one does
-// not have, and a flood ponds behind them. From each inflow, the path to an open edge whose highest
-// cell is lowest (a 4-neighbour priority flood, ties broken by length) is given the non-increasing
-// elevation profile closest to its own (isotonic regression): dams on it are cut, pits on it
-// filled, and it never climbs (a form of least-cost breaching, cf. Lindsay 2016). Cells off the
-// path are left as they are.
-Status breachInflowPaths(const Scenario& s, ScenarioDomain& d) {
-  if (!s.terrain.breachInflows) return {};
-  const int w = d.bed.georef.width, h = d.bed.georef.height;
-  const auto& open = s.model.boundaries;  // W E S N
-  auto outlet = [&](int x, int y) {
-    return (x == 0 && open[0] == Boundary::Open) || (x == w - 1 && open[1] == Boundary::Open) ||
-           (y == h - 1 && open[2] == Boundary::Open) || (y == 0 && open[3] == Boundary::Open);
-  };
-  auto& z = d.input.baseM;
-  for (size_t k = 0; k < d.sources.size(); ++k) {
-    struct Entry {
-      float top;
-      int length;
-      int cell;
-      bool operator>(const Entry& o) const { return top != o.top ? top > o.top : length > o.length; }
-    };
-    std::priority_queue<Entry, std::vector<Entry>, std::greater<>> queue;
-    std::vector<int> from(size_t(w) * size_t(h), -2);  // -2 unseen, -1 a start
-    for (auto [x, y] : d.sources[k].cells) {
-      const int c = y * w + x;
-      if (from[size_t(c)] == -2) queue.push({z.data[size_t(c)], 0, c});
-      from[size_t(c)] = -1;
-    }
-    int end = -1;
-    while (!queue.empty() && end < 0) {
-      const Entry e = queue.top();
-      queue.pop();
-      const int x = e.cell % w, y = e.cell / w;
-      if (outlet(x, y)) end = e.cell;
-      const int next[4][2] = {{x - 1, y}, {x + 1, y}, {x, y - 1}, {x, y + 1}};
-      for (const auto& n : next) {
-        if (n[0] < 0 || n[0] >= w || n[1] < 0 || n[1] >= h) continue;
-        const size_t c = size_t(n[1]) * size_t(w) + size_t(n[0]);
-        if (from[c] != -2 || !d.inside.data[c]) continue;
-        from[c] = e.cell;
-        queue.push({std::max(e.top, z.data[c]), e.length + 1, int(c)});
-      }
-    }
-    if (end < 0) {
-      return fail(s.at("terrain.breach_inflows") + "no open edge can be reached from the inflow \"" + d.sourceNames[k] +
-                  "\" (open an edge in model.boundary)");
-    }
-    std::vector<int> path;
-    for (int c = end; c >= 0; c = from[size_t(c)]) path.push_back(c);
-    std::reverse(path.begin(), path.end());
-    // The non-increasing profile closest to the path's (least squares: pool adjacent violators),
-    // so a dam is cut and a pit on the path is filled by about as much, not a trench dug down to
-    // the deepest pit.
-    struct Pool {
-      double sum;
-      int count;
-      double mean() const { return sum / count; }
-    };
-    std::vector<Pool> pools;
-    for (const int c : path) {
-      pools.push_back({double(z.data[size_t(c)]), 1});
-      while (pools.size() > 1 && pools.back().mean() > pools[pools.size() - 2].mean()) {
-        pools[pools.size() - 2].sum += pools.back().sum;
-        pools[pools.size() - 2].count += pools.back().count;
-        pools.pop_back();
-      }
-    }
-    size_t at = 0;
-    for (const auto& pool : pools) {
-      const float level = float(pool.mean());
-      for (int i = 0; i < pool.count; ++i, ++at) {
-        const size_t c = size_t(path[at]);
-        const double change = double(level) - double(z.data[c]);
-        if (change == 0) continue;
-        ++d.breach.cells;
-        (change < 0 ? d.breach.maxCutM : d.breach.maxFillM) =
-            std::max(change < 0 ? d.breach.maxCutM : d.breach.maxFillM, std::abs(change));
-        (change < 0 ? d.breach.cutM3 : d.breach.fillM3) += std::abs(change) * d.cellAreaM2.data[c];
-        z.data[c] = level;
-        d.bed.values.data[c] = level;
-      }
-    }
-    ++d.breach.paths;
-  }
-  return {};
-}
-
 // Where fill_depressions' floods start: the region's cells on an open edge, and voids that are
 // holes (the rows of `d`, of a region `height` rows high).
 gis::Grid<uint8_t> drainCells(const Scenario& s, const ScenarioDomain& d, int height) {
@@ -1170,7 +1082,7 @@ Result<ScenarioDomain> buildDomain(const Scenario& s, uint64_t memoryBudgetBytes
   STRATA_TRY_STATUS(checkModelParams(s, d.params));
   const RegionCells region{plan.grid.width, h, &d.inside, {}};
   STRATA_TRY_STATUS(placeInflows(s, plan, region, d));
-  STRATA_TRY_STATUS(breachInflowPaths(s, d));
+  STRATA_TRY_STATUS(detail::breachInflowPaths(s, detail::Ranks::single(), {0, h}, d.sources, d.sourceNames, d));
   STRATA_TRY_STATUS(fillDepressions(s, d));
   STRATA_TRY_STATUS(placeLevels(s, plan, region, d));
   STRATA_TRY_STATUS(checkLevelStages(s, lowestLevelBeds(s, d, d)));
@@ -1187,7 +1099,6 @@ Result<ScenarioDomain> buildDomain(const Scenario& s, uint64_t memoryBudgetBytes
 namespace detail {
 
 std::string wholeBuildStep(const Scenario& s) {
-  if (s.terrain.breachInflows) return "terrain.breach_inflows";
   for (size_t l = 0; l < s.terrain.layers.size(); ++l) {
     if (s.terrain.layers[l].atRest) return "terrain.layer[" + std::to_string(l) + "].at_rest";
   }

@@ -17,10 +17,10 @@
 namespace strata::scenario::detail {
 
 /// The scenario key of a step that needs the whole region at once, or empty when the domain can
-/// be built rows by rows: breach_inflows (a path search over the region), an at_rest layer
-/// (settles until nothing changes), voids to fill (GDAL fills them from their surroundings), a
-/// tile store resampled to cell_size (resampled whole).
-/// fill_depressions can: tile by tile (gis::fillDepressions).
+/// be built rows by rows: an at_rest layer (settles until nothing changes), voids to fill (GDAL
+/// fills them from their surroundings), a tile store resampled to cell_size (resampled whole).
+/// fill_depressions can (tile by tile: gis::fillDepressions), and breach_inflows (the ranks flood
+/// together: breach.hpp).
 std::string wholeBuildStep(const Scenario& s);
 
 class RowBuilder {

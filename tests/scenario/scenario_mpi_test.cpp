@@ -147,13 +147,13 @@ TEST(ScenarioMpi, AFloodOverTheRanksEqualsOneProcess) {
   fs::remove_all(dir);
 }
 
-// Without breach_inflows the ranks build the domain themselves, row by row, each from its own
-// windows of the DEM (domain_rows.hpp): a polygon region, fill_depressions tile by tile over the
-// ranks' rows and rain, with a fixed level and a spin-up, or with a dam break (which a spin-up
-// would release early). Maps, series, report and model input as one process's.
+// The ranks build the domain themselves, row by row, each from its own windows of the DEM
+// (domain_rows.hpp): a polygon region, breach_inflows flooded over the ranks (breach.hpp; the
+// path crosses the ranks' borders), fill_depressions tile by tile over the ranks' rows and rain,
+// with a fixed level and a spin-up, or with a dam break (which a spin-up would release early).
+// Maps, series, report and model input as one process's.
 TEST(ScenarioMpi, ADomainBuiltByTheRanksRowByRowEqualsOneProcess) {
   std::string base = floodText();
-  base.erase(base.find("breach_inflows = true\n"), 22);
   const auto bbox = base.find("bbox_lonlat");
   base.replace(bbox, base.find('\n', bbox) - bbox,
                "polygon_lonlat = [[-112.25, 36.02], [-112.001, 36.02], [-112.001, 36.18], [-112.25, 36.12]]");
@@ -204,6 +204,23 @@ TEST(ScenarioMpi, ADomainBuiltByTheRanksRowByRowEqualsOneProcess) {
     for (uint8_t in : domain->inside.data) walls += in ? 0 : 1;
     EXPECT_GT(walls, 100);  // the polygon cut the bounding box
     EXPECT_GT(domain->filled.cells, 0);
+    // The breached path has cells in more than one rank's rows (rows [h k / n, h (k + 1) / n)).
+    Scenario breachOnly = s, neither = s;
+    breachOnly.terrain.fillDepressions = neither.terrain.fillDepressions = false;
+    neither.terrain.breachInflows = false;
+    auto breached = buildDomain(breachOnly), plain = buildDomain(neither);
+    ASSERT_TRUE(breached && plain);
+    EXPECT_GT(breached->breach.cells, 10);
+    const int w = plain->bed.georef.width, h = plain->bed.georef.height;
+    std::vector<int> bands;
+    for (size_t i = 0; i < plain->input.baseM.size(); ++i) {
+      if (breached->input.baseM.data[i] == plain->input.baseM.data[i]) continue;
+      const int y = int(i / size_t(w));
+      int band = 0;
+      while (y >= int((long long)h * (band + 1) / worldSize())) ++band;
+      if (std::find(bands.begin(), bands.end(), band) == bands.end()) bands.push_back(band);
+    }
+    EXPECT_GE(int(bands.size()), std::min(worldSize(), 2)) << "the breached path stays in one rank's rows";
     if (std::string(name) == "dam") {
       auto water = gis::readDem((dir / "ranks" / "input" / "water.tif").string(), allowEmpty());
       ASSERT_TRUE(water) << water.message();
