@@ -15,6 +15,7 @@
 #include "breach.hpp"
 #include "domain_rows.hpp"
 #include "pieces.hpp"
+#include "settle.hpp"
 
 namespace strata::scenario::detail {
 namespace fs = std::filesystem;
@@ -162,6 +163,21 @@ std::vector<std::string> Ranks::allGatherBytes(const std::string& bytes) const {
   std::vector<std::string> out;
   for (int r = 0; r < size_; ++r) out.push_back(all.substr(size_t(offsets[size_t(r)]), size_t(counts[size_t(r)])));
   return out;
+}
+
+std::pair<std::string, std::string> Ranks::swapWithNeighbours(const std::string& up, const std::string& down) const {
+  if (!distributed_) return {};
+  const int before = rank_ > 0 ? rank_ - 1 : MPI_PROC_NULL, after = rank_ + 1 < size_ ? rank_ + 1 : MPI_PROC_NULL;
+  STRATA_CHECK(up.size() < size_t(INT_MAX) && down.size() < size_t(INT_MAX)) << "a rank's part of a swap exceeds 2 GB";
+  int upCount = int(up.size()), downCount = int(down.size()), fromBefore = 0, fromAfter = 0;
+  MPI_Sendrecv(&upCount, 1, MPI_INT, before, 0, &fromAfter, 1, MPI_INT, after, 0, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+  MPI_Sendrecv(&downCount, 1, MPI_INT, after, 1, &fromBefore, 1, MPI_INT, before, 1, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+  std::pair<std::string, std::string> got{std::string(size_t(fromBefore), '\0'), std::string(size_t(fromAfter), '\0')};
+  MPI_Sendrecv(up.data(), upCount, MPI_CHAR, before, 2, got.second.data(), fromAfter, MPI_CHAR, after, 2,
+               MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+  MPI_Sendrecv(down.data(), downCount, MPI_CHAR, after, 3, got.first.data(), fromBefore, MPI_CHAR, before, 3,
+               MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+  return got;
 }
 
 std::vector<double> Ranks::allGather(const std::vector<double>& values) const {
@@ -397,11 +413,18 @@ Result<RowsBuilt> buildByRows(const RowBuilder& b, const Scenario& s, const Rank
   for (int k = 0; k < n; ++k) tiles.push_back({0, firstRowOf(k), w, firstRowOf(k + 1) - firstRowOf(k)});
   const int y0 = firstRowOf(ranks.rank()), own = firstRowOf(ranks.rank() + 1) - y0;
   STRATA_CHECK(own > 0) << "buildByRows needs a row per rank";
-  // The row below too, for fill_depressions' joins across the border with the next rank's rows.
+  // The row below too, for fill_depressions' joins across the border with the next rank's rows
+  // (its base: at_rest leaves the layers of rows not this rank's as they are).
   const int end = s.terrain.fillDepressions ? std::min(h, y0 + own + 1) : y0 + own;
   auto built = b.rows(y0, end);
   STRATA_TRY_STATUS(ranks.agree(statusOf(built)));
   ScenarioDomain d = std::move(built).value();
+  settleAtRest(s, ranks, h, own, d);
+  std::vector<sim::ExactSum> tooSteep(d.layerCellsTooSteep.size());
+  for (size_t l = 0; l < tooSteep.size(); ++l) tooSteep[l].add(d.layerCellsTooSteep[l]);
+  ranks.sum(tooSteep);
+  shape.layerCellsTooSteep.clear();
+  for (const auto& count : tooSteep) shape.layerCellsTooSteep.push_back(int(count.value()));
 
   // What needs every row, over this rank's own rows: voids, the lowest bed (the datum), the area,
   // loose material.

@@ -54,6 +54,9 @@ class Ranks {
   std::vector<std::string> gatherToLead(const std::string& bytes) const;
   /// Collective: every rank's `bytes`, in rank order, on every rank.
   std::vector<std::string> allGatherBytes(const std::string& bytes) const;
+  /// Collective: sends `up` to the rank before this one and `down` to the one after it; returns
+  /// what they sent (the one before's `down`, the one after's `up`; empty where there is none).
+  std::pair<std::string, std::string> swapWithNeighbours(const std::string& up, const std::string& down) const;
 
  private:
   bool distributed_ = false;

@@ -23,6 +23,7 @@
 #include "breach.hpp"
 #include "distributed.hpp"
 #include "domain_rows.hpp"
+#include "settle.hpp"
 
 namespace strata::scenario {
 namespace {
@@ -623,56 +624,6 @@ Status measureRegion(const Plan& plan, ScenarioDomain& d) {
   return {};
 }
 
-// [[terrain.layer]] at_rest: loose material only where it can rest. Thermal weathering (E7,
-// docs/sim-erosion.md) tests a cell's topmost layer: it sheds when the bed (base + layers) drops
-// to a 4-neighbour by more than tan(its angle of repose) x the distance; the layers below it are
-// tested only once it is gone. So, until nothing changes: wherever the topmost layer is an
-// at_rest one and its cell would shed, that layer is left off (the next layer down becomes the
-// top and is tested in turn). Cells outside a polygon region are walls and are not compared.
-void settleAtRest(const Scenario& s, ScenarioDomain& d) {
-  const size_t L = d.input.layersM.size(), first = L - s.terrain.layers.size();  // the scenario's, on top
-  d.layerCellsTooSteep.assign(s.terrain.layers.size(), 0);
-  bool any = false;
-  for (const auto& spec : s.terrain.layers) any |= spec.atRest;
-  if (!any) return;
-  const int w = d.input.baseM.width, h = d.input.baseM.height;
-  std::vector<double> tanRepose(L);
-  for (size_t k = 0; k < L; ++k) tanRepose[k] = std::tan(double(d.input.materials[k].talusAngleDeg) * M_PI / 180.0);
-  auto bed = [&](int x, int y) {
-    double z = d.input.baseM.at(x, y);
-    for (const auto& l : d.input.layersM) z += l.at(x, y);
-    return z;
-  };
-  for (bool changed = true; changed;) {
-    changed = false;
-    for (int y = 0; y < h; ++y) {
-      for (int x = 0; x < w; ++x) {
-        if (!d.inside.at(x, y)) continue;
-        size_t top = L;
-        for (size_t k = L; k-- > 0;) {
-          if (d.input.layersM[k].at(x, y) > 0) {
-            top = k;
-            break;
-          }
-        }
-        if (top == L || top < first || !s.terrain.layers[top - first].atRest) continue;
-        const double z = bed(x, y);
-        const int next[4][3] = {{x - 1, y, 0}, {x + 1, y, 0}, {x, y - 1, 1}, {x, y + 1, 1}};
-        for (const auto& n : next) {
-          if (n[0] < 0 || n[0] >= w || n[1] < 0 || n[1] >= h || !d.inside.at(n[0], n[1])) continue;
-          const double length = n[2] == 0 ? d.input.rowDxM[size_t(y)] : d.input.dyM;
-          if (z - bed(n[0], n[1]) > tanRepose[top] * length) {
-            d.input.layersM[top].at(x, y) = 0;
-            d.layerCellsTooSteep[top - first] += 1;
-            changed = true;
-            break;
-          }
-        }
-      }
-    }
-  }
-}
-
 // Step 6: base and layers (of the rows read). Cells outside a polygon become walls. Returns the
 // lowest bed of the region's cells: the datum is the region's lowest point (floored), so float32
 // keeps millimetres.
@@ -1076,7 +1027,7 @@ Result<ScenarioDomain> buildDomain(const Scenario& s, uint64_t memoryBudgetBytes
   STRATA_TRY_STATUS(measureRegion(plan, d));
   STRATA_TRY(const float lowest, stackLayers(s, plan, storeLayers, d));
   d.input.datumM = std::floor(double(lowest));
-  settleAtRest(s, d);
+  detail::settleAtRest(s, detail::Ranks::single(), h, h, d);
   if (s.erosion.enabled && !hasLooseMaterial(d)) return refuseNoLooseMaterial(s);
   d.params = modelParams(s);
   STRATA_TRY_STATUS(checkModelParams(s, d.params));
@@ -1099,9 +1050,6 @@ Result<ScenarioDomain> buildDomain(const Scenario& s, uint64_t memoryBudgetBytes
 namespace detail {
 
 std::string wholeBuildStep(const Scenario& s) {
-  for (size_t l = 0; l < s.terrain.layers.size(); ++l) {
-    if (s.terrain.layers[l].atRest) return "terrain.layer[" + std::to_string(l) + "].at_rest";
-  }
   if (s.terrain.voids != decltype(s.terrain)::Voids::kRefuse) return "terrain.voids";
   if (!s.terrain.store.empty() && s.region.cellSizeM > 0) return "region.cell_size";
   return {};

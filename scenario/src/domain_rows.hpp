@@ -17,10 +17,10 @@
 namespace strata::scenario::detail {
 
 /// The scenario key of a step that needs the whole region at once, or empty when the domain can
-/// be built rows by rows: an at_rest layer (settles until nothing changes), voids to fill (GDAL
-/// fills them from their surroundings), a tile store resampled to cell_size (resampled whole).
-/// fill_depressions can (tile by tile: gis::fillDepressions), and breach_inflows (the ranks flood
-/// together: breach.hpp).
+/// be built rows by rows: voids to fill (GDAL fills them from their surroundings), a tile store
+/// resampled to cell_size (resampled whole). fill_depressions can (tile by tile:
+/// gis::fillDepressions), breach_inflows (the ranks flood together: breach.hpp) and at_rest
+/// layers (settled against the neighbours' border rows: settle.hpp).
 std::string wholeBuildStep(const Scenario& s);
 
 class RowBuilder {

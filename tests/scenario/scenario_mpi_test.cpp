@@ -19,6 +19,7 @@
 #include <strata/scenario/run.hpp>
 #include <strata/scenario/scenario.hpp>
 
+#include "../../scenario/src/distributed.hpp"
 #include "../../scenario/src/domain_rows.hpp"
 #include "mpi_support.hpp"
 #include "scenario_fixture.hpp"
@@ -54,7 +55,7 @@ std::string floodText() {
 std::string erosionText() {
   return scenarioText() +
          "[[terrain.layer]]\nmaterial = \"rock\"\nthickness = \"20 m\"\n"
-         "[[terrain.layer]]\nmaterial = \"sand\"\nthickness = \"1 m\"\n"
+         "[[terrain.layer]]\nmaterial = \"sand\"\nthickness = \"1 m\"\nat_rest = true\n"
          "[erosion]\nenabled = true\n";
 }
 
@@ -248,6 +249,39 @@ TEST(ScenarioMpi, ADomainBuiltByTheRanksRowByRowEqualsOneProcess) {
   if (worldRank() == 0) fs::remove_all(dir);
 }
 
+// at_rest layers settled by the ranks (settle.hpp) on a finer grid of the canyon, where cells on
+// the ranks' border rows lose a layer because of a cell across the border: each rank's rows of
+// every layer are the one process's, and so are the counts.
+TEST(ScenarioMpi, TheRanksSettleLayersAtRestAsOneProcess) {
+  const auto dir = sharedDir("at-rest");
+  std::string text = erosionText();
+  text.replace(text.find("cell_size = \"600 m\""), 19, "cell_size = \"150 m\"");
+  text += "[[terrain.layer]]\nmaterial = \"soil\"\nthickness = \"2 m\"\nat_rest = true\n";
+  const Scenario s = load(dir, "erode.toml", text);
+  auto whole = buildDomain(s);
+  ASSERT_TRUE(whole) << whole.message();
+  auto builder = detail::RowBuilder::plan(s, 0, worldSize(), false);
+  ASSERT_TRUE(builder) << builder.message();
+  auto built = detail::buildByRows(*builder, s, detail::Ranks::world());
+  ASSERT_TRUE(built) << built.message();
+  const auto& rows = built->rows;
+  const int w = whole->input.baseM.width;
+  ASSERT_EQ(rows.input.layersM.size(), whole->input.layersM.size());
+  for (size_t k = 0; k < rows.input.layersM.size(); ++k) {
+    const auto& mine = rows.input.layersM[k].data;
+    const auto first = whole->input.layersM[k].data.begin() + ptrdiff_t(rows.firstRow) * w;
+    EXPECT_TRUE(std::equal(mine.begin(), mine.end(), first)) << "layer " << k << " differs on rank " << worldRank();
+  }
+  EXPECT_EQ(built->shape.layerCellsTooSteep, whole->layerCellsTooSteep);
+  if (worldRank() == 0) {
+    std::printf("at_rest at 150 m: sand off %d cells, soil off %d\n", whole->layerCellsTooSteep[1],
+                whole->layerCellsTooSteep[2]);
+  }
+  EXPECT_GT(whole->layerCellsTooSteep[1], 100);
+  MPI_Barrier(MPI_COMM_WORLD);
+  if (worldRank() == 0) fs::remove_all(dir);
+}
+
 TEST(ScenarioMpi, AnErosionRunOverTheRanksEqualsOneProcess) {
   const auto dir = sharedDir("erosion");
   const Scenario s = load(dir, "erode.toml", erosionText());
@@ -263,6 +297,23 @@ TEST(ScenarioMpi, AnErosionRunOverTheRanksEqualsOneProcess) {
   ASSERT_TRUE(run) << run.message();
   ASSERT_TRUE(run->material);
   if (worldRank() != 0) return;
+  // The sand is left off the steepest cells (settled by the ranks against each other's border
+  // rows: settle.hpp), and the report says so as one process's does.
+  auto domain = buildDomain(s);
+  ASSERT_TRUE(domain) << domain.message();
+  std::printf("at_rest: sand left off %d cells\n", domain->layerCellsTooSteep[1]);
+  EXPECT_GT(domain->layerCellsTooSteep[1], 0);
+  auto reportOf = [](const fs::path& folder) {
+    std::ifstream report(folder / "report.md");
+    const std::string t((std::istreambuf_iterator<char>(report)), std::istreambuf_iterator<char>());
+    const auto from = t.find("## Scenario"), to = t.find("## Files");
+    return from == std::string::npos || to == std::string::npos ? std::string() : t.substr(from, to - from);
+  };
+  EXPECT_NE(reportOf(dir / "one").find("sand at rest"), std::string::npos);
+  EXPECT_EQ(reportOf(dir / "ranks"), reportOf(dir / "one"));
+  auto layer = gis::readDem((dir / "ranks" / "input" / "layer_2.tif").string(), allowEmpty());
+  ASSERT_TRUE(layer) << layer.message();
+  EXPECT_EQ(layer->values.data, domain->input.layersM[1].data);
   const auto& b = *run->material;
   std::printf("erosion on %d ranks: eroded %.6g m3 (one process %.6g), balance %.3g m3\n", worldSize(), b.erodedM3,
               reference.erodedM3, b.balanceM3());
