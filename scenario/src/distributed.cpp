@@ -31,6 +31,11 @@ void writeCells(ByteWriter& w, const std::vector<std::pair<int, int>>& cells) {
   }
   w.vec(flat);
 }
+std::string cellBytes(const std::vector<std::pair<int, int>>& cells) {
+  ByteWriter w;
+  writeCells(w, cells);
+  return w.out;
+}
 void readCells(ByteReader& r, std::vector<std::pair<int, int>>& cells) {
   std::vector<int32_t> flat;
   r.vec(flat);
@@ -441,7 +446,9 @@ Result<RowsBuilt> buildByRows(const RowBuilder& b, const Scenario& s, const Rank
   }
   ranks.sum(sums);
   ranks.min(low);
-  if (sums[0].value() > 0) return b.refuseVoids((long long)sums[0].value());
+  const long long voids = (long long)sums[0].value();
+  if (voids > 0 && s.terrain.voids == decltype(s.terrain)::Voids::kRefuse) return b.refuseVoids(voids);
+  shape.voidCells = int(voids);
   if (s.erosion.enabled && !ranks.minMax(loose ? 1 : 0).second) return b.refuseNoLooseMaterial();
   shape.input.datumM = std::floor(low[0]);
   shape.totalAreaM2 = sums[1].value();
@@ -468,6 +475,16 @@ Result<RowsBuilt> buildByRows(const RowBuilder& b, const Scenario& s, const Rank
   std::vector<double> levelBeds = b.lowestLevelBeds(d);
   ranks.min(levelBeds);
   STRATA_TRY_STATUS(b.checkLevelStages(levelBeds));
+  // voids = "holes": one level that drains every rank's holes (all of them on every rank).
+  std::vector<std::pair<int, int>> holes;
+  for (const std::string& bytes : ranks.allGatherBytes(cellBytes(b.voidHoleCells(d, own)))) {
+    ByteReader in{bytes};
+    std::vector<std::pair<int, int>> theirs;
+    readCells(in, theirs);
+    STRATA_CHECK(in.ok) << "buildByRows: a rank's holes did not decode";
+    holes.insert(holes.end(), theirs.begin(), theirs.end());
+  }
+  b.addVoidHoles(std::move(holes), shape);
   std::vector<double> damBeds = b.placeDamBreaks(d);
   ranks.min(damBeds);
   STRATA_TRY_STATUS(b.checkDamBreaks(damBeds));

@@ -586,6 +586,31 @@ Status readBed(const Scenario& s, const Plan& plan, int y0, int y1, ScenarioDoma
   return {};
 }
 
+// Fills the voids of rows [y0, y1) as the whole region's fill fills them there (every mode but
+// "refuse"): from the rows gis::voidFillRows names, read with a margin that doubles until it
+// holds them.
+Status fillVoidsOfRows(const Scenario& s, const Plan& plan, int y0, int y1, ScenarioDomain& d) {
+  if (s.terrain.voids == decltype(s.terrain)::Voids::kRefuse || d.voidCells == 0) return {};
+  const int w = plan.grid.width, h = plan.grid.height;
+  for (int margin = 16;; margin *= 2) {
+    const int top = std::max(0, y0 - margin), bottom = std::min(h, y1 + margin);
+    ScenarioDomain around;
+    std::vector<StoredLayer> layers;
+    STRATA_TRY_STATUS(readBed(s, plan, top, bottom, around, layers));
+    const auto span = gis::voidFillRows(around.bed.values, top, h, y0, y1);
+    if (!span) continue;
+    gis::Grid<float> rows(w, (*span)[1] - (*span)[0]);
+    const auto& all = around.bed.values.data;
+    std::copy(all.begin() + ptrdiff_t((*span)[0] - top) * w, all.begin() + ptrdiff_t((*span)[1] - top) * w,
+              rows.data.begin());
+    auto filled = gis::fillVoids(rows, std::max(w, h));
+    if (!filled) return fail(plan.source.path() + ": " + filled.message());
+    std::copy(rows.data.begin() + ptrdiff_t(y0 - (*span)[0]) * w, rows.data.begin() + ptrdiff_t(y1 - (*span)[0]) * w,
+              d.bed.values.data.begin());
+    return {};
+  }
+}
+
 // The rows [y0, y0 + height) of a raster warped onto the region's grid (a rain or layer raster):
 // the whole warp's bits there.
 Result<gis::Grid<float>> readRows(const std::string& path, const gis::Georef& grid, int y0, int height) {
@@ -774,15 +799,24 @@ Status checkLevelStages(const Scenario& s, const std::vector<double>& lowestBed)
 // Step 9b: [terrain] voids = "holes": the region's void cells are held at depth 0 (a fixed level
 // below every bed), so whatever water reaches them leaves the region there and is counted as the
 // level's outflow in the balance.
-void placeVoidHoles(const Scenario& s, ScenarioDomain& d) {
-  if (s.terrain.voids != decltype(s.terrain)::Voids::kHoles || d.voidCells == 0) return;
-  sim::LevelBoundary holes;
-  for (int y = 0; y < d.voids.height; ++y) {
+// The region's void cells that are holes (voids = "holes"), of the first `rows` rows of `d`, on
+// the region's rows.
+std::vector<std::pair<int, int>> voidHoleCells(const Scenario& s, const ScenarioDomain& d, int rows) {
+  std::vector<std::pair<int, int>> cells;
+  if (s.terrain.voids != decltype(s.terrain)::Voids::kHoles) return cells;
+  for (int y = 0; y < rows; ++y) {
     for (int x = 0; x < d.voids.width; ++x) {
-      if (d.voids.at(x, y) && d.inside.at(x, y)) holes.cells.push_back({x, y});
+      if (d.voids.at(x, y) && d.inside.at(x, y)) cells.push_back({x, d.firstRow + y});
     }
   }
-  if (holes.cells.empty()) return;
+  return cells;
+}
+
+// The holes as a level far below the region (the domain `d`'s datum) that drains them.
+void addVoidHoles(std::vector<std::pair<int, int>> cells, ScenarioDomain& d) {
+  if (cells.empty()) return;
+  sim::LevelBoundary holes;
+  holes.cells = std::move(cells);
   holes.stageM = TimeSeries::constant(d.input.datumM - 1e4);
   d.levels.push_back(std::move(holes));
   d.levelNames.push_back("voids (holes)");
@@ -1037,7 +1071,7 @@ Result<ScenarioDomain> buildDomain(const Scenario& s, uint64_t memoryBudgetBytes
   STRATA_TRY_STATUS(fillDepressions(s, d));
   STRATA_TRY_STATUS(placeLevels(s, plan, region, d));
   STRATA_TRY_STATUS(checkLevelStages(s, lowestLevelBeds(s, d, d)));
-  placeVoidHoles(s, d);
+  addVoidHoles(voidHoleCells(s, d, h), d);
   STRATA_TRY_STATUS(placeRain(s, plan, d));
   STRATA_TRY(const auto dams, damBreakCells(s, plan, region));
   STRATA_TRY_STATUS(checkDamBreaks(s, placeDamBreaks(s, dams, d)));
@@ -1050,7 +1084,6 @@ Result<ScenarioDomain> buildDomain(const Scenario& s, uint64_t memoryBudgetBytes
 namespace detail {
 
 std::string wholeBuildStep(const Scenario& s) {
-  if (s.terrain.voids != decltype(s.terrain)::Voids::kRefuse) return "terrain.voids";
   if (!s.terrain.store.empty() && s.region.cellSizeM > 0) return "region.cell_size";
   return {};
 }
@@ -1099,6 +1132,7 @@ Result<ScenarioDomain> RowBuilder::rows(int y0, int y1) const {
   std::vector<StoredLayer> storeLayers;
   STRATA_TRY_STATUS(readBed(s, plan, y0, y1, d, storeLayers));
   findVoids(d);
+  STRATA_TRY_STATUS(fillVoidsOfRows(s, plan, y0, y1, d));
   maskRegion(s, plan.frame, d);
   STRATA_TRY_STATUS(measureRegion(plan, d));
   STRATA_TRY_STATUS(statusOf(stackLayers(s, plan, storeLayers, d)));  // (the caller finds the lowest bed of its rows)
@@ -1107,6 +1141,12 @@ Result<ScenarioDomain> RowBuilder::rows(int y0, int y1) const {
 }
 
 Error RowBuilder::refuseVoids(long long count) const { return scenario::refuseVoids(impl_->plan.source, count); }
+std::vector<std::pair<int, int>> RowBuilder::voidHoleCells(const ScenarioDomain& d, int rows) const {
+  return scenario::voidHoleCells(impl_->s, d, rows);
+}
+void RowBuilder::addVoidHoles(std::vector<std::pair<int, int>> cells, ScenarioDomain& shape) const {
+  scenario::addVoidHoles(std::move(cells), shape);
+}
 bool RowBuilder::hasLooseMaterial(const ScenarioDomain& d) const { return scenario::hasLooseMaterial(d); }
 Error RowBuilder::refuseNoLooseMaterial() const { return scenario::refuseNoLooseMaterial(impl_->s); }
 gis::Grid<uint8_t> RowBuilder::drains(const ScenarioDomain& d) const {

@@ -17,10 +17,10 @@
 namespace strata::scenario::detail {
 
 /// The scenario key of a step that needs the whole region at once, or empty when the domain can
-/// be built rows by rows: voids to fill (GDAL fills them from their surroundings), a tile store
-/// resampled to cell_size (resampled whole). fill_depressions can (tile by tile:
-/// gis::fillDepressions), breach_inflows (the ranks flood together: breach.hpp) and at_rest
-/// layers (settled against the neighbours' border rows: settle.hpp).
+/// be built rows by rows: a tile store resampled to cell_size (resampled whole). fill_depressions
+/// can (tile by tile: gis::fillDepressions), breach_inflows (the ranks flood together:
+/// breach.hpp), at_rest layers (settled against the neighbours' border rows: settle.hpp) and
+/// voids (filled from the rows gis::voidFillRows names).
 std::string wholeBuildStep(const Scenario& s);
 
 class RowBuilder {
@@ -37,13 +37,19 @@ class RowBuilder {
   /// model, sources, levels, the rain (1 x 1 markers: rainMmPerHour for a rain raster,
   /// waterDepthM for dam breaks).
   const ScenarioDomain& shape() const;
-  /// Rows [y0, y1) of the region (firstRow y0): bed, voids (not filled), mask, cell areas and
-  /// their total, base (walls), layers, the rain raster. No datum (the lowest bed over all rows,
+  /// Rows [y0, y1) of the region (firstRow y0): bed (voids filled as the whole region's fill
+  /// fills them, unless voids = "refuse"), voids, mask, cell areas and their total, base (walls),
+  /// layers, the rain raster. No datum (the lowest bed over all rows,
   /// floored), nothing filled, no check that needs every row.
   Result<ScenarioDomain> rows(int y0, int y1) const;
 
   // What buildDomain does over the whole region, for the caller to do over the rows.
   Error refuseVoids(long long count) const;
+  /// voids = "holes": the void cells of the first `rows` rows of `rows` that are holes (on the
+  /// region's rows), and the level that drains them added to the shape (all ranks' cells, in
+  /// row-major order).
+  std::vector<std::pair<int, int>> voidHoleCells(const ScenarioDomain& rows, int count) const;
+  void addVoidHoles(std::vector<std::pair<int, int>> cells, ScenarioDomain& shape) const;
   bool hasLooseMaterial(const ScenarioDomain& rows) const;
   Error refuseNoLooseMaterial() const;
   gis::Grid<uint8_t> drains(const ScenarioDomain& rows) const;  ///< fill_depressions' open-edge cells

@@ -282,6 +282,57 @@ TEST(ScenarioMpi, TheRanksSettleLayersAtRestAsOneProcess) {
   if (worldRank() == 0) fs::remove_all(dir);
 }
 
+// Voids filled by the ranks (each from the rows gis::voidFillRows names, beyond its own where a
+// void needs them), made walls, or drained as holes: on Rainier's SRTM summit, whose voids cross
+// the ranks' borders, each rank's rows of the bed and the mask, the void count and the holes'
+// level are the one process's.
+TEST(ScenarioMpi, TheRanksFillVoidsAsOneProcess) {
+  const auto dir = sharedDir("voids");
+  for (const char* mode : {"fill", "walls", "holes"}) {
+    SCOPED_TRACE(mode);
+    const std::string text = "[terrain]\ndem = \"" + test::dataPath("rainier/mt_rainier_90m.tif") +
+                             "\"\nvoids = \"" + mode +
+                             "\"\n[region]\nbbox_lonlat = [-121.80, 46.80, -121.72, 46.88]\n"
+                             "[model]\nkind = \"flood\"\n[water.rain]\nrate = \"10 mm/h\"\n"
+                             "[time]\nduration = \"10 min\"\n";
+    const Scenario s = load(dir, std::string(mode) + ".toml", text);
+    auto whole = buildDomain(s);
+    ASSERT_TRUE(whole) << whole.message();
+    EXPECT_GT(whole->voidCells, 20);
+    auto builder = detail::RowBuilder::plan(s, 0, worldSize(), false);
+    ASSERT_TRUE(builder) << builder.message();
+    auto built = detail::buildByRows(*builder, s, detail::Ranks::world());
+    ASSERT_TRUE(built) << built.message();
+    const auto& rows = built->rows;
+    const int w = whole->input.baseM.width, h = whole->input.baseM.height;
+    auto same = [&](const auto& mine, const auto& all) {
+      return std::equal(mine.data.begin(), mine.data.end(), all.data.begin() + ptrdiff_t(rows.firstRow) * w);
+    };
+    EXPECT_TRUE(same(rows.input.baseM, whole->input.baseM)) << "rank " << worldRank();
+    EXPECT_TRUE(same(rows.inside, whole->inside)) << "rank " << worldRank();
+    EXPECT_EQ(built->shape.voidCells, whole->voidCells);
+    EXPECT_EQ(built->shape.levels.size(), whole->levels.size());
+    EXPECT_EQ(built->shape.levelNames, whole->levelNames);
+    if (!whole->levels.empty() && built->shape.levels.size() == whole->levels.size()) {
+      EXPECT_EQ(built->shape.levels.back().cells, whole->levels.back().cells);
+    }
+    // The voids lie in more than one rank's rows.
+    std::vector<int> bands;
+    for (int y = 0; y < h; ++y) {
+      for (int x = 0; x < w; ++x) {
+        if (!whole->voids.at(x, y)) continue;
+        int band = 0;
+        while (y >= int((long long)h * (band + 1) / worldSize())) ++band;
+        if (std::find(bands.begin(), bands.end(), band) == bands.end()) bands.push_back(band);
+      }
+    }
+    EXPECT_GE(int(bands.size()), std::min(worldSize(), 2));
+    if (worldRank() == 0) std::printf("voids = %s: %d voids over %zu ranks' rows\n", mode, whole->voidCells, bands.size());
+  }
+  MPI_Barrier(MPI_COMM_WORLD);
+  if (worldRank() == 0) fs::remove_all(dir);
+}
+
 TEST(ScenarioMpi, AnErosionRunOverTheRanksEqualsOneProcess) {
   const auto dir = sharedDir("erosion");
   const Scenario s = load(dir, "erode.toml", erosionText());
