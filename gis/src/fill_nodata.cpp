@@ -27,8 +27,8 @@ Result<size_t> fillVoids(Grid<float>& grid, int maxSearchCells) {
   CPLErr err = band->RasterIO(GF_Write, 0, 0, grid.width, grid.height, grid.data.data(), grid.width, grid.height,
                               GDT_Float32, 0, 0);
   if (err == CE_None) {
-    err = GDALFillNodata(GDALRasterBand::ToHandle(band), nullptr, double(maxSearchCells), 0, 0,
-                         nullptr, nullptr, nullptr);
+    err = GDALFillNodata(GDALRasterBand::ToHandle(band), nullptr, double(maxSearchCells), 0, 0, nullptr, nullptr,
+                         nullptr);
   }
   if (err == CE_None) {
     err = band->RasterIO(GF_Read, 0, 0, grid.width, grid.height, grid.data.data(), grid.width, grid.height, GDT_Float32,
@@ -42,8 +42,8 @@ Result<size_t> fillVoids(Grid<float>& grid, int maxSearchCells) {
 
 std::optional<std::array<int, 2>> voidFillRows(const Grid<float>& rows, int top, int height, int y0, int y1) {
   const int w = rows.width, bottom = top + rows.height;
-  STRATA_CHECK(top <= y0 && y0 <= y1 && y1 <= bottom && bottom <= height) << "voidFillRows: rows [" << y0 << ", "
-                                                                          << y1 << ") are not held";
+  STRATA_CHECK(top <= y0 && y0 <= y1 && y1 <= bottom && bottom <= height)
+      << "voidFillRows: rows [" << y0 << ", " << y1 << ") are not held";
   std::array<int, 2> span{y0, y1};
   // The first valid row above (step -1) or below (step +1) cell (x, y) in its column: the grid's
   // edge where the column has none, nothing where `rows` ends before either.

@@ -3,6 +3,7 @@
 // target's cells are read directly; the output grid defaults to the union of the inputs.
 #include <strata/gis/mosaic.hpp>
 
+#include <gdal_vrt.h>
 #include <gdalwarper.h>
 
 #include <algorithm>
@@ -41,7 +42,8 @@ bool nearlyEqual(double a, double b, double rel) { return std::abs(a - b) <= rel
 struct Source {
   MosaicInput in;
   std::string name;
-  DatasetPtr ds;  // the file (with any assigned georeference) or the in-memory raster
+  DatasetPtr held;  // an in-memory raster that is a window of `ds` (MosaicInput::within)
+  DatasetPtr ds;    // the file (with any assigned georeference) or the in-memory raster
   std::optional<DemFile> file;
   Georef georef;  // the input's own
   int band = 1;
@@ -63,6 +65,40 @@ Result<Source> openSource(const MosaicInput& input) {
   Source s;
   s.in = input;
   s.name = inputName(input);
+  if (input.raster && input.within) {
+    // A virtual raster of the larger one's size and georeference, holding the window's cells
+    // where they lie in it (GDAL's VRT: nothing of the rest is allocated).
+    const Georef& g = *input.within;
+    const auto& v = input.raster->values;
+    if (!(input.withinX >= 0 && input.withinY >= 0 && input.withinX + v.width <= g.width &&
+          input.withinY + v.height <= g.height)) {
+      return fail(s.name + ": the window does not lie inside the raster it is a window of");
+    }
+    STRATA_TRY(s.held, detail::memDataset(windowOf(g, input.withinX, input.withinY, v.width, v.height), &v));
+    detail::GdalErrorCapture errors;
+    GDALDriver* vrt = GetGDALDriverManager()->GetDriverByName("VRT");
+    STRATA_CHECK(vrt) << "GDAL has no VRT driver";
+    s.ds.reset(vrt->Create("", g.width, g.height, 0, GDT_Float32, nullptr));
+    if (!s.ds) return fail(s.name + ": cannot make a virtual raster: " + errors.last());
+    double gt[6];
+    for (int i = 0; i < 6; ++i) gt[i] = g.transform.c[i];
+    s.ds->SetGeoTransform(gt);
+    STRATA_TRY(OGRSpatialReference srs, detail::srsOf(g));
+    s.ds->SetSpatialRef(&srs);
+    if (VRTAddBand(GDALDataset::ToHandle(s.ds.get()), GDT_Float32, nullptr) != CE_None) {
+      return fail(s.name + ": cannot make a virtual raster: " + errors.last());
+    }
+    GDALRasterBandH band = GDALGetRasterBand(GDALDataset::ToHandle(s.ds.get()), 1);
+    GDALSetRasterNoDataValue(band, std::nan(""));
+    if (VRTAddSimpleSource(static_cast<VRTSourcedRasterBandH>(band), GDALRasterBand::ToHandle(s.held->GetRasterBand(1)),
+                           0, 0, v.width, v.height, input.withinX, input.withinY, v.width, v.height, nullptr,
+                           VRT_NODATA_UNSET) != CE_None) {
+      return fail(s.name + ": cannot make a virtual raster: " + errors.last());
+    }
+    s.georef = g;
+    s.noData = std::nan("");
+    return s;
+  }
   if (input.raster) {
     STRATA_TRY(s.ds, detail::memDataset(input.raster->georef, &input.raster->values));
     s.georef = input.raster->georef;
@@ -187,10 +223,11 @@ Result<Grid<float>> sample(Source& s, const Georef& target, const CellRect& w) {
     const CellRect src{w.x - s.dx, w.y - s.dy, w.width, w.height};
     if (s.file) return s.file->readPadded(src);
     const auto& v = s.in.raster->values;
+    const int ox = s.in.within ? s.in.withinX : 0, oy = s.in.within ? s.in.withinY : 0;  // the window's place
     Grid<float> out(w.width, w.height, kNoData);
     for (int y = 0; y < w.height; ++y) {
       for (int x = 0; x < w.width; ++x) {
-        if (v.contains(src.x + x, src.y + y)) out.at(x, y) = v.at(src.x + x, src.y + y);
+        if (v.contains(src.x + x - ox, src.y + y - oy)) out.at(x, y) = v.at(src.x + x - ox, src.y + y - oy);
       }
     }
     return out;
@@ -201,17 +238,20 @@ Result<Grid<float>> sample(Source& s, const Georef& target, const CellRect& w) {
                   w.y > s.py1 + kMargin)) {
     return Grid<float>(w.width, w.height, kNoData);
   }
-  const Georef win = windowOf(target, w.x, w.y, w.width, w.height);
-  STRATA_TRY(DatasetPtr dst, detail::memDataset(win, nullptr));
+  // The transformer maps the whole target grid's cells (a one-cell dataset of the target's CRS,
+  // then the target's own geotransform): a window's cells are found where the whole grid's are,
+  // to the bit, whatever the window (a window's own corner would round differently).
+  STRATA_TRY(DatasetPtr dst, detail::memDataset(windowOf(target, 0, 0, 1, 1), nullptr));
 
   detail::GdalErrorCapture errors;
   // Exact transformer: no approximation error at cell centres (GDAL's default allows 0.125 px).
   void* transformer =
       GDALCreateGenImgProjTransformer2(GDALDataset::ToHandle(s.ds.get()), GDALDataset::ToHandle(dst.get()), nullptr);
   if (!transformer) return fail(s.name + ": no transformation to the mosaic grid: " + errors.last());
+  GDALSetGenImgProjTransformerDstGeoTransform(transformer, target.transform.c);
   GDALWarpOptions* wo = GDALCreateWarpOptions();
   wo->hSrcDS = GDALDataset::ToHandle(s.ds.get());
-  wo->hDstDS = GDALDataset::ToHandle(dst.get());
+  wo->hDstDS = nullptr;  // warped into `out` (WarpRegionToBuffer)
   wo->nBandCount = 1;
   wo->panSrcBands = static_cast<int*>(CPLMalloc(sizeof(int)));
   wo->panSrcBands[0] = s.band;
@@ -235,20 +275,23 @@ Result<Grid<float>> sample(Source& s, const Georef& target, const CellRect& w) {
   }
   wo->pfnTransformer = GDALGenImgProjTransform;
   wo->pTransformerArg = transformer;
+  Grid<float> out(w.width, w.height, kNoData);
   CPLErr err = CE_Failure;
   {
+    // In strips of about 4 M cells, each with the source window it needs (as ChunkAndWarpImage).
     GDALWarpOperation op;
-    if (op.Initialize(wo) == CE_None) err = op.ChunkAndWarpImage(0, 0, w.width, w.height);
+    if (op.Initialize(wo) == CE_None) {
+      const int strip = std::max(1, std::min(w.height, (1 << 22) / std::max(1, w.width)));
+      err = CE_None;
+      for (int y = 0; y < w.height && err == CE_None; y += strip) {
+        const int rows = std::min(strip, w.height - y);
+        err = op.WarpRegionToBuffer(w.x, w.y + y, w.width, rows, &out.at(0, y), GDT_Float32);
+      }
+    }
   }
   GDALDestroyGenImgProjTransformer(transformer);
   GDALDestroyWarpOptions(wo);
   if (err != CE_None) return fail(s.name + ": warp onto the mosaic grid failed: " + errors.last());
-
-  Grid<float> out(w.width, w.height);
-  if (dst->GetRasterBand(1)->RasterIO(GF_Read, 0, 0, w.width, w.height, out.data.data(), w.width, w.height, GDT_Float32,
-                                      0, 0) != CE_None) {
-    return fail(s.name + ": reading the warped grid failed: " + errors.last());
-  }
   // Scale and offset after the warp: the kernels are affine combinations with weights summing to
   // 1 (and min picks a value), so this equals warping metres.
   if (s.scale != 1 || s.offset != 0) {

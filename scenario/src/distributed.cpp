@@ -475,6 +475,11 @@ Result<RowsBuilt> buildByRows(const RowBuilder& b, const Scenario& s, const Rank
   std::vector<double> levelBeds = b.lowestLevelBeds(d);
   ranks.min(levelBeds);
   STRATA_TRY_STATUS(b.checkLevelStages(levelBeds));
+  // voids = "walls": no place on one, in any rank's rows (the first such place, as one process).
+  const int wall = b.firstPlaceOnWalls(d, own);
+  if (const long long first = ranks.minMax(wall < 0 ? LLONG_MAX : wall).first; first != LLONG_MAX) {
+    return b.refusePlaceOnWalls(int(first));
+  }
   // voids = "holes": one level that drains every rank's holes (all of them on every rank).
   std::vector<std::pair<int, int>> holes;
   for (const std::string& bytes : ranks.allGatherBytes(cellBytes(b.voidHoleCells(d, own)))) {

@@ -166,14 +166,23 @@ class TerrainSource {
     return readField(bedField_, w);
   }
 
-  /// What gis::warpToGrid resamples from: the DEM file `path` itself (GDAL reads what it needs;
-  /// by default the first DEM), or, for a store, the window already read (`nativeBed`).
-  gis::MosaicInput resampleInput(const gis::Raster& nativeBed, const std::string& path = {}) const {
-    if (store_) return {"", nativeBed};
+  /// What gis::MosaicReader resamples from: the DEM file `path` itself (GDAL reads what it needs;
+  /// by default the first DEM).
+  gis::MosaicInput resampleInput(const std::string& path = {}) const {
     gis::MosaicInput in{path.empty() ? path_ : path, std::nullopt};
     const gis::ReadOptions ro = readOptions(in.path);
     in.assignCrs = ro.crs;
     in.assignTransform = ro.transform;
+    return in;
+  }
+
+  /// A store's window `w` as a warp of a store window of it sees it (MosaicInput::within): its
+  /// georeference, the one readBed gives it.
+  gis::MosaicInput storeWindowInput(gis::Raster cells, const gis::CellRect& w, int x, int y) const {
+    gis::MosaicInput in{"", std::move(cells)};
+    in.within = store_->windowGeoref(w, 0);
+    in.withinX = x;
+    in.withinY = y;
     return in;
   }
 
@@ -539,9 +548,10 @@ Status handleVoids(const Scenario& s, const TerrainSource& source, ScenarioDomai
 // resampled to region.cell_size (coarser cells take the lowest of the cells they cover: averaging
 // raises a canyon's narrow floor towards its rim and dams the river, docs/scenario.md),
 // mosaicked when the scenario lists several DEMs; and the store's layers on the same grid. Any
-// rows have the bits the whole grid has there (gis::MosaicReader reads windows of its grid as the
-// grid has them; a native window is the DEM's own cells), but a store resampled to cell_size,
-// which is resampled whole (wholeBuildStep).
+// rows have the bits the whole grid has there: gis::MosaicReader reads windows of its grid as the
+// grid has them, a native window is the DEM's own cells, and a store resampled to cell_size is
+// warped from the store's cells under the rows (with a margin for the kernel) as from the whole
+// region's.
 Status readBed(const Scenario& s, const Plan& plan, int y0, int y1, ScenarioDomain& d,
                std::vector<StoredLayer>& storeLayers) {
   const auto& source = plan.source;
@@ -549,20 +559,36 @@ Status readBed(const Scenario& s, const Plan& plan, int y0, int y1, ScenarioDoma
   const gis::Georef& grid = plan.grid;
   const bool resample = s.region.cellSizeM > 0, mosaic = s.terrain.dems.size() > 1;
   d.firstRow = y0;
-  if (!resample || source.kind() == "store") {
-    const gis::CellRect native =
-        resample ? frame.window : gis::CellRect{frame.window.x, frame.window.y + y0, frame.window.width, y1 - y0};
+  if (!resample) {
+    const gis::CellRect native{frame.window.x, frame.window.y + y0, frame.window.width, y1 - y0};
     STRATA_TRY(d.bed, source.readBed(native));
     STRATA_TRY(storeLayers, source.readLayers(native));
   }
   if (resample && source.kind() == "store") {
-    STRATA_CHECK(y0 == 0 && y1 == grid.height) << "a store resampled to cell_size is built whole";
-    gis::MosaicInput in = source.resampleInput(d.bed);
+    constexpr int kMargin = 4;  // store cells: a kernel reaches 2
+    const int top = frame.window.y, bottom = frame.window.y + frame.window.height;
+    const int n0 = std::max(top, top + int(std::floor(y0 / frame.scaleY)) - kMargin);
+    const int n1 = std::min(bottom, top + int(std::ceil(y1 / frame.scaleY)) + kMargin);
+    const gis::CellRect native{frame.window.x, n0, frame.window.width, n1 - n0};
+    STRATA_TRY(auto bed, source.readBed(native));
+    STRATA_TRY(storeLayers, source.readLayers(native));
+    auto warpRows = [&](gis::MosaicInput in) -> Result<gis::Raster> {
+      STRATA_TRY(auto reader, gis::MosaicReader::open({std::move(in)}, grid));
+      gis::Raster out;
+      out.georef = rowsGeoref(grid, y0, y1);
+      STRATA_TRY(out.values, reader.read({0, y0, grid.width, y1 - y0}));
+      return out;
+    };
+    // Each warped as the region's whole window of the store is (MosaicInput::within).
+    auto windowOfRegion = [&](gis::Raster cells) {
+      return source.storeWindowInput(std::move(cells), frame.window, 0, n0 - top);
+    };
+    gis::MosaicInput in = windowOfRegion(std::move(bed));
     in.resampling = std::min(frame.scaleX, frame.scaleY) < 1 ? gis::Resampling::Minimum : gis::Resampling::Bilinear;
-    STRATA_TRY(d.bed, gis::warpToGrid(in, grid));
+    STRATA_TRY(d.bed, warpRows(std::move(in)));
     // Stored layer thicknesses are averaged (bilinear): their volume is what matters, not a channel.
     for (auto& layer : storeLayers) {
-      STRATA_TRY(layer.thickness, gis::warpToGrid({"", std::move(layer.thickness)}, grid));
+      STRATA_TRY(layer.thickness, warpRows(windowOfRegion(std::move(layer.thickness))));
     }
     return {};
   }
@@ -570,13 +596,13 @@ Status readBed(const Scenario& s, const Plan& plan, int y0, int y1, ScenarioDoma
   std::vector<gis::MosaicInput> inputs;
   if (mosaic) {
     for (const auto& p : s.terrain.dems) {
-      gis::MosaicInput in = source.resampleInput({}, p);
+      gis::MosaicInput in = source.resampleInput(p);
       in.mode = gis::BlendMode::Replace;
       in.resampling = gis::Resampling::MinimumIfCoarser;  // the lowest-elevation rule, as above
       inputs.push_back(std::move(in));
     }
   } else {
-    gis::MosaicInput in = source.resampleInput({});
+    gis::MosaicInput in = source.resampleInput();
     in.resampling = std::min(frame.scaleX, frame.scaleY) < 1 ? gis::Resampling::Minimum : gis::Resampling::Bilinear;
     inputs.push_back(std::move(in));
   }
@@ -685,8 +711,8 @@ Result<float> stackLayers(const Scenario& s, const Plan& plan, std::vector<Store
   return lo;
 }
 
-// Which cells of the region's grid are the region's: the mask (a whole build), or the polygon
-// alone (rows built apart, where no void makes a wall: wholeBuildStep).
+// Which cells of the region's grid are the region's: a mask, or the polygon alone (the places: a
+// void wall under one is refused, firstPlaceOnWalls).
 struct RegionCells {
   int width = 0, height = 0;
   const gis::Grid<uint8_t>* mask = nullptr;
@@ -1050,6 +1076,46 @@ sim::SimParams modelParams(const Scenario& s) {
   return p;
 }
 
+// voids = "walls": a void is a wall no water enters, so an inflow, a level or a dam break on one
+// would pour into (or hold water in) a wall. Refused, naming the first such place: inflows, then
+// levels, then dam breaks (their order as an index; -1 when none is on a void of `d`'s first
+// `rows` rows).
+int firstPlaceOnWalls(const Scenario& s, const std::vector<sim::Source>& sources,
+                      const std::vector<sim::LevelBoundary>& levels, const std::vector<CellList>& dams,
+                      const ScenarioDomain& d, int rows) {
+  if (s.terrain.voids != decltype(s.terrain)::Voids::kWalls) return -1;
+  auto onWall = [&](const CellList& cells) {
+    for (auto [x, y] : cells) {
+      const int local = y - d.firstRow;
+      if (local >= 0 && local < rows && d.voids.at(x, local)) return true;
+    }
+    return false;
+  };
+  int index = 0;
+  for (const auto& src : sources) {
+    if (onWall(src.cells)) return index;
+    ++index;
+  }
+  for (size_t l = 0; l < s.water.levels.size() && l < levels.size(); ++l, ++index) {
+    if (onWall(levels[l].cells)) return index;
+  }
+  for (const auto& cells : dams) {
+    if (onWall(cells)) return index;
+    ++index;
+  }
+  return -1;
+}
+
+Error refusePlaceOnWalls(const Scenario& s, int index) {
+  const size_t i = size_t(index), inflows = s.water.inflows.size(), levels = s.water.levels.size();
+  const Place& place = i < inflows            ? s.water.inflows[i].place
+                       : i < inflows + levels ? s.water.levels[i - inflows].place
+                                              : s.water.damBreaks[i - inflows - levels].polygon;
+  return placeError(s, place,
+                    "it lies on cells without data, which voids = \"walls\" makes walls no water enters; move it, "
+                    "or set [terrain] voids = \"fill\" or \"holes\"");
+}
+
 Result<ScenarioDomain> buildDomain(const Scenario& s, uint64_t memoryBudgetBytes, int ranks) {
   STRATA_TRY(auto plan, planRegion(s, memoryBudgetBytes, ranks, false, true));
   const int h = plan.grid.height;
@@ -1065,7 +1131,10 @@ Result<ScenarioDomain> buildDomain(const Scenario& s, uint64_t memoryBudgetBytes
   if (s.erosion.enabled && !hasLooseMaterial(d)) return refuseNoLooseMaterial(s);
   d.params = modelParams(s);
   STRATA_TRY_STATUS(checkModelParams(s, d.params));
-  const RegionCells region{plan.grid.width, h, &d.inside, {}};
+  // The region's cells for places: the polygon's (a void wall under a place is refused below).
+  const RegionCells region{
+      plan.grid.width, h, nullptr,
+      plan.frame.polygonPx.empty() ? std::vector<std::array<double, 2>>{} : plan.frame.toRegion(plan.frame.polygonPx)};
   STRATA_TRY_STATUS(placeInflows(s, plan, region, d));
   STRATA_TRY_STATUS(detail::breachInflowPaths(s, detail::Ranks::single(), {0, h}, d.sources, d.sourceNames, d));
   STRATA_TRY_STATUS(fillDepressions(s, d));
@@ -1074,6 +1143,9 @@ Result<ScenarioDomain> buildDomain(const Scenario& s, uint64_t memoryBudgetBytes
   addVoidHoles(voidHoleCells(s, d, h), d);
   STRATA_TRY_STATUS(placeRain(s, plan, d));
   STRATA_TRY(const auto dams, damBreakCells(s, plan, region));
+  if (const int wall = firstPlaceOnWalls(s, d.sources, d.levels, dams, d, h); wall >= 0) {
+    return refusePlaceOnWalls(s, wall);
+  }
   STRATA_TRY_STATUS(checkDamBreaks(s, placeDamBreaks(s, dams, d)));
   d.bedRangeM = bedRange(d, h);
   return d;
@@ -1082,11 +1154,6 @@ Result<ScenarioDomain> buildDomain(const Scenario& s, uint64_t memoryBudgetBytes
 // ---- Built rows by rows -------------------------------------------------------------------------
 
 namespace detail {
-
-std::string wholeBuildStep(const Scenario& s) {
-  if (!s.terrain.store.empty() && s.region.cellSizeM > 0) return "region.cell_size";
-  return {};
-}
 
 struct RowBuilder::Impl {
   const Scenario& s;
@@ -1100,8 +1167,6 @@ RowBuilder::RowBuilder(RowBuilder&&) noexcept = default;
 RowBuilder::~RowBuilder() = default;
 
 Result<RowBuilder> RowBuilder::plan(const Scenario& s, uint64_t memoryBudgetBytes, int ranks, bool pictures) {
-  const std::string step = wholeBuildStep(s);
-  STRATA_CHECK(step.empty()) << step << " needs the whole region: RowBuilder cannot build it";
   STRATA_TRY(auto plan, planRegion(s, memoryBudgetBytes, ranks, true, pictures));
   ScenarioDomain shape;
   shape.bed.georef = plan.grid;
@@ -1141,6 +1206,10 @@ Result<ScenarioDomain> RowBuilder::rows(int y0, int y1) const {
 }
 
 Error RowBuilder::refuseVoids(long long count) const { return scenario::refuseVoids(impl_->plan.source, count); }
+int RowBuilder::firstPlaceOnWalls(const ScenarioDomain& d, int rows) const {
+  return scenario::firstPlaceOnWalls(impl_->s, impl_->shape.sources, impl_->shape.levels, impl_->damCells, d, rows);
+}
+Error RowBuilder::refusePlaceOnWalls(int index) const { return scenario::refusePlaceOnWalls(impl_->s, index); }
 std::vector<std::pair<int, int>> RowBuilder::voidHoleCells(const ScenarioDomain& d, int rows) const {
   return scenario::voidHoleCells(impl_->s, d, rows);
 }

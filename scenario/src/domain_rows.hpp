@@ -16,19 +16,12 @@
 
 namespace strata::scenario::detail {
 
-/// The scenario key of a step that needs the whole region at once, or empty when the domain can
-/// be built rows by rows: a tile store resampled to cell_size (resampled whole). fill_depressions
-/// can (tile by tile: gis::fillDepressions), breach_inflows (the ranks flood together:
-/// breach.hpp), at_rest layers (settled against the neighbours' border rows: settle.hpp) and
-/// voids (filled from the rows gis::voidFillRows names).
-std::string wholeBuildStep(const Scenario& s);
-
 class RowBuilder {
  public:
   /// Plans the build (reads no cell; every rank makes the same): the region's grid, per-row cell
   /// sizes, materials, the model, inflows and levels on cells, the rain. The memory check is a
   /// rank's share of a run over `ranks` (with the pictures' gather on the lead when `pictures`).
-  /// `s` must outlive the builder, and wholeBuildStep(s) be empty.
+  /// `s` must outlive the builder.
   static Result<RowBuilder> plan(const Scenario& s, uint64_t memoryBudgetBytes, int ranks, bool pictures);
   RowBuilder(RowBuilder&&) noexcept;
   ~RowBuilder();
@@ -45,6 +38,10 @@ class RowBuilder {
 
   // What buildDomain does over the whole region, for the caller to do over the rows.
   Error refuseVoids(long long count) const;
+  /// voids = "walls": the first place (inflows, levels, dam breaks in order) with a cell on a
+  /// void of the first `count` rows of `rows` (-1: none), and its refusal.
+  int firstPlaceOnWalls(const ScenarioDomain& rows, int count) const;
+  Error refusePlaceOnWalls(int index) const;
   /// voids = "holes": the void cells of the first `rows` rows of `rows` that are holes (on the
   /// region's rows), and the level that drains them added to the shape (all ranks' cells, in
   /// row-major order).

@@ -769,15 +769,15 @@ Result<RunSummary> runScenario(const Scenario& s, const RunOptions& opt) {
   }
   const int intervals = int(intervalCount);
   // The domain. In one process: built whole. Over MPI ranks: built rows by rows, each rank its
-  // own from its windows of the DEM (domain_rows.hpp), unless a step needs the whole region at
-  // once (wholeBuildStep) or there are fewer rows than ranks: then the lead builds it whole. Either
-  // way the model input is written into input/ before the run folder's solver reads its blocks
-  // from it, and every rank runs on the domain's shape.
+  // own from its windows of the DEM or store (domain_rows.hpp), unless the region has fewer rows
+  // than there are ranks (a region that small fits anywhere): then the lead builds it whole.
+  // Either way the model input is written into input/ before the run folder's solver reads its
+  // blocks from it, and every rank runs on the domain's shape.
   STRATA_TRY(auto engine, startContext(opt.backend.value_or(s.model.backend), opt.pictures, ranks));
   ScenarioDomain domain;
   Status status;
   std::optional<detail::RowBuilder> byRows;
-  if (ranks.distributed() && detail::wholeBuildStep(s).empty()) {
+  if (ranks.distributed()) {
     auto planned = detail::RowBuilder::plan(s, opt.memoryBudgetBytes, ranks.size(), opt.pictures);
     STRATA_TRY_STATUS(ranks.agree(statusOf(planned)));
     if (planned->shape().bed.georef.height >= ranks.size()) byRows.emplace(std::move(planned).value());

@@ -171,7 +171,6 @@ TEST(ScenarioMpi, ADomainBuiltByTheRanksRowByRowEqualsOneProcess) {
     SCOPED_TRACE(name);
     const auto dir = sharedDir(std::string("rows-") + name);
     const Scenario s = load(dir, "rows.toml", text);
-    ASSERT_EQ(detail::wholeBuildStep(s), "");  // built by the ranks
     if (worldRank() == 0) {
       auto one = runScenario(s, options(dir / "one", "flood"));
       ASSERT_TRUE(one) << one.message();
@@ -290,8 +289,8 @@ TEST(ScenarioMpi, TheRanksFillVoidsAsOneProcess) {
   const auto dir = sharedDir("voids");
   for (const char* mode : {"fill", "walls", "holes"}) {
     SCOPED_TRACE(mode);
-    const std::string text = "[terrain]\ndem = \"" + test::dataPath("rainier/mt_rainier_90m.tif") +
-                             "\"\nvoids = \"" + mode +
+    const std::string text = "[terrain]\ndem = \"" + test::dataPath("rainier/mt_rainier_90m.tif") + "\"\nvoids = \"" +
+                             mode +
                              "\"\n[region]\nbbox_lonlat = [-121.80, 46.80, -121.72, 46.88]\n"
                              "[model]\nkind = \"flood\"\n[water.rain]\nrate = \"10 mm/h\"\n"
                              "[time]\nduration = \"10 min\"\n";
@@ -327,7 +326,30 @@ TEST(ScenarioMpi, TheRanksFillVoidsAsOneProcess) {
       }
     }
     EXPECT_GE(int(bands.size()), std::min(worldSize(), 2));
-    if (worldRank() == 0) std::printf("voids = %s: %d voids over %zu ranks' rows\n", mode, whole->voidCells, bands.size());
+    if (worldRank() == 0) {
+      std::printf("voids = %s: %d voids over %zu ranks' rows\n", mode, whole->voidCells, bands.size());
+    }
+    if (std::string(mode) != "walls") continue;
+    // A spring on a void made a wall is refused, on every rank with the one process's message.
+    int vx = -1, vy = -1;
+    for (int i = int(whole->voids.size()) - 1; i >= 0 && vx < 0; --i) {
+      if (whole->voids.data[size_t(i)]) vx = i % w, vy = i / w;
+    }
+    const auto& c = whole->bed.georef.transform.c;
+    char spring[256];
+    std::snprintf(spring, sizeof spring,
+                  "[[water.inflow]]\nname = \"spring\"\nat_lonlat = [%.9f, %.9f]\nhydrograph = [[0, 10], [60, 10]]\n",
+                  c[0] + (vx + 0.5) * c[1], c[3] + (vy + 0.5) * c[5]);
+    const Scenario onWall = load(dir, "on-wall.toml", text + spring);
+    auto refused = buildDomain(onWall);
+    ASSERT_FALSE(refused);
+    EXPECT_NE(refused.message().find("on-wall.toml:"), std::string::npos) << refused.message();
+    EXPECT_NE(refused.message().find("voids = \"walls\" makes walls"), std::string::npos) << refused.message();
+    auto plan = detail::RowBuilder::plan(onWall, 0, worldSize(), false);
+    ASSERT_TRUE(plan) << plan.message();
+    auto byRows = detail::buildByRows(*plan, onWall, detail::Ranks::world());
+    ASSERT_FALSE(byRows);
+    EXPECT_EQ(byRows.message(), refused.message());
   }
   MPI_Barrier(MPI_COMM_WORLD);
   if (worldRank() == 0) fs::remove_all(dir);

@@ -15,6 +15,7 @@
 #include <strata/terrain/ingest.hpp>
 #include <strata/terrain/tile_store.hpp>
 
+#include "../../scenario/src/domain_rows.hpp"
 #include "strata_test.hpp"
 
 namespace strata::scenario {
@@ -227,6 +228,45 @@ TEST(ScenarioStore, StoredLayersComeWithTheirMaterials) {
   EXPECT_EQ(d->input.materials[1].name, "soil");
   for (float v : d->input.layersM[0].data) ASSERT_FLOAT_EQ(v, 2.0f);  // resampled, still 2 m
   for (float v : d->input.layersM[1].data) ASSERT_FLOAT_EQ(v, 0.5f);
+}
+
+// A store resampled to cell_size, built rows by rows as MPI ranks build it (domain_rows.hpp):
+// each band of rows is warped from the store's cells under it, and has the whole build's bits,
+// bed and stored layer alike, coarser (the lowest cell) and finer (bilinear) than the store. So
+// do a DEM's (each band warped from the file, on the whole grid's cells).
+TEST(ScenarioStore, ResampledStoreRowsHaveTheWholeBuildsBits) {
+  const auto dir = ingestGrandCanyon("scenario_store_rows", 1, 6, 2.0f);
+  for (const auto& [terrain, size] : {std::pair{storeLine(dir), "600 m"}, std::pair{storeLine(dir), "150 m"},
+                                      std::pair{demLine(), "150 m"}, std::pair{demLine(), "90 m"}}) {
+    SCOPED_TRACE(terrain + " " + size);
+    const bool store = terrain != demLine();
+    const std::string text =
+        "[terrain]\n" + terrain + "\n[region]\nbbox_lonlat = [-112.25, 36.02, -112.001, 36.18]\ncell_size = \"" + size +
+        "\"\n" + kInflow + "[model]\nboundary = { east = \"closed\" }\n[time]\nduration = \"1 h\"\n";
+    auto s = parseScenario(text, "/runs/t.toml");
+    ASSERT_TRUE(s) << s.message();
+    auto whole = buildDomain(*s);
+    ASSERT_TRUE(whole) << whole.message();
+    if (store) {
+      ASSERT_EQ(whole->input.layersM.size(), 1u);  // the stored sand
+    }
+    auto builder = detail::RowBuilder::plan(*s, 0, 3, false);
+    ASSERT_TRUE(builder) << builder.message();
+    const int w = whole->bed.georef.width, h = whole->bed.georef.height;
+    for (int band = 0; band < 3; ++band) {
+      const int y0 = h * band / 3, y1 = h * (band + 1) / 3;
+      auto rows = builder->rows(y0, y1);
+      ASSERT_TRUE(rows) << rows.message();
+      auto same = [&](const gis::Grid<float>& mine, const gis::Grid<float>& all) {
+        return std::equal(mine.data.begin(), mine.data.end(), all.data.begin() + ptrdiff_t(y0) * w);
+      };
+      EXPECT_TRUE(same(rows->bed.values, whole->bed.values)) << "band " << band;
+      ASSERT_EQ(rows->input.layersM.size(), whole->input.layersM.size());
+      for (size_t k = 0; k < rows->input.layersM.size(); ++k) {
+        EXPECT_TRUE(same(rows->input.layersM[k], whole->input.layersM[k])) << "band " << band << " layer " << k;
+      }
+    }
+  }
 }
 
 TEST(ScenarioStore, MissingStoreIsRefusedNamingTheKey) {

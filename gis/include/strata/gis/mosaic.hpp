@@ -58,6 +58,12 @@ struct MosaicInput {
   /// A CRS and/or geotransform assigned to the file, replacing its own (for DEMs without one).
   std::optional<std::string> assignCrs = std::nullopt;
   std::optional<GeoTransform> assignTransform = std::nullopt;
+  /// With `raster`: the raster is a window of a larger one whose georeference is `within` (its
+  /// cells from cell (withinX, withinY) of it), warped as that larger raster is: a target cell
+  /// whose kernel lies on the cells held gets the bits a warp of the larger raster gives it (the
+  /// source cell of each target cell is found on the larger raster's grid, not the window's).
+  std::optional<Georef> within = std::nullopt;
+  int withinX = 0, withinY = 0;
 };
 
 /// The input's name in messages: its path, or "in-memory raster".
