@@ -1,12 +1,14 @@
 #include "breach.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cstdint>
 #include <cstring>
 #include <limits>
 #include <queue>
 
 #include <strata/core/bytes.hpp>
+#include <strata/core/log.hpp>
 
 #include "distributed.hpp"
 
@@ -78,6 +80,8 @@ Status breachInflowPaths(const Scenario& s, const Ranks& ranks, const std::vecto
   std::vector<int8_t> from(size_t(y1 - y0) * size_t(w));
 
   for (size_t k = 0; k < sources.size(); ++k) {
+    const auto started = std::chrono::steady_clock::now();
+    long long rounds = 0, taken = 0;
     // The flood: from the inflow's cells until the first open-edge cell in key order.
     std::fill(from.begin(), from.end(), kUnseen);
     std::priority_queue<Key, std::vector<Key>, std::greater<>> queue;
@@ -111,6 +115,7 @@ Status breachInflowPaths(const Scenario& s, const Ranks& ranks, const std::vecto
         if (r != me) others = std::min(others, t);
       }
       if (!(first < end)) break;  // nothing left that comes before the outlet found
+      ++rounds;
       // Take cells while nothing another rank holds, or could still send, comes first: what this
       // rank sends now comes after the cell it was reached from, and so does all that follows it.
       Key bound = std::min(others, end), found = kNone;
@@ -118,6 +123,7 @@ Status breachInflowPaths(const Scenario& s, const Ranks& ranks, const std::vecto
       while (!queue.empty() && queue.top() < bound) {
         const Key e = queue.top();
         queue.pop();
+        ++taken;
         const int x = int(e.cell % w), y = int(e.cell / w);
         if (outlet(x, y)) {
           found = e;
@@ -224,6 +230,11 @@ Status breachInflowPaths(const Scenario& s, const Ranks& ranks, const std::vecto
       }
     }
     ++d.breach.paths;
+    if (ranks.lead()) {
+      log::debug("breach") << "inflow \"" << names[k] << "\": a path of " << path.size() << " cells, " << taken
+                           << " cells taken on the lead, " << rounds << " rounds over " << ranks.size() << " rank(s), "
+                           << std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count() << " s";
+    }
   }
   return {};
 }
