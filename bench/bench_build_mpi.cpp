@@ -62,7 +62,7 @@ int main(int argc, char** argv) {
     long long cells = 0;
     if (ranks.lead()) {
       const auto t = Clock::now();
-      auto d = scenario::buildDomain(*s, 0, ranks.size());
+      auto d = scenario::buildDomain(*s);
       one = seconds(t);
       if (!d) std::fprintf(stderr, "buildDomain: %s\n", d.message().c_str()), status = 1;
       if (d) cells = (long long)d->bed.values.size();

@@ -42,25 +42,6 @@ void readCells(ByteReader& r, std::vector<std::pair<int, int>>& cells) {
   cells.clear();
   for (size_t i = 0; i + 1 < flat.size(); i += 2) cells.emplace_back(flat[i], flat[i + 1]);
 }
-void writeSeries(ByteWriter& w, const TimeSeries& s) { w.vec(s.samples()); }
-void readSeries(ByteReader& r, TimeSeries& s) {
-  std::vector<TimeSeries::Sample> samples;
-  r.vec(samples);
-  if (r.ok && !samples.empty()) s = TimeSeries(std::move(samples));
-}
-
-// A material's fields in order, for a ByteWriter (M = const Material) or a ByteReader.
-template <class IO, class M>
-void materialFields(IO& io, M& m) {
-  io.str(m.name);
-  io.pod(m.colour);
-  io.pod(m.erodibility);
-  io.pod(m.dissolutionRate);
-  io.pod(m.talusAngleDeg);
-  io.pod(m.densityKgM3);
-  io.pod(m.weatheringRatePerS);
-}
-
 // One window of one model input file.
 Result<gis::Grid<float>> readInputWindow(const fs::path& file, const gis::CellRect& window) {
   gis::ReadOptions o;
@@ -191,111 +172,6 @@ std::vector<double> Ranks::allGather(const std::vector<double>& values) const {
   MPI_Allgather(values.data(), int(values.size()), MPI_DOUBLE, all.data(), int(values.size()), MPI_DOUBLE,
                 MPI_COMM_WORLD);
   return all;
-}
-
-// A georeference's fields in order, for a ByteWriter (G = const Georef) or a ByteReader.
-template <class IO, class G>
-void georefFields(IO& io, G& g) {
-  io.str(g.crsWkt);
-  io.str(g.crsName);
-  io.pod(g.geographic);
-  io.pod(g.transform.c);
-  io.pod(g.width);
-  io.pod(g.height);
-  io.str(g.body.name);
-  io.pod(g.body.semiMajorM);
-  io.pod(g.body.flattening);
-  io.str(g.verticalUnit);
-}
-
-// What the report says of the domain's build, for a ByteWriter (D = const ScenarioDomain) or a
-// ByteReader.
-template <class IO, class D>
-void reportFields(IO& io, D& d) {
-  for (auto* names : {&d.sourceNames, &d.levelNames}) {
-    uint64_t n = names->size();
-    io.pod(n);
-    if constexpr (!std::is_const_v<D>) names->resize(size_t(std::min<uint64_t>(n, io.left())));
-    for (auto& name : *names) io.str(name);
-  }
-  io.pod(d.damBreakVolumeM3);
-  io.pod(d.totalAreaM2);
-  io.pod(d.bedRangeM);
-  io.pod(d.breach);
-  io.pod(d.filled);
-  io.pod(d.voidCells);
-  io.vec(d.layerCellsTooSteep);
-}
-
-std::string encodeDomainShape(const ScenarioDomain& d) {
-  ByteWriter w;
-  georefFields(w, d.bed.georef);
-  w.pod(int32_t(d.bed.georef.epsg.value_or(-1)));
-  w.pod(d.params);
-  w.vec(d.input.rowDxM);
-  w.pod(d.input.dyM);
-  w.pod(d.input.datumM);
-  w.pod(uint64_t(d.input.materials.size()));
-  for (const auto& m : d.input.materials) materialFields(w, m);
-  w.pod(uint8_t(d.input.waterDepthM.size() > 0));
-  w.pod(uint8_t(d.input.rainMmPerHour.size() > 0));
-  w.pod(uint64_t(d.sources.size()));
-  for (const auto& s : d.sources) {
-    writeCells(w, s.cells);
-    writeSeries(w, s.dischargeM3S);
-  }
-  w.pod(uint64_t(d.levels.size()));
-  for (const auto& l : d.levels) {
-    writeCells(w, l.cells);
-    writeSeries(w, l.stageM);
-  }
-  w.pod(d.rainMmPerHour);
-  w.pod(d.rainStartS);
-  w.pod(d.rainEndS);
-  reportFields(w, d);
-  return w.out;
-}
-
-Result<ScenarioDomain> decodeDomainShape(std::string_view bytes) {
-  ByteReader r{bytes};
-  ScenarioDomain d;
-  georefFields(r, d.bed.georef);
-  int32_t epsg = -1;
-  r.pod(epsg);
-  if (epsg >= 0) d.bed.georef.epsg = epsg;
-  r.pod(d.params);
-  r.vec(d.input.rowDxM);
-  r.pod(d.input.dyM);
-  r.pod(d.input.datumM);
-  uint64_t n = 0;
-  r.pod(n);
-  for (uint64_t i = 0; r.ok && i < n && i < uint64_t(kMaxInputLayers); ++i)
-    materialFields(r, d.input.materials.emplace_back());
-  uint8_t water = 0, rain = 0;
-  r.pod(water);
-  r.pod(rain);
-  // A one-cell marker: the lead's domain has these grids (their cells are in input/).
-  if (water) d.input.waterDepthM = gis::Grid<float>(1, 1, 0.0f);
-  if (rain) d.input.rainMmPerHour = gis::Grid<float>(1, 1, 0.0f);
-  r.pod(n);
-  for (uint64_t i = 0; r.ok && i < n; ++i) {
-    auto& s = d.sources.emplace_back();
-    readCells(r, s.cells);
-    readSeries(r, s.dischargeM3S);
-  }
-  r.pod(n);
-  for (uint64_t i = 0; r.ok && i < n; ++i) {
-    auto& l = d.levels.emplace_back();
-    readCells(r, l.cells);
-    readSeries(r, l.stageM);
-  }
-  r.pod(d.rainMmPerHour);
-  r.pod(d.rainStartS);
-  r.pod(d.rainEndS);
-  reportFields(r, d);
-  if (!r.ok || r.left() != 0)
-    return fail("the domain sent by rank 0 is damaged (" + std::to_string(bytes.size()) + " bytes)");
-  return d;
 }
 
 std::vector<std::string> modelInputFiles(int layers) {

@@ -63,14 +63,6 @@ class Ranks {
   int rank_ = 0, size_ = 1;
 };
 
-/// What every rank needs of the domain besides its cells: the region's georeference, the model,
-/// inflows, levels, rain, materials, cell sizes and datum, and what the report says of the
-/// domain's build (names, areas, volumes, the bed's range, the conditioning's counts).
-std::string encodeDomainShape(const ScenarioDomain& d);
-/// The domain with no cells from encodeDomainShape's bytes: every grid empty but waterDepthM and
-/// rainMmPerHour, which are 1 x 1 where the lead's domain has them (modelInputSource reads them).
-Result<ScenarioDomain> decodeDomainShape(std::string_view bytes);
-
 /// The run folder's model input files for `layers` layers (relative paths): input/base.tif,
 /// input/layer_K.tif (K = 1 the bottom layer), input/water.tif, input/rain.tif.
 std::vector<std::string> modelInputFiles(int layers);
@@ -79,8 +71,7 @@ inline constexpr int kMaxInputLayers = 64;
 
 /// Collective: writes the model input (base, layers, initial water and rain raster when present)
 /// as float32 GeoTIFFs in the region's CRS (`georef`, the whole region's) into `runDir`/input:
-/// each rank its rows of the region, `d` (its grids' rows from d.firstRow; none: a rank with no
-/// rows, e.g. all but the lead when the lead built the whole domain). `layers`, `water` and
+/// each rank its rows of the region, `d` (its grids' rows from d.firstRow). `layers`, `water` and
 /// `rain`: which files the region has (the same on every rank).
 Status writeModelInput(const Ranks& ranks, const std::filesystem::path& runDir, const gis::Georef& georef,
                        const ScenarioDomain& d, int layers, bool water, bool rain);
@@ -92,17 +83,19 @@ struct RowsBuilt {
   ScenarioDomain shape, rows;
 };
 /// Collective: the domain built rows by rows over the ranks (domain_rows.hpp): rank r builds rows
-/// [r h / N, (r + 1) h / N) from its own windows of the DEM, the ranks combine the datum, the
-/// totals and the checks, and fill_depressions runs tile by tile (each rank's rows a tile; the
-/// labels' graph is gathered to the lead, solved there and sent back). Writes nothing (a check
-/// that fails leaves no file). Needs at least one row per rank.
+/// [r h / N, (r + 1) h / N) from its own windows of the DEM or store, the ranks combine the
+/// datum, the totals and the checks, settle at_rest layers against each other's border rows
+/// (settle.hpp), flood breach_inflows together (breach.hpp), and fill_depressions runs tile by
+/// tile (each rank's rows a tile; the labels' graph is gathered to the lead, solved there and
+/// sent back). Writes nothing (a check that fails leaves no file). Needs at least one row per
+/// rank (RowBuilder::plan refuses a region with fewer).
 Result<RowsBuilt> buildByRows(const RowBuilder& builder, const Scenario& s, const Ranks& ranks);
 /// Collective: every rank writes its rows into the model input and, with `elevation`, into
 /// maps/elevation.tif.
 Status writeRows(const Ranks& ranks, const std::filesystem::path& runDir, const RowsBuilt& built, bool elevation);
 
-/// The region read window by window from those files (`shape` from decodeDomainShape or the
-/// lead's domain): what each rank builds its blocks from.
+/// The region read window by window from those files (`shape`: RowsBuilt::shape): what each
+/// rank builds its blocks from.
 sim::RegionSource modelInputSource(const std::filesystem::path& runDir, const ScenarioDomain& shape);
 
 /// checkpoint.R-of-N.bin: rank R's part of a run checkpointed on N ranks.

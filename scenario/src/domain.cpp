@@ -353,20 +353,19 @@ Result<RegionFrame> regionWindow(const Scenario& s, const TerrainSource& source,
 // per layer), the checkpoint (the saved state, and its encoding beside it), what the outputs read
 // back at each interval (detail::readPieces: the state block, depth, flood statistics, mask, the
 // model input's window, in erosion runs suspended sediment and the layers now and at the start),
-// and the domain (bed, mask, area in double, base, layers, water, rain). Over
-// `ranks` MPI ranks the lead, the heaviest, first builds the whole domain and writes it as the
-// model input; during the run every rank holds a 1/ranks share (its blocks' halos add ~10% at
-// the default block sizes) of the solver, checkpoint and read-back. Built by rows (RowBuilder),
-// every rank builds a 1/ranks share of the domain (and lets it go before the run): no rank holds
-// a whole grid. Pictures add a bounded amount on the lead (pictureBytes).
-double bytesPerCell(int layers, int ranks, bool byRows) {
+// and the domain (bed, mask, area in double, base, layers, water, rain). Over `ranks` MPI ranks
+// every rank builds a 1/ranks share of the domain (RowBuilder, and lets it go before the run),
+// then holds a 1/ranks share (its blocks' halos add ~10% at the default block sizes) of the
+// solver, checkpoint and read-back: no rank holds a whole grid. Pictures add a bounded amount on
+// the lead (pictureBytes).
+double bytesPerCell(int layers, int ranks) {
   const double solver = 4.0 * (9 * 4 + 8 + 5 + layers);
   const double checkpoint = 2 * 4.0 * (4 + 4 + 4 + 8 + 4 + layers);
   const double readBack = 16 + 4 + 16 + 1 + 4.0 * (3 + layers) + 4 + 8.0 * layers;
   const double domain = 4 + 1 + 8 + 4 + 4.0 * layers + 4 + 4;
   if (ranks <= 1) return solver + checkpoint + readBack + domain;
   const double run = (solver + checkpoint + readBack) * 1.1 / ranks;
-  return std::max(byRows ? domain * 1.1 / ranks : domain, run);
+  return std::max(domain * 1.1 / ranks, run);
 }
 
 // What pictures hold on the lead: the bed drawn and the state gathered for it (depth; in erosion
@@ -400,7 +399,7 @@ gis::Georef windowGeoref(const gis::Georef& full, const gis::CellRect& w) {
 // this process can have (`budget` bytes; 0: what the machine has available), its share of a run
 // over `ranks` MPI ranks.
 Status planGrid(const Scenario& s, const TerrainSource& source, RegionFrame& frame, uint64_t budget, int ranks,
-                bool byRows, bool pictures) {
+                bool pictures) {
   const gis::Georef g0 = windowGeoref(source.georef(), frame.window);
   double width = g0.width, height = g0.height;
   if (s.region.cellSizeM > 0) {
@@ -430,9 +429,8 @@ Status planGrid(const Scenario& s, const TerrainSource& source, RegionFrame& fra
   const int layers = std::max<int>(1, source.layerCount() + int(s.terrain.layers.size()));
   const double cells = width * height, nativeCells = double(g0.width) * g0.height;
   // The window as read (and GDAL's copy while it resamples) comes on top.
-  const double native = s.region.cellSizeM > 0 ? 8 * nativeCells / (byRows ? ranks : 1) : 0;
-  const double bytes =
-      cells * bytesPerCell(layers, ranks, byRows) + native + (pictures ? pictureBytes(width, height) : 0);
+  const double native = s.region.cellSizeM > 0 ? 8 * nativeCells / ranks : 0;
+  const double bytes = cells * bytesPerCell(layers, ranks) + native + (pictures ? pictureBytes(width, height) : 0);
   const double available = budget > 0 ? double(budget) : double(availableMemoryBytes());
   const bool tooWide = width > std::numeric_limits<int>::max() / 2 || height > std::numeric_limits<int>::max() / 2;
   if (tooWide || (available > 0 && bytes > available)) {
@@ -445,6 +443,14 @@ Status planGrid(const Scenario& s, const TerrainSource& source, RegionFrame& fra
                              : available > 0 ? "and " + formatBytes(available) + " are available"
                                              : "more than there is";
     return fail(s.at(sizeKey(s)) + cellSize + msg + have + " (use larger cells or a smaller region)");
+  }
+  if (ranks > height) {
+    char msg[200];
+    std::snprintf(msg, sizeof msg,
+                  "the region is %.0f cells high, fewer than the %d MPI ranks (each builds and runs its own rows): "
+                  "run it on at most %.0f ranks, or use smaller cells",
+                  height, ranks, height);
+    return fail(s.at(sizeKey(s)) + msg);
   }
   frame.width = int(width);
   frame.height = int(height);
@@ -486,11 +492,11 @@ Result<std::vector<Material>> layerMaterials(const Scenario& s, const TerrainSou
 
 // Steps 1 and 2, and the grid: the region's window of the source, the grid planned against
 // memory, its georeference (the window's, resampled to region.cell_size) and cell sizes.
-Result<Plan> planRegion(const Scenario& s, uint64_t budget, int ranks, bool byRows, bool pictures) {
+Result<Plan> planRegion(const Scenario& s, uint64_t budget, int ranks, bool pictures) {
   STRATA_TRY(auto source, TerrainSource::open(s));
   STRATA_TRY(auto mapper, PixelMapper::create(source.georef()));
   STRATA_TRY(auto frame, regionWindow(s, source, mapper));
-  STRATA_TRY_STATUS(planGrid(s, source, frame, budget, ranks, byRows, pictures));
+  STRATA_TRY_STATUS(planGrid(s, source, frame, budget, ranks, pictures));
   const gis::Georef g0 = windowGeoref(source.georef(), frame.window);
   gis::Georef grid = g0;
   if (s.region.cellSizeM > 0) {
@@ -1116,8 +1122,8 @@ Error refusePlaceOnWalls(const Scenario& s, int index) {
                     "or set [terrain] voids = \"fill\" or \"holes\"");
 }
 
-Result<ScenarioDomain> buildDomain(const Scenario& s, uint64_t memoryBudgetBytes, int ranks) {
-  STRATA_TRY(auto plan, planRegion(s, memoryBudgetBytes, ranks, false, true));
+Result<ScenarioDomain> buildDomain(const Scenario& s, uint64_t memoryBudgetBytes) {
+  STRATA_TRY(auto plan, planRegion(s, memoryBudgetBytes, 1, true));
   const int h = plan.grid.height;
   ScenarioDomain d;
   std::vector<StoredLayer> storeLayers;
@@ -1167,7 +1173,7 @@ RowBuilder::RowBuilder(RowBuilder&&) noexcept = default;
 RowBuilder::~RowBuilder() = default;
 
 Result<RowBuilder> RowBuilder::plan(const Scenario& s, uint64_t memoryBudgetBytes, int ranks, bool pictures) {
-  STRATA_TRY(auto plan, planRegion(s, memoryBudgetBytes, ranks, true, pictures));
+  STRATA_TRY(auto plan, planRegion(s, memoryBudgetBytes, ranks, pictures));
   ScenarioDomain shape;
   shape.bed.georef = plan.grid;
   shape.input.rowDxM = plan.rowDxM;
@@ -1182,7 +1188,7 @@ Result<RowBuilder> RowBuilder::plan(const Scenario& s, uint64_t memoryBudgetByte
   STRATA_TRY_STATUS(placeLevels(s, plan, region, shape));
   STRATA_TRY_STATUS(placeRain(s, plan, shape));
   STRATA_TRY(auto dams, damBreakCells(s, plan, region));
-  // One-cell markers, as decodeDomainShape leaves: the rows have a rain raster, initial water.
+  // One-cell markers (modelInputSource reads them): the rows have a rain raster, initial water.
   if (s.water.rain && !s.water.rain->raster.empty()) shape.input.rainMmPerHour = gis::Grid<float>(1, 1, 0.0f);
   if (!dams.empty()) shape.input.waterDepthM = gis::Grid<float>(1, 1, 0.0f);
   return RowBuilder(std::make_unique<Impl>(Impl{s, std::move(plan), std::move(shape), std::move(dams)}));

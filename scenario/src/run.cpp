@@ -768,30 +768,21 @@ Result<RunSummary> runScenario(const Scenario& s, const RunOptions& opt) {
     return fail(s.at("time.output_interval") + msg);
   }
   const int intervals = int(intervalCount);
-  // The domain. In one process: built whole. Over MPI ranks: built rows by rows, each rank its
-  // own from its windows of the DEM or store (domain_rows.hpp), unless the region has fewer rows
-  // than there are ranks (a region that small fits anywhere): then the lead builds it whole.
-  // Either way the model input is written into input/ before the run folder's solver reads its
-  // blocks from it, and every rank runs on the domain's shape.
+  // The domain. In one process: built whole. Over MPI ranks: each rank builds its own rows from
+  // its windows of the DEM or store (domain_rows.hpp; the region needs a row per rank), writes
+  // them into input/ (the model input the run's blocks read) and runs on the domain's shape.
   STRATA_TRY(auto engine, startContext(opt.backend.value_or(s.model.backend), opt.pictures, ranks));
   ScenarioDomain domain;
-  Status status;
-  std::optional<detail::RowBuilder> byRows;
+  std::optional<detail::RowsBuilt> rows;
   if (ranks.distributed()) {
     auto planned = detail::RowBuilder::plan(s, opt.memoryBudgetBytes, ranks.size(), opt.pictures);
     STRATA_TRY_STATUS(ranks.agree(statusOf(planned)));
-    if (planned->shape().bed.georef.height >= ranks.size()) byRows.emplace(std::move(planned).value());
+    STRATA_TRY(rows, detail::buildByRows(*planned, s, ranks));
+  } else {
+    STRATA_TRY(domain, buildDomain(s, opt.memoryBudgetBytes));
   }
-  std::optional<detail::RowsBuilt> rows;
-  if (byRows) {
-    STRATA_TRY(rows, detail::buildByRows(*byRows, s, ranks));
-  } else if (ranks.lead()) {
-    auto built = buildDomain(s, opt.memoryBudgetBytes, ranks.size());
-    if (built) domain = std::move(built).value();
-    status = statusOf(built);
-  }
-  STRATA_TRY_STATUS(ranks.agree(status));
 
+  Status status;
   std::optional<FileLock> lock;  // held by the lead for the whole run
   if (ranks.lead()) {
     auto taken = takeRunFolder(opt);
@@ -811,25 +802,9 @@ Result<RunSummary> runScenario(const Scenario& s, const RunOptions& opt) {
     STRATA_TRY_STATUS(detail::writeRows(ranks, opt.outDir, *rows, elevation));
     domain = std::move(rows->shape);
     rows.reset();  // this rank's rows: read back from input/ by its blocks
-  } else {
-    if (elevation) {
-      std::vector<gis::GridWindow> whole;
-      if (ranks.lead()) whole.push_back({0, 0, domain.bed.values});
-      STRATA_TRY_STATUS(
-          detail::writeRaster(ranks, opt.outDir / "maps" / "elevation.tif", domain.bed.georef, {}, whole));
-    }
-    if (ranks.distributed()) {
-      // The lead's domain: its shape to every rank, its cells into input/. Every rank, the lead
-      // too, then runs on the shape and reads its blocks from input/.
-      const std::string shape = ranks.fromLead(ranks.lead() ? detail::encodeDomainShape(domain) : std::string());
-      auto decoded = detail::decodeDomainShape(shape);
-      STRATA_TRY_STATUS(ranks.agree(statusOf(decoded)));
-      const ScenarioDomain& sh = *decoded;
-      STRATA_TRY_STATUS(detail::writeModelInput(ranks, opt.outDir, sh.bed.georef, domain,
-                                                int(sh.input.materials.size()), sh.input.waterDepthM.size() > 0,
-                                                sh.input.rainMmPerHour.size() > 0));
-      domain = std::move(decoded).value();
-    }
+  } else if (elevation) {
+    STRATA_TRY_STATUS(detail::writeRaster(ranks, opt.outDir / "maps" / "elevation.tif", domain.bed.georef, {},
+                                          {{0, 0, domain.bed.values}}));
   }
   const std::string name = displayName(s.name);
   if (ranks.lead()) {
@@ -837,8 +812,9 @@ Result<RunSummary> runScenario(const Scenario& s, const RunOptions& opt) {
     log::info(opt.command) << name << ": " << g.width << " x " << g.height << " cells, " << domain.totalAreaM2 / 1e6
                            << " km^2, " << domain.sources.size() << " inflow(s), " << domain.levels.size()
                            << " fixed level(s), " << formatDuration(s.durationS) << " simulated"
-                           << (byRows ? ", built by the " + std::to_string(ranks.size()) + " ranks row by row"
-                                      : std::string());
+                           << (ranks.distributed()
+                                   ? ", built by the " + std::to_string(ranks.size()) + " ranks row by row"
+                                   : std::string());
   }
   const CheckpointOwner owner{opt.command, fnv1a(scenarioText)};
   const fs::path checkpointPath =

@@ -17,6 +17,7 @@
 #include <strata/scenario/domain.hpp>
 #include <strata/sim/cpu_solver.hpp>
 
+#include "../../scenario/src/domain_rows.hpp"
 #include "scenario_fixture.hpp"
 #include "strata_test.hpp"
 
@@ -36,6 +37,26 @@ const std::string kInflow =
 // A spring inside the 3857 DEM's western part (it ends at 112.85 W).
 const std::string kInflowWest =
     "[[water.inflow]]\nname = \"spring\"\nat_lonlat = [-113.0, 36.2]\nhydrograph = [[0, 100], [3600, 100]]\n";
+
+// Over MPI ranks each rank builds and runs its own rows: a region with fewer rows than ranks is
+// refused before anything is read, naming the key that sets its size and how many ranks can run
+// it.
+TEST(ScenarioDomain, ARegionWithFewerRowsThanRanksIsRefused) {
+  auto s = parseScenario("[terrain]\ndem = \"" + test::dataPath("grand_canyon/grand_canyon_512.tif") +
+                             "\"\n[region]\nbbox_lonlat = [-112.25, 36.02, -112.001, 36.18]\ncell_size = \"600 m\"\n" +
+                             kInflow + "[time]\nduration = \"1 h\"\n",
+                         "/runs/t.toml");
+  ASSERT_TRUE(s) << s.message();
+  auto whole = buildDomain(*s);
+  ASSERT_TRUE(whole) << whole.message();
+  const int h = whole->bed.georef.height;
+  auto refused = detail::RowBuilder::plan(*s, 0, h + 1, false);
+  ASSERT_FALSE(refused);
+  EXPECT_EQ(refused.message().rfind(s->at("region.cell_size"), 0), 0u) << refused.message();
+  EXPECT_NE(refused.message().find("run it on at most " + std::to_string(h) + " ranks"), std::string::npos)
+      << refused.message();
+  EXPECT_TRUE(detail::RowBuilder::plan(*s, 0, h, false));
+}
 
 TEST(ScenarioDomain, CutsTheRegionWindowWithGeodesicCellSizes) {
   auto d = domainOf("bbox_lonlat = [-112.5, 36.01, -112.001, 36.3]", kInflow);

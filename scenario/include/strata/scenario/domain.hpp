@@ -62,9 +62,9 @@ inline constexpr float kWallElevationM = 20000.0f;
 /// machine has available; refused naming region.cell_size before anything is read), the bed
 /// (resampled to region.cell_size, mosaicked), the polygon mask, geodesic cell sizes, the layer
 /// stack (with erosion on, some loose material), the model parameters, and the inflows, levels,
-/// rain and dam breaks placed on cells. `ranks` > 1: the lead rank of a run over that many MPI
-/// ranks builds it (it holds the domain and a share of the solver: the memory check is its).
-Result<ScenarioDomain> buildDomain(const Scenario& scenario, uint64_t memoryBudgetBytes = 0, int ranks = 1);
+/// rain and dam breaks placed on cells. One process's build (over MPI ranks each builds its own
+/// rows: scenario/src/domain_rows.hpp, with the same bits).
+Result<ScenarioDomain> buildDomain(const Scenario& scenario, uint64_t memoryBudgetBytes = 0);
 
 /// Cell sizes of a georeferenced grid as the solvers use them: the geodesic area of each cell,
 /// dy the geodesic length of a column cell, and per-row dx such that dx * dy is the row's cell
