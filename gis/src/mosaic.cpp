@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <vector>
 
 #include "gdal_util.hpp"
 
@@ -278,14 +279,17 @@ Result<Grid<float>> sample(Source& s, const Georef& target, const CellRect& w) {
   Grid<float> out(w.width, w.height, kNoData);
   CPLErr err = CE_Failure;
   {
-    // In strips of about 4 M cells, each with the source window it needs (as ChunkAndWarpImage).
+    // In strips of rows, each with the source window it needs (as ChunkAndWarpImage would): at
+    // most ~4 M cells of the window and ~16 M cells of the source under them (many source cells
+    // to a cell where the target is much coarser; a single row may exceed that).
     GDALWarpOperation op;
     if (op.Initialize(wo) == CE_None) {
-      const int strip = std::max(1, std::min(w.height, (1 << 22) / std::max(1, w.width)));
+      const double perCell = s.xScale > 0 && s.yScale > 0 ? std::max(1.0, 1.0 / (s.xScale * s.yScale)) : 1.0;
+      const double stripCells = std::min(double(1 << 22), double(1 << 24) / perCell);
+      const int strip = int(std::clamp(stripCells / std::max(1, w.width), 1.0, double(w.height)));
       err = CE_None;
       for (int y = 0; y < w.height && err == CE_None; y += strip) {
-        const int rows = std::min(strip, w.height - y);
-        err = op.WarpRegionToBuffer(w.x, w.y + y, w.width, rows, &out.at(0, y), GDT_Float32);
+        err = op.WarpRegionToBuffer(w.x, w.y + y, w.width, std::min(strip, w.height - y), &out.at(0, y), GDT_Float32);
       }
     }
   }
