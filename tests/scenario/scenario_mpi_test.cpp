@@ -19,6 +19,7 @@
 #include <strata/scenario/run.hpp>
 #include <strata/scenario/scenario.hpp>
 
+#include "../../scenario/src/breach.hpp"
 #include "../../scenario/src/distributed.hpp"
 #include "../../scenario/src/domain_rows.hpp"
 #include "mpi_support.hpp"
@@ -246,6 +247,63 @@ TEST(ScenarioMpi, ADomainBuiltByTheRanksRowByRowEqualsOneProcess) {
   MPI_Barrier(MPI_COMM_WORLD);
   EXPECT_FALSE(fs::exists(dir / "ranks"));
   if (worldRank() == 0) fs::remove_all(dir);
+}
+
+// breach_inflows on terrain full of ties (whole-metre elevations 0..3, so many paths are as high
+// and as long, and often as low in sum), on thin ranks (one to three rows each: the flood crosses
+// their borders all the time): every rank's rows of the carved base, and the breach's figures,
+// equal one process's, for 16 terrains and two inflows each.
+TEST(ScenarioMpi, TheRanksBreachAsOneProcessWhereManyPathsTie) {
+  Scenario s;
+  s.terrain.breachInflows = true;
+  s.model.boundaries = {Boundary::Open, Boundary::Closed, Boundary::Closed, Boundary::Closed};  // W E S N
+  int carved = 0;
+  for (uint32_t seed = 1; seed <= 16; ++seed) {
+    const int w = 48, h = int(4 + seed % 9);
+    ScenarioDomain whole;
+    whole.bed.values = gis::Grid<float>(w, h);
+    for (int y = 0; y < h; ++y) {
+      for (int x = 0; x < w; ++x) {
+        uint32_t v = seed * 2654435761u ^ uint32_t(x) * 73856093u ^ uint32_t(y) * 19349663u;
+        v ^= v >> 13, v *= 0x5bd1e995u, v ^= v >> 15;
+        whole.bed.values.at(x, y) = float(v % 4);
+      }
+    }
+    whole.input.baseM = whole.bed.values;
+    whole.inside = gis::Grid<uint8_t>(w, h, 1);
+    whole.cellAreaM2 = gis::Grid<double>(w, h, 100.0);
+    std::vector<sim::Source> sources(2);
+    sources[0].cells = {{w - 1, 0}, {w - 1, h / 2}};
+    sources[1].cells = {{w - 2, h - 1}};
+    const std::vector<std::string> names{"a", "b"};
+    ScenarioDomain one = whole;
+    ASSERT_TRUE(detail::breachInflowPaths(s, detail::Ranks::single(), {0, h}, sources, names, one));
+    carved += one.breach.cells;
+
+    // This rank's rows [h r / n, h (r + 1) / n) (at least 4 rows: one or more per rank).
+    std::vector<int> starts;
+    for (int r = 0; r <= worldSize(); ++r) starts.push_back(int((long long)h * r / worldSize()));
+    const int y0 = starts[size_t(worldRank())], rows = starts[size_t(worldRank()) + 1] - y0;
+    ScenarioDomain mine;
+    mine.firstRow = y0;
+    auto cut = [&](const auto& g) {
+      std::remove_cvref_t<decltype(g)> out(w, rows);
+      std::copy(g.data.begin() + ptrdiff_t(y0) * w, g.data.begin() + ptrdiff_t(y0 + rows) * w, out.data.begin());
+      return out;
+    };
+    mine.bed.values = cut(whole.bed.values);
+    mine.input.baseM = cut(whole.input.baseM);
+    mine.inside = cut(whole.inside);
+    mine.cellAreaM2 = cut(whole.cellAreaM2);
+    ASSERT_TRUE(detail::breachInflowPaths(s, detail::Ranks::world(), starts, sources, names, mine));
+    const auto expected = cut(one.input.baseM);
+    EXPECT_EQ(mine.input.baseM.data, expected.data)
+        << "terrain " << seed << " (" << h << " rows), rank " << worldRank();
+    EXPECT_EQ(mine.breach.cells, one.breach.cells) << "terrain " << seed;
+    EXPECT_EQ(mine.breach.cutM3, one.breach.cutM3) << "terrain " << seed;
+    EXPECT_EQ(mine.breach.fillM3, one.breach.fillM3) << "terrain " << seed;
+  }
+  EXPECT_GT(carved, 40);
 }
 
 // at_rest layers settled by the ranks (settle.hpp) on a finer grid of the canyon, where cells on
