@@ -8,7 +8,6 @@
 //
 // (STRATA_LOG=debug adds the breach's rounds and its time on each build.)
 #include <mpi.h>
-#include <unistd.h>
 
 #include <chrono>
 #include <cstdio>
@@ -20,21 +19,12 @@
 
 #include "../scenario/src/distributed.hpp"
 #include "../scenario/src/domain_rows.hpp"
+#include "sleepy_barrier.hpp"
 
 namespace {
+using strata::bench::sleepyBarrier;
 using namespace strata;
 using Clock = std::chrono::steady_clock;
-
-// A barrier that sleeps instead of spinning: the ranks left out give the core to rank 0.
-void sleepyBarrier() {
-  MPI_Request r;
-  MPI_Ibarrier(MPI_COMM_WORLD, &r);
-  int done = 0;
-  while (!done) {
-    MPI_Test(&r, &done, MPI_STATUS_IGNORE);
-    if (!done) usleep(500);
-  }
-}
 
 double seconds(Clock::time_point from) { return std::chrono::duration<double>(Clock::now() - from).count(); }
 

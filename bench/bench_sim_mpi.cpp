@@ -18,7 +18,6 @@
 // Threads: run with OMP_NUM_THREADS=1 to measure ranks, not threads.
 #include <mpi.h>
 #include <time.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -32,8 +31,10 @@
 #include <strata/sim/distributed_solver.hpp>
 
 #include "canyon_flood.hpp"
+#include "sleepy_barrier.hpp"
 
 namespace {
+using strata::bench::sleepyBarrier;
 using namespace strata;
 using namespace strata::sim;
 
@@ -52,18 +53,6 @@ double cpuSeconds() {
   timespec t{};
   clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
   return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
-}
-
-// A barrier that sleeps instead of spinning: the ranks left out of a one-rank run give the core
-// to rank 0.
-void sleepyBarrier() {
-  MPI_Request r;
-  MPI_Ibarrier(MPI_COMM_WORLD, &r);
-  int done = 0;
-  while (!done) {
-    MPI_Test(&r, &done, MPI_STATUS_IGNORE);
-    if (!done) usleep(500);
-  }
 }
 
 // A flood that keeps every cell wet and moving: 1 m of water over a rolling bed, with a 1 m bump

@@ -109,46 +109,55 @@ void Ranks::max(std::vector<double>& values) const {
   if (distributed_) MPI_Allreduce(MPI_IN_PLACE, values.data(), int(values.size()), MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
 }
 
+namespace {
+
+// Each rank's offset in a gather of `counts` bytes (under 2 GB in all: MPI counts are int).
+std::vector<int> offsetsOf(const std::vector<int>& counts) {
+  std::vector<int> offsets(counts.size());
+  size_t total = 0;
+  for (size_t r = 0; r < counts.size(); ++r) {
+    offsets[r] = int(total);
+    total += size_t(counts[r]);
+  }
+  STRATA_CHECK(total < size_t(INT_MAX)) << "a gather over the ranks exceeds 2 GB";
+  return offsets;
+}
+
+// The gathered bytes back as each rank's part.
+std::vector<std::string> partsOf(const std::string& all, const std::vector<int>& counts,
+                                 const std::vector<int>& offsets) {
+  std::vector<std::string> out;
+  for (size_t r = 0; r < counts.size(); ++r) out.push_back(all.substr(size_t(offsets[r]), size_t(counts[r])));
+  return out;
+}
+
+}  // namespace
+
 std::vector<std::string> Ranks::gatherToLead(const std::string& bytes) const {
   if (!distributed_) return {bytes};
   STRATA_CHECK(bytes.size() < size_t(INT_MAX)) << "a rank's part of a gather exceeds 2 GB";
   int n = int(bytes.size());
-  std::vector<int> counts(static_cast<size_t>(size_)), offsets(static_cast<size_t>(size_));
+  std::vector<int> counts(static_cast<size_t>(size_)), offsets;
   MPI_Gather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, MPI_COMM_WORLD);
   std::string all;
   if (lead()) {
-    size_t total = 0;
-    for (int r = 0; r < size_; ++r) {
-      offsets[size_t(r)] = int(total);
-      total += size_t(counts[size_t(r)]);
-    }
-    STRATA_CHECK(total < size_t(INT_MAX)) << "a gather to rank 0 exceeds 2 GB";
-    all.resize(total);
+    offsets = offsetsOf(counts);
+    all.resize(size_t(offsets.back()) + size_t(counts.back()));
   }
   MPI_Gatherv(bytes.data(), n, MPI_CHAR, all.data(), counts.data(), offsets.data(), MPI_CHAR, 0, MPI_COMM_WORLD);
-  std::vector<std::string> out;
-  if (!lead()) return out;
-  for (int r = 0; r < size_; ++r) out.push_back(all.substr(size_t(offsets[size_t(r)]), size_t(counts[size_t(r)])));
-  return out;
+  return lead() ? partsOf(all, counts, offsets) : std::vector<std::string>{};
 }
 
 std::vector<std::string> Ranks::allGatherBytes(const std::string& bytes) const {
   if (!distributed_) return {bytes};
   STRATA_CHECK(bytes.size() < size_t(INT_MAX)) << "a rank's part of a gather exceeds 2 GB";
   int n = int(bytes.size());
-  std::vector<int> counts(static_cast<size_t>(size_)), offsets(static_cast<size_t>(size_));
+  std::vector<int> counts(static_cast<size_t>(size_));
   MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, MPI_COMM_WORLD);
-  size_t total = 0;
-  for (int r = 0; r < size_; ++r) {
-    offsets[size_t(r)] = int(total);
-    total += size_t(counts[size_t(r)]);
-  }
-  STRATA_CHECK(total < size_t(INT_MAX)) << "a gather over the ranks exceeds 2 GB";
-  std::string all(total, '\0');
+  const std::vector<int> offsets = offsetsOf(counts);
+  std::string all(size_t(offsets.back()) + size_t(counts.back()), '\0');
   MPI_Allgatherv(bytes.data(), n, MPI_CHAR, all.data(), counts.data(), offsets.data(), MPI_CHAR, MPI_COMM_WORLD);
-  std::vector<std::string> out;
-  for (int r = 0; r < size_; ++r) out.push_back(all.substr(size_t(offsets[size_t(r)]), size_t(counts[size_t(r)])));
-  return out;
+  return partsOf(all, counts, offsets);
 }
 
 std::pair<std::string, std::string> Ranks::swapWithNeighbours(const std::string& up, const std::string& down) const {

@@ -565,6 +565,16 @@ Status readBed(const Scenario& s, const Plan& plan, int y0, int y1, ScenarioDoma
   const gis::Georef& grid = plan.grid;
   const bool resample = s.region.cellSizeM > 0, mosaic = s.terrain.dems.size() > 1;
   d.firstRow = y0;
+  // The lowest-elevation rule where the grid is coarser than the source, else bilinear.
+  const auto kernel = std::min(frame.scaleX, frame.scaleY) < 1 ? gis::Resampling::Minimum : gis::Resampling::Bilinear;
+  // Rows [y0, y1) of the region's grid warped from `inputs`.
+  auto warpRows = [&](std::vector<gis::MosaicInput> inputs) -> Result<gis::Raster> {
+    STRATA_TRY(auto reader, gis::MosaicReader::open(std::move(inputs), grid));
+    gis::Raster out;
+    out.georef = rowsGeoref(grid, y0, y1);
+    STRATA_TRY(out.values, reader.read({0, y0, grid.width, y1 - y0}));
+    return out;
+  };
   if (!resample) {
     const gis::CellRect native{frame.window.x, frame.window.y + y0, frame.window.width, y1 - y0};
     STRATA_TRY(d.bed, source.readBed(native));
@@ -578,23 +588,16 @@ Status readBed(const Scenario& s, const Plan& plan, int y0, int y1, ScenarioDoma
     const gis::CellRect native{frame.window.x, n0, frame.window.width, n1 - n0};
     STRATA_TRY(auto bed, source.readBed(native));
     STRATA_TRY(storeLayers, source.readLayers(native));
-    auto warpRows = [&](gis::MosaicInput in) -> Result<gis::Raster> {
-      STRATA_TRY(auto reader, gis::MosaicReader::open({std::move(in)}, grid));
-      gis::Raster out;
-      out.georef = rowsGeoref(grid, y0, y1);
-      STRATA_TRY(out.values, reader.read({0, y0, grid.width, y1 - y0}));
-      return out;
-    };
     // Each warped as the region's whole window of the store is (MosaicInput::within).
     auto windowOfRegion = [&](gis::Raster cells) {
       return source.storeWindowInput(std::move(cells), frame.window, 0, n0 - top);
     };
     gis::MosaicInput in = windowOfRegion(std::move(bed));
-    in.resampling = std::min(frame.scaleX, frame.scaleY) < 1 ? gis::Resampling::Minimum : gis::Resampling::Bilinear;
-    STRATA_TRY(d.bed, warpRows(std::move(in)));
+    in.resampling = kernel;
+    STRATA_TRY(d.bed, warpRows({std::move(in)}));
     // Stored layer thicknesses are averaged (bilinear): their volume is what matters, not a channel.
     for (auto& layer : storeLayers) {
-      STRATA_TRY(layer.thickness, warpRows(windowOfRegion(std::move(layer.thickness))));
+      STRATA_TRY(layer.thickness, warpRows({windowOfRegion(std::move(layer.thickness))}));
     }
     return {};
   }
@@ -609,18 +612,12 @@ Status readBed(const Scenario& s, const Plan& plan, int y0, int y1, ScenarioDoma
     }
   } else {
     gis::MosaicInput in = source.resampleInput();
-    in.resampling = std::min(frame.scaleX, frame.scaleY) < 1 ? gis::Resampling::Minimum : gis::Resampling::Bilinear;
+    in.resampling = kernel;
     inputs.push_back(std::move(in));
   }
-  STRATA_TRY(auto reader, gis::MosaicReader::open(std::move(inputs), grid));
-  d.bed.georef = rowsGeoref(grid, y0, y1);
-  STRATA_TRY(d.bed.values, reader.read({0, y0, grid.width, y1 - y0}));
+  STRATA_TRY(d.bed, warpRows(std::move(inputs)));
   return {};
 }
-
-// Fills the voids of rows [y0, y1) as the whole region's fill fills them there (every mode but
-// "refuse"): from the rows gis::voidFillRows names, read with a margin that doubles until it
-// holds them.
 Status fillVoidsOfRows(const Scenario& s, const Plan& plan, int y0, int y1, ScenarioDomain& d) {
   if (s.terrain.voids == decltype(s.terrain)::Voids::kRefuse || d.voidCells == 0) return {};
   const int w = plan.grid.width, h = plan.grid.height;
