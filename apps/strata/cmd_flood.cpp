@@ -22,6 +22,11 @@ struct FloodArgs {
 
 void addRunCommand(CLI::App& app, const char* name, const char* help, bool erosion) {
   auto* cmd = app.add_subcommand(name, help);
+  cmd->footer(
+      "[model] kind = \"flood\" (the default) is the finite-volume shallow-water model with Manning friction "
+      "whose answers converge with the step and the cell size. kind = \"pipe\" is the virtual-pipe model of "
+      "interactive terrain authoring: it has no friction, and its depths and speeds depend on the pipe area and the "
+      "time step; they are not physical (docs/sim-water.md).");
   auto args = std::make_shared<FloodArgs>();
   cmd->add_option("scenario", args->scenario, "Scenario file (TOML, see docs/scenario.md)")->required();
   cmd->add_option("-o,--out", args->outDir, "Run folder (default: runs/<scenario name>)");

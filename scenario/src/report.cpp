@@ -138,8 +138,11 @@ Status writeReport(const fs::path& runDir, const ReportInput& in) {
         ", " + fmt("%.0f", d.totalAreaM2 / 1e6) + " km², elevations " + fmt("%.0f", lo) + " to " + fmt("%.0f", hi) +
         " m |\n";
   md += std::string("| model | ") +
-        (s.model.kind == sim::WaterModel::kFiniteVolume ? "flood mode (finite-volume shallow water, Manning friction)"
-                                                        : "virtual pipes") +
+        (s.model.kind == sim::WaterModel::kFiniteVolume
+             ? "flood mode (finite-volume shallow water, Manning friction)"
+             : "virtual pipes: an interactive authoring model without friction, whose depths and speeds depend on "
+               "the pipe area and the time step and are not physical (kind = \"flood\" for analysis, "
+               "docs/sim-water.md)") +
         ", Manning n = " + fmt("%.3f", s.model.manningN) + " s/m^(1/3), CFL " + fmt("%.2f", s.model.cfl) +
         (s.model.kind == sim::WaterModel::kFiniteVolume ? (s.model.sharpSlopes ? ", MC slopes" : ", minmod slopes")
                                                         : "") +

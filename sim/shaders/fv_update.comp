@@ -83,15 +83,16 @@ void main() {
     huNew = 0.0;
     hvNew = 0.0;
   }
+  // W19: Manning friction, implicit, in both stages.
+  if (hNew > dry && n2 > 0.0) {
+    const float speed = sqrt(huNew * huNew + hvNew * hvNew) / hNew;
+    const float c = 0.5 + 0.5 * sqrt(1.0 + 4.0 * (dt * g * n2 * speed / pow(hNew, 4.0 / 3.0)));
+    huNew /= c;
+    hvNew /= c;
+  }
   if (final_ == 0) {
     stage[i] = vec4(hNew, s, huNew, hvNew);
     return;
-  }
-  if (hNew > dry && n2 > 0.0) {
-    const float speed = sqrt(huNew * huNew + hvNew * hvNew) / hNew;
-    const float c = 1.0 + dt * g * n2 * speed / pow(hNew, 4.0 / 3.0);
-    huNew /= c;
-    hvNew /= c;
   }
   // E5: suspended sediment moves with the water volume crossing each face, upwind.
   const float denI = max(h * A, outflowTotal(p) * dt);

@@ -22,13 +22,25 @@ Side primOf(int which, ivec2 c, int dir) {
   return dir < 2 ? Side(s.x, bed[i] + s.x, u, v) : Side(s.x, bed[i] + s.x, v, u);
 }
 
-// W21: cell c's value at its face dir (W, E, N, S): limited slopes along the face normal.
+// W21: cell c's value at its face dir (W, E, N, S): limited slopes along the face normal. A cell
+// on the grid's edge along the normal has one neighbour: W27, at an open edge its depth and
+// surface continue the slope from that neighbour (the depth's bounded so that neither face goes
+// below zero); anything else is first order there.
 Side faceSide(int which, ivec2 c, int dir) {
   Side m0 = primOf(which, c, dir);
   const ivec2 a = dir < 2 ? ivec2(1, 0) : ivec2(0, 1);
-  if (!insideGrid(c - a) || !insideGrid(c + a)) return m0;
-  const Side m = primOf(which, c - a, dir), pp = primOf(which, c + a, dir);
+  const bool lo = !insideGrid(c - a), hi = !insideGrid(c + a);
   const float half_ = (dir == 1 || dir == 3) ? 0.5 : -0.5;
+  if (lo || hi) {
+    const uint openLow = dir < 2 ? 1u : 4u, openHigh = dir < 2 ? 2u : 8u;  // W, E / N, S bits
+    if (lo == hi || (P.openEdges & (lo ? openLow : openHigh)) == 0u) return m0;
+    const Side n = primOf(which, lo ? c + a : c - a, dir);
+    const float sh = lo ? n.h - m0.h : m0.h - n.h, se = lo ? n.eta - m0.eta : m0.eta - n.eta;
+    m0.h += half_ * clamp(sh, -2.0 * m0.h, 2.0 * m0.h);
+    m0.eta += half_ * se;
+    return m0;
+  }
+  const Side m = primOf(which, c - a, dir), pp = primOf(which, c + a, dir);
   m0.h += half_ * limitedSlope(m0.h - m.h, pp.h - m0.h);
   m0.eta += half_ * limitedSlope(m0.eta - m.eta, pp.eta - m0.eta);
   m0.un += half_ * limitedSlope(m0.un - m.un, pp.un - m0.un);

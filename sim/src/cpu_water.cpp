@@ -367,18 +367,29 @@ STRATA_ROW_KERNEL void primitivesRow(const float* h, const float* hu, const floa
 
 // W21 for a row of one primitive: from the cell's value c and its neighbours' m (before) and p
 // (after) along the face normal, the value at the far face (+ half a limited slope) and at the
-// near face (- half); with no neighbour on one side (an edge row, or columns 0 and w - 1 when
-// `edgeColumns`) both are the cell's own value.
+// near face (- half). A cell on the grid's edge along the normal (an edge row, `lowRow` /
+// `highRow`, or columns 0 and w - 1 when `columns`) has one neighbour: W27, at an open edge its
+// depth and surface continue the slope from that neighbour (`extrapolate`; the depth's slope
+// bounded so that neither face goes below zero), anything else is first order (the cell's own
+// value at both faces).
+enum class EdgeSlope { kNone, kSurface, kDepth };
 STRATA_ROW_KERNEL void reconstructRow(const float* c, const float* m, const float* pv, float* plus, float* minus,
-                                      int x0, int x1, bool edgeRow, bool edgeColumns, int w, bool mc) {
+                                      int x0, int x1, bool lowRow, bool highRow, bool columns, bool openLow,
+                                      bool openHigh, EdgeSlope extrapolate, int w, bool mc) {
   auto cells = [=](auto kMC) {
 #pragma omp simd
     for (int x = x0; x < x1; ++x) {
       const float cx = c[x];
-      const float sl = limitedSlope<decltype(kMC)::value>(cx - m[x], pv[x] - cx);
-      const bool edge = edgeRow | (edgeColumns & ((x == 0) | (x == w - 1)));
-      plus[x] = edge ? cx : cx + 0.5f * sl;
-      minus[x] = edge ? cx : cx + -0.5f * sl;
+      const float back = cx - m[x], fwd = pv[x] - cx;
+      const float sl = limitedSlope<decltype(kMC)::value>(back, fwd);
+      const bool lo = lowRow | (columns & (x == 0)), hi = highRow | (columns & (x == w - 1));
+      const float one = lo ? fwd : back;  // the one-sided slope towards the inside
+      const float bounded = minOf(maxOf(one, -2.0f * cx), 2.0f * cx);
+      const float ex = extrapolate == EdgeSlope::kDepth ? bounded : one;
+      const bool open = (lo != hi) & (lo ? openLow : openHigh) & (extrapolate != EdgeSlope::kNone);
+      const float slope = (lo | hi) ? (open ? ex : 0.0f) : sl;
+      plus[x] = cx + 0.5f * slope;
+      minus[x] = cx + -0.5f * slope;
     }
   };
   mc ? cells(std::true_type{}) : cells(std::false_type{});
@@ -432,20 +443,23 @@ void Impl::fvFacePass(const Water& u, bool average) {
       primitivesRow(u.h.row(y), u.hu.row(y), u.hv.row(y), bed.row(y), primRow(sc, y, 0), primRow(sc, y, 1),
                     primRow(sc, y, 2), primRow(sc, y, 3), pa, pb, dry);
     };
+    // Primitives h, eta, v, u (y sides) or h, eta, u, v (x sides): W27 extrapolates h and eta.
+    const EdgeSlope kinds[4] = {EdgeSlope::kDepth, EdgeSlope::kSurface, EdgeSlope::kNone, EdgeSlope::kNone};
     auto ySides = [&](int y) {  // south and north sides of row y's cells (un = v, ut = u)
-      const bool edge = y == 0 || y == h - 1;
-      const int ym = edge ? y : y - 1, yp = edge ? y : y + 1;
+      const int ym = y > 0 ? y - 1 : y, yp = y + 1 < h ? y + 1 : y;
       const int comp[4] = {0, 1, 3, 2};  // h, eta, v, u
       for (int k = 0; k < 4; ++k) {
         reconstructRow(primRow(sc, y, comp[k]), primRow(sc, ym, comp[k]), primRow(sc, yp, comp[k]), ySideRow(sc, y, k),
-                       ySideRow(sc, y, 4 + k), r.x0, r.x1, edge, false, w, mc);
+                       ySideRow(sc, y, 4 + k), r.x0, r.x1, y == 0, y == h - 1, false, open & kEdgeNorth,
+                       open & kEdgeSouth, kinds[k], w, mc);
       }
     };
     auto xSides = [&](int y) {  // east and west sides of row y's cells (un = u, ut = v)
       const int xb = std::min(r.x1 + 1, w);
       for (int k = 0; k < 4; ++k) {
         const float* c = primRow(sc, y, k);
-        reconstructRow(c, c - 1, c + 1, xSideRow(sc, k), xSideRow(sc, 4 + k), r.x0, xb, false, true, w, mc);
+        reconstructRow(c, c - 1, c + 1, xSideRow(sc, k), xSideRow(sc, 4 + k), r.x0, xb, false, false, true,
+                       open & kEdgeWest, open & kEdgeEast, kinds[k], w, mc);
       }
     };
     if (r.y0 > 0) prims(r.y0 - 1);
@@ -672,7 +686,7 @@ STRATA_ROW_KERNEL void frictionRow(const float* h, float* hu, float* hv, float* 
   for (int x = x0; x < x1; ++x) power[x] = h[x] > dry ? std::pow(h[x], 4.0f / 3.0f) : 1.0f;
 #pragma omp simd
   for (int x = x0; x < x1; ++x) {
-    const float cf = 1.0f + dtgnSpeed[x] / power[x];
+    const float cf = 0.5f + 0.5f * std::sqrt(1.0f + 4.0f * (dtgnSpeed[x] / power[x]));
     const bool wet = h[x] > dry;
     hu[x] = wet ? hu[x] / cf : hu[x];
     hv[x] = wet ? hv[x] / cf : hv[x];
@@ -739,11 +753,11 @@ void Impl::fvUpdatePass(bool final) {
       };
       forEdgesAndInterior(run.x0, run.x1, w, y == 0 || y == h - 1, edgeCell,
                           [&](int xa, int xb) { fvUpdateRow(c, r, xa, xb, final, sed); });
-      if (!final) continue;
       if (n2 > 0.0f) {
         Plane& sc = scratch[size_t(thread)];
         frictionRow(r.oh, r.ohu, r.ohv, sc.row(0), sc.row(1), run.x0, run.x1, dt * p.gravityMS2, n2, p.dryDepthM);
       }
+      if (!final) continue;
       if (p.erosionEnabled) tiltRows(y, run.x0, run.x1);
     }
   });

@@ -58,6 +58,30 @@ TEST(ScenarioRun, FloodRunsOnTheCpuWithoutGl) {
   EXPECT_NE(slurp(opt.outDir / "report.md").find("on CPU"), std::string::npos);
 }
 
+// Issue 30: the pipe model does not converge (no friction); its report says that its depths are
+// not physical, the flood mode's does not.
+TEST(ScenarioRun, PipeRunsSayTheirDepthsAreNotPhysical) {
+  const auto dir = strata::test::tempDir("pipe-run");
+  std::string text = scenarioText();
+  auto swap = [&](const std::string& from, const std::string& to) { text.replace(text.find(from), from.size(), to); };
+  swap("kind = \"flood\"", "kind = \"pipe\"");
+  swap("duration = \"20 min\"", "duration = \"5 min\"");
+  const auto file = dir / "pipe.toml";
+  std::ofstream(file) << text;
+  auto scenario = loadScenario(file);
+  ASSERT_TRUE(scenario) << scenario.message();
+  RunOptions opt;
+  opt.outDir = dir / "run";
+  opt.backend = Backend::kCpu;
+  opt.pictures = false;
+  opt.plots = false;
+  auto summary = runScenario(*scenario, opt);
+  ASSERT_TRUE(summary) << summary.message();
+  const std::string report = slurp(opt.outDir / "report.md");
+  EXPECT_NE(report.find("virtual pipes: an interactive authoring model"), std::string::npos) << report;
+  EXPECT_NE(report.find("not physical"), std::string::npos);
+}
+
 // An erosion run writes what an erosion user needs (issue 16): net cut and fill, each layer's
 // final thickness, the exposed material and the load at the end as GeoTIFFs, and a per-material
 // table and the material balance in the report, which closes (E9) and agrees with the maps.
