@@ -47,9 +47,11 @@ namespace ts = strata::sim;
 //  - pipe_update (W3, W4): h, s, 4 outflows in, the state out: 40 B; 30 flops (+ 75 flops of
 //    sediment fractions when erosion is on).
 //  - with erosion: tilt (E0) 8 B, 10 flops; erode (E1-E4, E6) h, s, hu, hv, tilt, 4 layers, base
-//    in, s, 4 layers, bed out: 64 B, 42 flops; thermal_flux (E7, E8) h, bed, 4 layers in, 4
-//    outflows out: 40 B, 45 flops (thermal_apply runs only where material moves: nowhere on this
-//    gentle terrain).
+//    in, s, 4 layers, bed, scour out: 68 B; the force-based law 48 flops, the shear-stress law 62
+//    (its cube root and exponential each counted as 10); thermal_flux (E7, E8) bed, scour, 4
+//    layers in, 4 outflows out: 40 B; per direction 8 flops of E7 and 22 of E8 (a square root,
+//    two divisions, Culmann's test): 120 flops (thermal_apply runs only where material moves:
+//    nowhere on this gentle terrain).
 //  - flood mode: sources 24 B / 8; each face pass (W13-W17, W21, W23): h, hu, hv, bed in (19 B
 //    with the 3 extra rows of each 16-row run), 2 faces x 4 fluxes and the 2 bed-source terms out
 //    (40 B), the corrector's also reading the old ones (40 B): 59 B / 236 flops and 99 B / 246
@@ -61,8 +63,12 @@ struct Work {
   double bytes, flops;
 };
 constexpr Work kPipes{24 + 40 + 40, 8 + 68 + 30};
-constexpr Work kErosion{kPipes.bytes + 8 + 64 + 40, kPipes.flops + 75 + 10 + 42 + 45};
+constexpr Work kErosion{kPipes.bytes + 8 + 68 + 40, kPipes.flops + 75 + 10 + 48 + 120};
 constexpr Work kFlood{24 + 59 + 72 + 99 + 16 + 76 + 12, 8 + 236 + 56 + 246 + 15 + 76 + 10};
+// Flood mode with sediment (E5's denominators and transport: 12 B, 40 flops) and the erosion
+// passes above, by law.
+constexpr Work kFloodForceBased{kFlood.bytes + 12 + 8 + 68 + 40, kFlood.flops + 40 + 10 + 48 + 120};
+constexpr Work kFloodShear{kFlood.bytes + 12 + 8 + 68 + 40, kFlood.flops + 40 + 10 + 62 + 120};
 
 // ---------------------------------------------------------------------------------------------
 // The machine's floors (measured once, before the benchmarks)
@@ -169,6 +175,7 @@ ts::SimParams erosion() {
   ts::SimParams p = pipes();
   p.erosionEnabled = true;
   p.thermalEnabled = true;
+  p.erosionLaw = ts::ErosionLaw::kForceBased;  // the pipes have no Manning n for a shear stress
   p.capacityK = 0.05f;
   p.erosionRate = 0.5f;
   p.depositionRate = 0.3f;
@@ -180,6 +187,18 @@ ts::SimParams flood() {
   p.maxDtS = 5.0f;
   p.cflAlpha = 0.45f;
   p.manningN = 0.03f;
+  return p;
+}
+// Flood mode with erosion, weathering and bank failure on four layers, by law (issue 30: the
+// shear-stress law's cost beside the force-based one's).
+ts::SimParams floodErosion(ts::ErosionLaw law) {
+  ts::SimParams p = flood();
+  p.erosionEnabled = true;
+  p.thermalEnabled = true;
+  p.erosionLaw = law;
+  p.capacityK = 0.05f;
+  p.erosionRate = 0.5f;
+  p.depositionRate = 0.3f;
   return p;
 }
 
@@ -266,7 +285,11 @@ void registerAll() {
     Work work;
   };
   const Model models[] = {
-      {"pipes", pipes(), kPipes}, {"pipes_erosion_thermal_4layers", erosion(), kErosion}, {"flood", flood(), kFlood}};
+      {"pipes", pipes(), kPipes},
+      {"pipes_erosion_thermal_4layers", erosion(), kErosion},
+      {"flood", flood(), kFlood},
+      {"flood_erosion_forcebased_4layers", floodErosion(ts::ErosionLaw::kForceBased), kFloodForceBased},
+      {"flood_erosion_shear_4layers", floodErosion(ts::ErosionLaw::kShearStress), kFloodShear}};
   struct Variant {
     const char* name;
     int threads;

@@ -487,6 +487,29 @@ Result<std::vector<Material>> layerMaterials(const Scenario& s, const TerrainSou
     }
     out.push_back(table[size_t(m)]);
   }
+  // [materials.NAME]: the run's changes to a material's constants.
+  for (const auto& c : s.materials) {
+    if (findMaterial(table, c.name) < 0) {
+      std::string names;
+      for (const auto& mat : table) names += (names.empty() ? "" : ", ") + mat.name;
+      return fail(s.at("materials." + c.name) + "unknown material \"" + oneLine(c.name) + "\" (" + names + ")");
+    }
+    for (auto& m : out) {
+      if (m.name != c.name) continue;
+      auto set = [](float& field, const std::optional<double>& v) {
+        if (v) field = float(*v);
+      };
+      set(m.criticalShearPa, c.criticalShearPa);
+      set(m.shearErodibility, c.shearErodibility);
+      set(m.settlingVelocityMS, c.settlingVelocityMS);
+      set(m.frictionAngleDeg, c.frictionAngleDeg);
+      set(m.cohesionPa, c.cohesionPa);
+      set(m.talusAngleDeg, c.talusAngleDeg);
+      set(m.weatheringRatePerS, c.weatheringRatePerS);
+      set(m.dissolutionRate, c.dissolutionRate);
+      set(m.erodibility, c.erodibility);
+    }
+  }
   return out;
 }
 
@@ -1072,6 +1095,7 @@ sim::SimParams modelParams(const Scenario& s) {
   if (s.erosion.enabled) {
     p.erosionEnabled = true;
     p.thermalEnabled = s.erosion.thermal;
+    p.erosionLaw = s.erosion.law;
     p.capacityK = float(s.erosion.capacity);
     p.erosionRate = float(s.erosion.erosionRate);
     p.depositionRate = float(s.erosion.depositionRate);

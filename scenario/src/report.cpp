@@ -97,6 +97,43 @@ std::string materialSection(const MaterialBudget& b) {
   return md;
 }
 
+// The erosion model that ran and its constants (issue 30: the report names the law).
+std::string erosionModelSection(const Scenario& s, const ScenarioDomain& d) {
+  std::string md = "## Erosion model\n\n";
+  if (s.erosion.law == sim::ErosionLaw::kShearStress) {
+    md +=
+        "Shear-stress law (docs/sim-erosion.md, E1-E3): the flow entrains the topmost layer at "
+        "E = k_d (τ − τ_c) where the bed shear stress τ = ρ g n² |u|² / h^(1/3) exceeds the material's "
+        "critical shear stress (Partheniades 1965; k_d and τ_c after Hanson and Simon 2001), and the load settles "
+        "at D = w_s c with the settling velocity of the deposit layer's material (Hairsine and Rose 1992); "
+        "Manning n = " +
+        fmt("%.3f", s.model.manningN) + ". ";
+  } else {
+    md +=
+        "Force-based capacity law of the seed systems (docs/sim-erosion.md, E1-E3; Stava et al. 2008): capacity "
+        "C = Kc sin(tilt) |v| (1 − h / 1 m), Kc = " +
+        fmt("%.3g", s.erosion.capacity) + " s, pick-up Ks = " + fmt("%.3g", s.erosion.erosionRate) +
+        " /s, settling Kd = " + fmt("%.3g", s.erosion.depositionRate) +
+        " /s: model constants for authoring terrain, not calibrated in physical units. ";
+  }
+  md += s.erosion.thermal ? "Dry slopes weather down to each material's talus angle at its weathering rate (E7); "
+                            "banks fall into what the flow scours at their toe, at their friction angle and "
+                            "cohesion, no more than the scour (E8).\n\n"
+                          : "Weathering and bank failure are off ([erosion] thermal = false).\n\n";
+  md +=
+      "| layer | material | τ_c (Pa) | k_d (m/(s Pa)) | w_s (m/s) | friction angle | cohesion (Pa) | talus angle | "
+      "weathering (1/s) | dissolution (1/s) |\n|---|---|---|---|---|---|---|---|---|---|\n";
+  for (size_t l = 0; l < d.input.materials.size(); ++l) {
+    const auto& m = d.input.materials[l];
+    md += "| " + std::to_string(l + 1) + " | " + m.name + " | " + fmt("%.3g", m.criticalShearPa) + " | " +
+          fmt("%.3g", m.shearErodibility) + " | " + fmt("%.3g", m.settlingVelocityMS) + " | " +
+          fmt("%.0f°", m.frictionAngleDeg) + " | " + fmt("%.3g", m.cohesionPa) + " | " + fmt("%.0f°", m.talusAngleDeg) +
+          " | " + fmt("%.3g", m.weatheringRatePerS) + " | " + fmt("%.3g", m.dissolutionRate) + " |\n";
+  }
+  md += "\nThe top layer receives every deposit; the suspended load settles at its material's w_s.\n\n";
+  return md;
+}
+
 Status writeReport(const fs::path& runDir, const ReportInput& in) {
   const auto& s = in.scenario;
   const auto& d = in.domain;
@@ -260,6 +297,7 @@ Status writeReport(const fs::path& runDir, const ReportInput& in) {
     md += "\n";
   }
 
+  if (s.erosion.enabled) md += erosionModelSection(s, d);
   if (sum.material) md += materialSection(*sum.material);
 
   // --- Maps and plots

@@ -43,6 +43,11 @@ constexpr Unit kUnits[] = {
     {"m^3/s", "discharge", 1.0},
     {"m/s", "speed", 1.0},
     {"km/h", "speed", 1.0 / 3.6},
+    {"cm/s", "speed", 1e-2},
+    {"mm/s", "speed", 1e-3},
+    {"Pa", "stress", 1.0},
+    {"kPa", "stress", 1e3},
+    {"MPa", "stress", 1e6},
 };
 
 std::string unitsOf(std::string_view dimension) {
@@ -282,6 +287,12 @@ constexpr Range kRate{0, 10.0 / 3600, false, "10 m/h"};  // rain, evaporation
 constexpr Range kManning{0, 1, false, "1"};
 constexpr Range kMaxStep{0, 86400, true, "1 d"};
 constexpr Range kErosionConstant{0, 100, false, "100"};
+constexpr Range kStress{0, 1e7, false, "10 MPa"};  // critical shear stress
+constexpr Range kCohesion{0, 1e9, false, "1000 MPa"};
+constexpr Range kShearErodibility{0, 1e-2, false, "0.01 m/(s Pa)"};
+constexpr Range kSettling{0, 10, false, "10 m/s"};
+constexpr Range kAngle{0, 89.9, true, "89.9 degrees"};
+constexpr Range kPerSecond{0, 1e3, false, "1000 per second"};
 constexpr Range kDuration{0, 3650 * 86400.0, true, "3650 d"};
 constexpr Range kSpinUp{0, 365 * 86400.0, false, "365 d"};
 constexpr Range kSpinUpTolerance{0, 0.5, true, "0.5"};
@@ -499,21 +510,89 @@ Status readErosion(const Reader& r, const toml::table& root, Scenario& s) {
   const auto* t = root["erosion"].as_table();
   if (!t) return {};
   STRATA_TRY_STATUS(r.onlyKeys(
-      *t, "erosion", {"enabled", "capacity", "erosion_rate", "deposition_rate", "dissolution_rate", "thermal"}));
+      *t, "erosion", {"enabled", "law", "capacity", "erosion_rate", "deposition_rate", "dissolution_rate", "thermal"}));
   if (const auto* e = t->get("enabled")) {
     STRATA_TRY(s.erosion.enabled, r.boolean(*e, "erosion.enabled"));
   }
   if (const auto* e = t->get("thermal")) {
     STRATA_TRY(s.erosion.thermal, r.boolean(*e, "erosion.thermal"));
   }
+  if (const auto* e = t->get("law")) {
+    STRATA_TRY(auto law, r.string(*e, "erosion.law"));
+    if (law == "shear") {
+      s.erosion.law = sim::ErosionLaw::kShearStress;
+    } else if (law == "force-based") {
+      s.erosion.law = sim::ErosionLaw::kForceBased;
+    } else {
+      return r.error(*e, "erosion.law", "\"" + oneLine(law) + "\" is not \"shear\" or \"force-based\"");
+    }
+  }
+  // Dissolution is a material's constant (E4), as every rate of the shear-stress law is.
+  if (const auto* e = t->get("dissolution_rate")) {
+    return r.error(*e, "erosion.dissolution_rate",
+                   "dissolution is a material's constant: set dissolution_rate in [materials.NAME] "
+                   "(docs/scenario.md)");
+  }
   const std::pair<const char*, double*> numbers[] = {{"capacity", &s.erosion.capacity},
                                                      {"erosion_rate", &s.erosion.erosionRate},
-                                                     {"deposition_rate", &s.erosion.depositionRate},
-                                                     {"dissolution_rate", &s.erosion.dissolutionRate}};
+                                                     {"deposition_rate", &s.erosion.depositionRate}};
   for (const auto& [name, out] : numbers) {
     if (const auto* n = t->get(name)) {
-      STRATA_TRY(*out, r.number(*n, std::string("erosion.") + name, kErosionConstant));
+      const std::string key = std::string("erosion.") + name;
+      if (s.erosion.law != sim::ErosionLaw::kForceBased) {
+        return r.error(*n, key,
+                       "belongs to law = \"force-based\"; the shear-stress law takes its constants from the "
+                       "materials ([materials.NAME], docs/scenario.md)");
+      }
+      STRATA_TRY(*out, r.number(*n, key, kErosionConstant));
     }
+  }
+  return {};
+}
+
+// [materials.NAME]: a material's constants changed for this run.
+Status readMaterials(const Reader& r, const toml::table& root, Scenario& s) {
+  const auto* node = root.get("materials");
+  if (!node) return {};
+  const auto* t = node->as_table();
+  if (!t) return r.error(*node, "materials", "expected tables [materials.NAME]");
+  for (auto&& [name, v] : *t) {
+    const std::string key = "materials." + std::string(name.str());
+    const auto* mt = v.as_table();
+    if (!mt) return r.error(v, key, "expected a table of the material's constants");
+    STRATA_TRY_STATUS(r.onlyKeys(*mt, key,
+                                 {"critical_shear", "shear_erodibility", "settling_velocity", "friction_angle",
+                                  "cohesion", "talus_angle", "weathering_rate", "dissolution_rate", "erodibility"}));
+    Scenario::MaterialChange c;
+    c.name = std::string(name.str());
+    struct Field {
+      const char* key;
+      std::optional<double> Scenario::MaterialChange::*out;
+      const char* dimension;  // nullptr: a bare number
+      Range range;
+    };
+    const Field fields[] = {
+        {"critical_shear", &Scenario::MaterialChange::criticalShearPa, "stress", kStress},
+        {"shear_erodibility", &Scenario::MaterialChange::shearErodibility, nullptr, kShearErodibility},
+        {"settling_velocity", &Scenario::MaterialChange::settlingVelocityMS, "speed", kSettling},
+        {"friction_angle", &Scenario::MaterialChange::frictionAngleDeg, nullptr, kAngle},
+        {"cohesion", &Scenario::MaterialChange::cohesionPa, "stress", kCohesion},
+        {"talus_angle", &Scenario::MaterialChange::talusAngleDeg, nullptr, kAngle},
+        {"weathering_rate", &Scenario::MaterialChange::weatheringRatePerS, nullptr, kPerSecond},
+        {"dissolution_rate", &Scenario::MaterialChange::dissolutionRate, nullptr, kPerSecond},
+        {"erodibility", &Scenario::MaterialChange::erodibility, nullptr, kErosionConstant},
+    };
+    for (const auto& f : fields) {
+      const auto* n = mt->get(f.key);
+      if (!n) continue;
+      const std::string k = key + "." + f.key;
+      if (f.dimension) {
+        STRATA_TRY(c.*f.out, r.quantity(*n, k, f.dimension, f.range));
+      } else {
+        STRATA_TRY(c.*f.out, r.number(*n, k, f.range));
+      }
+    }
+    s.materials.push_back(std::move(c));
   }
   return {};
 }
@@ -777,7 +856,8 @@ Result<Scenario> parseScenario(std::string_view text, const std::filesystem::pat
     return fail(r.file + ":" + std::to_string(e.source().begin.line) + ": " + oneLine(e.description()));
   }
   STRATA_TRY_STATUS(r.onlyKeys(
-      root, "", {"name", "description", "terrain", "region", "model", "erosion", "water", "time", "outputs"}));
+      root, "",
+      {"name", "description", "terrain", "region", "model", "erosion", "materials", "water", "time", "outputs"}));
   s.file = fileName;
   if (const auto* n = root.get("name")) {
     STRATA_TRY(s.name, r.string(*n, "name"));
@@ -790,6 +870,7 @@ Result<Scenario> parseScenario(std::string_view text, const std::filesystem::pat
   STRATA_TRY_STATUS(readRegion(r, root, s));
   STRATA_TRY_STATUS(readModel(r, root, s));
   STRATA_TRY_STATUS(readErosion(r, root, s));
+  STRATA_TRY_STATUS(readMaterials(r, root, s));
   STRATA_TRY_STATUS(readTime(r, root, s));  // before [water]: rain must start within the run
   STRATA_TRY_STATUS(readWater(r, root, s));
   STRATA_TRY_STATUS(readOutputs(r, root, s));

@@ -28,14 +28,14 @@ struct SimParams {
   float deepWaterM;
   float minSinTilt;
   float slowWaterMS;
-  float thermalRate;
-  float wetTalusScale;
-  float maxErosionPerStepM;
+  int erosionLaw;  // ErosionLaw: 0 shear stress, 1 force-based (E1-E3)
+  float waterDensityKgM3;
+  float bankFillShare;
   int slopeLimiter;  // SlopeLimiter: 0 minmod, 1 MC (W21)
-  float bankDepthM;
-  float bankSlipRatePerS;
   float pad0;
   float pad1;
+  float pad2;
+  float pad3;
 };
 
 // The work-group shape of the grid kernels (the sources, pipe, erosion, thermal and flood passes).
@@ -47,6 +47,14 @@ struct SimMaterial {
   float dissolutionRate;
   float tanTalus;
   float weatheringRatePerS;
+  float criticalShearPa;
+  float shearErodibility;
+  float settlingVelocityMS;
+  float tanFriction;
+  float sinFriction;
+  float cosFriction;
+  float cohesionHeightM;
+  float pad0;
 };
 
 struct SourceEntry {

@@ -1,9 +1,9 @@
 // The CPU backend's erosion passes (docs/sim-erosion.md): erosion, deposition and dissolution
-// (E1-E4, E6), then thermal weathering (E7, E8) as two passes, the flux a cell sheds to each
-// neighbour and what it receives. One function per pass; each cell's arithmetic is the matching
-// kernel's under sim/shaders/, written with selects instead of branches so a row's cells run as
-// vectors (for up to kVectorLayers layers, a compile-time count; more layers take the same code
-// with the count at run time).
+// (E1-E4, E6), then thermal weathering and bank failure (E7, E8) as two passes, the flux a cell
+// sheds to each neighbour and what it receives. One function per pass; each cell's arithmetic is
+// the matching kernel's under sim/shaders/, written with selects instead of branches so a row's
+// cells run as vectors (for up to kVectorLayers layers, a compile-time count; more layers take
+// the same code with the count at run time).
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -22,22 +22,25 @@ struct Stack {
 };
 
 struct ErosionConst {
-  float dt, dry, deepWater, capacityK, minSinTilt, erosionRate, depositionRate, slowWater, maxPerStep;
-  const float *erodibility, *dissolutionRate;  // per layer
+  float dt, dry, rhoGn2;  // rhoGn2: rho g n^2 of the bed shear stress (E1)
+  bool forceBased;        // ErosionLaw::kForceBased
+  float deepWater, capacityK, minSinTilt, erosionRate, depositionRate, slowWater, settling;
+  const float *erodibility, *dissolutionRate, *criticalShear, *shearErodibility;  // per layer
 };
 
 struct ThermalConst {
   int w, h;
-  float dt, wetTalusScale, dy, bankDepth, slowWater, slipShare;
+  float dt, dy, fillShare;
   const float *tanTalus, *share;  // per layer; share: stepShare of its weathering rate this step
+  const float *tanFriction, *sinFriction, *cosFriction, *cohesionHeight;  // per layer (E8)
 };
 
 // One row of thermal_flux.comp's inputs: row y and its neighbours above and below (row y itself
 // at an edge), and its four outflows.
 struct ThermalRow {
   int y;
-  float dx;
-  const float *h, *hN, *hS, *hu, *huN, *huS, *hv, *hvN, *hvS, *b, *bN, *bS;
+  float dx, A, AN, AS;                        // cell areas of rows y, y - 1, y + 1
+  const float *b, *bN, *bS, *sc, *scN, *scS;  // beds and this step's toe scour
   float* out[4];
 };
 
@@ -128,41 +131,70 @@ inline float stackBed(const Stack& st, float base, int x) {
   return b;
 }
 
-// sim/shaders/erode.comp for one cell.
+// 1 - exp(-a), without the cancellation for small a (erode.comp's oneMinusExp).
+inline float oneMinusExp(float a) {
+  const float series = a * (1.0f - a * (0.5f - a * (1.0f / 6.0f)));
+  return a < 1e-3f ? series : 1.0f - std::exp(-a);
+}
+
+// (1 - exp(-l)) / l, 1 at l = 0: what a quantity relaxing at rate k towards a target moves over
+// a step, as a share of (target - now) k dt, with l = k dt (E2, E3). Exact for any step, so the
+// exchange does not depend on it.
+inline float relaxShare(float l) {
+  const float series = 1.0f - l * (0.5f - l * (1.0f / 6.0f));
+  const float exact = (1.0f - std::exp(-l)) / l;
+  return l < 1e-3f ? series : exact;
+}
+
+// sim/shaders/erode.comp for one cell: E1-E3 (the step's net exchange between the bed and the
+// load), E4 (dissolution), E6 (settling where dry); what the flow took off the bed goes to
+// `scour` (E8's toe).
 template <int kL>
 inline void erodeCell(const ErosionConst& c, const Stack& st, float* s, float* bed, const float* base, const float* h,
-                      const float* hu, const float* hv, const float* tilt, int x) {
+                      const float* hu, const float* hv, const float* tilt, float* scour, int x) {
   const int n = kL > 0 ? kL : st.count, sedimentLayer = n - 1;
   const float hx = h[x], sx = s[x];
   const bool wet = hx > c.dry;
-  // E1: capacity from tilt and speed, falling to 0 in deep water.
-  const float speed = std::sqrt(hu[x] * hu[x] + hv[x] * hv[x]) / hx;
+  const float hw = wet ? hx : 1.0f;  // a depth to divide by
+  const float q2 = hu[x] * hu[x] + hv[x] * hv[x];
+  const float speed = std::sqrt(q2) / hw;
+  const int top = topLayer<kL>(st, x);
+  const float topLayerM = layerAt<kL>(st, x, top);
+  // E1-E3, shear-stress law: tau = rho g n^2 |u|^2 / h^(1/3); the load s relaxes towards
+  // E h / w_s at the rate w_s / h, entrainment E = k_d (tau - tau_c) of the topmost layer.
+  const float tau = c.rhoGn2 * (q2 / (hw * hw)) / std::pow(hw, 1.0f / 3.0f);
+  const float excess = maxOf(tau - materialAt<kL>(c.criticalShear, n, top), 0.0f);
+  const float entrain = top >= 0 ? materialAt<kL>(c.shearErodibility, n, top) * excess : 0.0f;
+  const float lambda = c.settling * c.dt / hw;
+  const float netShear = (entrain - c.settling * sx / hw) * c.dt * relaxShare(lambda);
+  // E1-E3, force-based law: capacity C from tilt and speed, falling to 0 in deep water; the load
+  // relaxes towards C at Ks erodibility (below it) or Kd (above it).
   const float shallow = 1.0f - hx / c.deepWater;  // std::clamp(shallow, 0, 1), as values
   const float depthFactor = shallow < 0.0f ? 0.0f : (1.0f < shallow ? 1.0f : shallow);
   const float capacity = c.capacityK * maxOf(tilt[x], c.minSinTilt) * speed * depthFactor;
-  const int top = topLayer<kL>(st, x);
-  const bool pick_ = sx < capacity;
-  // E2: below capacity the water picks up the topmost layer, scaled by its erodibility.
-  const float erodibility = materialAt<kL>(c.erodibility, n, top);
-  const float topLayerM = layerAt<kL>(st, x, top);
-  const float eroded =
-      exactTake(topLayerM, minOf(minOf(c.erosionRate * (capacity - sx) * c.dt * erodibility, c.maxPerStep), topLayerM));
-  const bool erode = wet & pick_ & (top >= 0);
+  const float gap = capacity - sx;
+  const float rate = gap > 0.0f ? c.erosionRate * materialAt<kL>(c.erodibility, n, top) : c.depositionRate;
+  const float netForce = gap * oneMinusExp(rate * c.dt);
+  const float net = c.forceBased ? netForce : netShear;  // > 0: the flow takes from the bed
+  // E2: the flow takes from the topmost layer.
+  const float eroded = exactTake(topLayerM, minOf(maxOf(net, 0.0f), topLayerM));
+  const bool erode = wet & (net > 0.0f) & (top >= 0);
   takeFrom<kL>(st, x, top, eroded, erode);
-  // E3: above it, the excess settles as the top (sediment) layer.
+  // E3: the load settles as the top (sediment) layer.
   const float sed = st.at(sedimentLayer, x);
-  const float deposited = exactGive(sed, minOf(c.depositionRate * (sx - capacity) * c.dt, sx), sx);
-  const bool deposit = wet & !pick_;
+  const float deposited = exactGive(sed, minOf(-net, sx), sx);
+  const bool deposit = wet & (net < 0.0f);
   float s1 = erode ? sx + eroded : (deposit ? sx - deposited : sx);
   st.at(sedimentLayer, x) = deposit ? sed + deposited : sed;
   // E4: slow water dissolves the (new) topmost layer.
   const int top2 = topLayer<kL>(st, x);
-  const float rate = materialAt<kL>(c.dissolutionRate, n, top2);
+  const float dissolution = materialAt<kL>(c.dissolutionRate, n, top2);
   const float top2M = layerAt<kL>(st, x, top2);
-  const float dissolved = exactTake(top2M, minOf(minOf(rate * hx * c.dt, c.maxPerStep), top2M));
+  const float dissolved = exactTake(top2M, minOf(dissolution * hx * c.dt, top2M));
   const bool dissolve = wet & (speed < c.slowWater) & (top2 >= 0);
   takeFrom<kL>(st, x, top2, dissolved, dissolve);
   s1 = dissolve ? s1 + dissolved : s1;
+  scour[x] = (erode ? eroded : 0.0f) + (dissolve ? dissolved : 0.0f);
   // E6: where the water is gone its load settles.
   const float sed2 = st.at(sedimentLayer, x);
   st.at(sedimentLayer, x) = wet ? sed2 : sed2 + s1;
@@ -174,44 +206,105 @@ inline void erodeCell(const ErosionConst& c, const Stack& st, float* s, float* b
 
 // erode.comp for the cells [x0, x1) of a row.
 STRATA_ROW_KERNEL void erosionRow(const ErosionConst& c, const Stack& st, float* s, float* bed, const float* base,
-                                  const float* h, const float* hu, const float* hv, const float* tilt, int x0, int x1) {
+                                  const float* h, const float* hu, const float* hv, const float* tilt, float* scour,
+                                  int x0, int x1) {
   withLayerCount(st.count, [&](auto kL) {
 #pragma omp simd
-    for (int x = x0; x < x1; ++x) erodeCell<decltype(kL)::value>(c, st, s, bed, base, h, hu, hv, tilt, x);
+    for (int x = x0; x < x1; ++x) erodeCell<decltype(kL)::value>(c, st, s, bed, base, h, hu, hv, tilt, scour, x);
   });
 }
 
-// sim/shaders/erode.comp: E1-E4 (capacity, erosion, deposition, dissolution); E6 (settling when
-// dry). Purely local: each cell reads and writes only itself. Runs over the active blocks: in a
-// quiet cell (no water, no load) it changes nothing.
+// sim/shaders/erode.comp: E1-E4 (the exchange between bed and load, dissolution); E6 (settling
+// when dry); the toe scour of E8. Purely local: each cell reads and writes only itself. Runs over the active blocks: in
+// a quiet cell (no water, no load) it changes nothing.
 void Impl::erosionPass() {
   forRuns(water, [&](const Run& r, int) {
     const ErosionConst c{dt,
                          p.dryDepthM,
+                         p.waterDensityKgM3 * p.gravityMS2 * p.manningN * p.manningN,
+                         p.erosionLaw == ErosionLaw::kForceBased,
                          p.deepWaterM,
                          p.capacityK,
                          p.minSinTilt,
                          p.erosionRate,
                          p.depositionRate,
                          p.slowWaterMS,
-                         p.maxErosionPerStepM,
+                         settling,
                          erodibility.data(),
-                         dissolutionRate.data()};
+                         dissolutionRate.data(),
+                         criticalShear.data(),
+                         shearErodibility.data()};
     Water& u = now();
     for (int y = r.y0; y < r.y1; ++y) {
       erosionRow(c, Stack{layers.row(y), layerStride, L}, u.s.row(y), bed.row(y), base.row(y), u.h.row(y), u.hu.row(y),
-                 u.hv.row(y), tilt.row(y), r.x0, r.x1);
+                 u.hv.row(y), tilt.row(y), scour.row(y), r.x0, r.x1);
     }
   });
 }
 
 namespace {
 
-// The share of a talus excess moved in a step of dt at `rate` (1/s), capped by thermalRate
-// (E7): thermalRate * r dt / (1 + r dt), ~ r dt for short steps, thermalRate for long ones.
-inline float stepShare(float thermalRate, float rate, float dt) {
-  const float a = rate * dt;
-  return thermalRate * (a / (1.0f + a));
+// E7: the share of a talus excess moved in a step of dt at `rate` (1/s): 1 - exp(-r dt). Moving
+// half of it (the drop falls twice what the cell gives, with equal areas) relaxes the excess as
+// exp(-r t), whatever the step.
+inline float stepShare(float rate, float dt) { return oneMinusExp(rate * dt); }
+
+// What a layer of a cell would send towards each neighbour this step (m over this cell), given
+// the drops to the neighbours below what the layers above shed (`drop`), the float noise of the
+// beds, the distances, and E8's bound per direction (`credit`).
+// E7, weathering: half of the excess over the talus slope, times the layer's share this step.
+// E8, bank failure: towards a neighbour the flow scoured this step, a bank steeper than the
+// layer's friction angle phi' whose height exceeds Culmann's critical height
+// (4 c' / gamma) sin(beta) cos(phi') / (1 - cos(beta - phi')) (0 for loose grains) sends half of
+// its excess over phi', up to the credit. The larger of the two counts.
+struct LayerWants {
+  float want[4], maxW, sumW;
+};
+inline LayerWants layerWants(const ThermalConst& c, int l, const bool in[4], const float drop[4], const float noise[4],
+                             const float dist[4], const float credit[4]) {
+  LayerWants r{{0.0f, 0.0f, 0.0f, 0.0f}, 0.0f, 0.0f};
+  const float tanT = c.tanTalus[l], share = c.share[l];
+  const float tanF = c.tanFriction[l], sinF = c.sinFriction[l], cosF = c.cosFriction[l], hc = c.cohesionHeight[l];
+  for (int d = 0; d < 4; ++d) {
+    const float e = drop[d] - tanT * dist[d];
+    const float weather = 0.5f * ((e > noise[d] ? e : 0.0f) * share);
+    const float ef = drop[d] - tanF * dist[d];
+    const float len = std::sqrt(drop[d] * drop[d] + dist[d] * dist[d]);
+    const float sinB = drop[d] / len, cosB = dist[d] / len;
+    const float cosBP = cosB * cosF + sinB * sinF;  // cos(beta - phi')
+    const bool fails = (ef > noise[d]) & (drop[d] * (1.0f - cosBP) > hc * (sinB * cosF));
+    const float slump = fails ? minOf(0.5f * ef, credit[d]) : 0.0f;
+    r.want[d] = in[d] ? maxOf(weather, slump) : 0.0f;
+    r.maxW = maxOf(r.maxW, r.want[d]);
+    r.sumW += r.want[d];
+  }
+  return r;
+}
+
+// The inputs of a cell's thermal flux: which neighbours exist, the drops to them, the float noise
+// of the two beds (an excess within it is rounding, not a slope, as W1a), the distances and E8's
+// credit towards each (bankFillShare of what the flow took off the neighbour this step, in m
+// over this cell).
+struct Around {
+  bool in[4];
+  float drop[4], noise[4], dist[4], credit[4];
+};
+template <bool kEdge>
+inline Around around(const ThermalConst& c, const ThermalRow& r, int x) {
+  Around a;
+  const bool in[4] = {!kEdge || x > 0, !kEdge || x < c.w - 1, !kEdge || r.y > 0, !kEdge || r.y < c.h - 1};
+  const int xw = in[0] ? x - 1 : x, xe = in[1] ? x + 1 : x;
+  const float bj[4] = {r.b[xw], r.b[xe], r.bN[x], r.bS[x]};
+  const float scj[4] = {r.sc[xw], r.sc[xe], r.scN[x], r.scS[x]};
+  const float Aj[4] = {r.A, r.A, r.AN, r.AS};
+  for (int d = 0; d < 4; ++d) {
+    a.in[d] = in[d];
+    a.dist[d] = d < 2 ? r.dx : c.dy;
+    a.drop[d] = r.b[x] - bj[d];
+    a.noise[d] = kHeadNoise * maxOf(std::abs(r.b[x]), std::abs(bj[d]));
+    a.credit[d] = in[d] ? c.fillShare * scj[d] * (Aj[d] / r.A) : 0.0f;
+  }
+  return a;
 }
 
 // thermalFluxCell for the topmost layer alone (the layers below are reached only through it, so
@@ -219,76 +312,39 @@ inline float stepShare(float thermalRate, float rate, float dt) {
 // cell where anything is shed). Its arithmetic is thermalFluxCell's for that layer.
 template <bool kEdge, int kL>
 inline void thermalFluxTopCell(const ThermalConst& c, const ThermalRow& r, const Stack& st, int x) {
-  const bool in[4] = {!kEdge || x > 0, !kEdge || x < c.w - 1, !kEdge || r.y > 0, !kEdge || r.y < c.h - 1};
-  const int xw = in[0] ? x - 1 : x, xe = in[1] ? x + 1 : x;
-  const int n = kL > 0 ? kL : st.count;
-  const float hj[4] = {r.h[xw], r.h[xe], r.hN[x], r.hS[x]};
-  const float huj[4] = {r.hu[xw], r.hu[xe], r.huN[x], r.huS[x]};
-  const float hvj[4] = {r.hv[xw], r.hv[xe], r.hvN[x], r.hvS[x]};
-  const float bj[4] = {r.b[xw], r.b[xe], r.bN[x], r.bS[x]};
+  const Around a = around<kEdge>(c, r, x);
   const int top = topLayer<kL>(st, x);
-  const float t = layerAt<kL>(st, x, top), tanT = materialAt<kL>(c.tanTalus, n, top);
-  const float share = materialAt<kL>(c.share, n, top);
-  float weighted[4], maxW = 0.0f, sumW = 0.0f;
-  for (int d = 0; d < 4; ++d) {
-    const float dist = d < 2 ? r.dx : c.dy;
-    const float speed = std::sqrt(huj[d] * huj[d] + hvj[d] * hvj[d]) / maxOf(hj[d], c.bankDepth);
-    const bool undercut = in[d] & (hj[d] > c.bankDepth) & (speed > c.slowWater);
-    const float noise = kHeadNoise * maxOf(std::abs(r.b[x]), std::abs(bj[d]));
-    const float e = (r.b[x] - bj[d]) - (undercut ? tanT * c.wetTalusScale : tanT) * dist;
-    const float wd = (e > noise ? e : 0.0f) * (undercut ? c.slipShare : share);
-    weighted[d] = in[d] ? wd : 0.0f;
-    maxW = maxOf(maxW, weighted[d]);
-    sumW += weighted[d];
-  }
-  const bool sheds = (top >= 0) & (sumW > 0.0f);
-  const float moved = sheds ? exactTake(t, minOf(t, 0.5f * maxW)) : 0.0f;
-  const float inv = sheds ? moved / sumW : 0.0f;
-  for (int d = 0; d < 4; ++d) r.out[d][x] = weighted[d] * inv;
+  const float t = layerAt<kL>(st, x, top);
+  const LayerWants lw = layerWants(c, top < 0 ? 0 : top, a.in, a.drop, a.noise, a.dist, a.credit);
+  const bool sheds = (top >= 0) & (lw.sumW > 0.0f);
+  const float moved = sheds ? exactTake(t, minOf(t, lw.maxW)) : 0.0f;
+  const float inv = sheds ? moved / lw.sumW : 0.0f;
+  for (int d = 0; d < 4; ++d) r.out[d][x] = lw.want[d] * inv;
 }
 
-// sim/shaders/thermal_flux.comp for one cell: E7 (each layer of the stack, from the top down,
-// sheds where the slope exceeds its own talus angle, at its own rate and no more than its own
-// thickness; a layer below is reached only through layers shed whole), E8 (a bank above flowing
-// water of real depth slips at wetTalusScale times the angle, at bankSlipRatePerS).
+// sim/shaders/thermal_flux.comp for one cell: E7 and E8 for each layer of the stack, from the top
+// down (each layer at its own angles, rate and cohesion, no more than its own thickness; a layer
+// below is reached only through layers shed whole).
 template <bool kEdge, int kL>
 inline void thermalFluxCell(const ThermalConst& c, const ThermalRow& r, const Stack& st, int x) {
-  const bool in[4] = {!kEdge || x > 0, !kEdge || x < c.w - 1, !kEdge || r.y > 0, !kEdge || r.y < c.h - 1};
-  const int xw = in[0] ? x - 1 : x, xe = in[1] ? x + 1 : x;
+  Around a = around<kEdge>(c, r, x);
   const int n = kL > 0 ? kL : st.count;
-  const float hj[4] = {r.h[xw], r.h[xe], r.hN[x], r.hS[x]};
-  const float huj[4] = {r.hu[xw], r.hu[xe], r.huN[x], r.huS[x]};
-  const float hvj[4] = {r.hv[xw], r.hv[xe], r.hvN[x], r.hvS[x]};
-  const float bj[4] = {r.b[xw], r.b[xe], r.bN[x], r.bS[x]};
-  const float slipShare = c.slipShare;
-  float drop[4], noise[4], dist[4];
-  bool undercut[4];
-  for (int d = 0; d < 4; ++d) {
-    dist[d] = d < 2 ? r.dx : c.dy;
-    // E8: the neighbour holds flowing water of real depth.
-    const float speed = std::sqrt(huj[d] * huj[d] + hvj[d] * hvj[d]) / maxOf(hj[d], c.bankDepth);
-    undercut[d] = in[d] & (hj[d] > c.bankDepth) & (speed > c.slowWater);
-    drop[d] = r.b[x] - bj[d];
-    // An excess within float32 resolution of the beds is rounding, not a slope (as W1a).
-    noise[d] = kHeadNoise * maxOf(std::abs(r.b[x]), std::abs(bj[d]));
-  }
-  float out[4] = {0.0f, 0.0f, 0.0f, 0.0f}, shedAbove = 0.0f;
+  float out[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+  const float drop0[4] = {a.drop[0], a.drop[1], a.drop[2], a.drop[3]};
+  float shedAbove = 0.0f;
   bool reach = true;  // every layer above this one is empty or shed whole
   for (int l = n - 1; l >= 0; --l) {
-    const float t = st.at(l, x), tanT = c.tanTalus[l];
-    const float share = c.share[l];
-    float weighted[4], maxW = 0.0f, sumW = 0.0f;
+    const float t = st.at(l, x);
+    for (int d = 0; d < 4; ++d) a.drop[d] = drop0[d] - shedAbove;
+    const LayerWants lw = layerWants(c, l, a.in, a.drop, a.noise, a.dist, a.credit);
+    const bool sheds = reach & (t > 0.0f) & (lw.sumW > 0.0f);
+    const float moved = sheds ? exactTake(t, minOf(t, lw.maxW)) : 0.0f;
+    const float inv = sheds ? moved / lw.sumW : 0.0f;
     for (int d = 0; d < 4; ++d) {
-      const float e = (drop[d] - shedAbove) - (undercut[d] ? tanT * c.wetTalusScale : tanT) * dist[d];
-      const float wd = (e > noise[d] ? e : 0.0f) * (undercut[d] ? slipShare : share);
-      weighted[d] = in[d] ? wd : 0.0f;
-      maxW = maxOf(maxW, weighted[d]);
-      sumW += weighted[d];
+      const float part = lw.want[d] * inv;
+      out[d] += part;
+      a.credit[d] = maxOf(a.credit[d] - part, 0.0f);
     }
-    const bool sheds = reach & (t > 0.0f) & (sumW > 0.0f);
-    const float moved = sheds ? exactTake(t, minOf(t, 0.5f * maxW)) : 0.0f;
-    const float inv = sheds ? moved / sumW : 0.0f;
-    for (int d = 0; d < 4; ++d) out[d] += weighted[d] * inv;
     shedAbove += moved;
     reach = reach & (moved >= t);
   }
@@ -314,44 +370,41 @@ STRATA_ROW_KERNEL void thermalFluxRow(const ThermalConst& c, const ThermalRow& r
 
 ThermalConst Impl::thermalConst() {
   thermalShare.resize(weatheringRate.size());
-  for (size_t l = 0; l < weatheringRate.size(); ++l) thermalShare[l] = stepShare(p.thermalRate, weatheringRate[l], dt);
+  for (size_t l = 0; l < weatheringRate.size(); ++l) thermalShare[l] = stepShare(weatheringRate[l], dt);
   return {w,
           h,
           dt,
-          p.wetTalusScale,
           dy,
-          p.bankDepthM,
-          p.slowWaterMS,
-          stepShare(p.thermalRate, p.bankSlipRatePerS, dt),
+          p.bankFillShare,
           tanTalus.data(),
-          thermalShare.data()};
+          thermalShare.data(),
+          tanFriction.data(),
+          sinFriction.data(),
+          cosFriction.data(),
+          cohesionHeight.data()};
 }
 
-// sim/shaders/thermal_flux.comp: E7 (talus transfer), E8 (undercut banks slip).
-// Each cell writes only its own four outflows. Runs over the blocks whose inputs (bed, layers,
-// water of the cell and its neighbours) may have changed since their last evaluation, and
-// records per block whether any of its cells sheds material.
+// sim/shaders/thermal_flux.comp: E7 (weathering to the talus angle), E8 (banks falling into the
+// scoured toe). Each cell writes only its own four outflows. Runs over the blocks whose inputs
+// (bed, layers, scour of the cell and its neighbours) may have changed since their last
+// evaluation, and records per block whether any of its cells sheds material.
 void Impl::thermalFluxPass() {
   const ThermalConst c = thermalConst();
   forRuns(thermalEval, [&](const Run& r, int) {
     for (int bx = r.x0 / kBlock; bx * kBlock < r.x1; ++bx) thermalMoving[size_t(r.y0 / kBlock * bw + bx)] = 0;
-    const Water& u = now();
     for (int y = r.y0; y < r.y1; ++y) {
       const int yn = std::max(y - 1, 0), ys = std::min(y + 1, h - 1);
       const ThermalRow row{y,
                            rowDx[size_t(y)],
-                           u.h.row(y),
-                           u.h.row(yn),
-                           u.h.row(ys),
-                           u.hu.row(y),
-                           u.hu.row(yn),
-                           u.hu.row(ys),
-                           u.hv.row(y),
-                           u.hv.row(yn),
-                           u.hv.row(ys),
+                           rowArea[size_t(y)],
+                           rowArea[size_t(yn)],
+                           rowArea[size_t(ys)],
                            bed.row(y),
                            bed.row(yn),
                            bed.row(ys),
+                           scour.row(y),
+                           scour.row(yn),
+                           scour.row(ys),
                            {thermal[0].row(y), thermal[1].row(y), thermal[2].row(y), thermal[3].row(y)}};
       const Stack st{layers.row(y), layerStride, L};
       thermalFluxRow(c, row, st, r.x0, r.x1);

@@ -88,7 +88,10 @@ struct Impl {
   SimParams p;
   int threads = 1;
   bool skip = true;
-  std::vector<float> erodibility, dissolutionRate, tanTalus, weatheringRate;  // per layer (MaterialConstants)
+  // Per layer, MaterialConstants as columns (E1-E8).
+  std::vector<float> erodibility, dissolutionRate, tanTalus, weatheringRate, criticalShear, shearErodibility;
+  std::vector<float> tanFriction, sinFriction, cosFriction, cohesionHeight;
+  float settling = 0.0f;              // w_s of the deposit (top) layer's material: the suspended load's (E3)
   std::vector<float> thermalShare;    // per layer: E7's share of the excess moved this step
   std::vector<float> rowDx, rowArea;  // per row: dx and the cell area dx * dy
   std::vector<float> faceWidthY;      // per y-face (height + 1): the mean of the two rows' dx
@@ -104,6 +107,7 @@ struct Impl {
   Plane accum[8];              // (sum, error) of water out, evaporated, sediment out, level exchange (m^3)
   Plane tilt;                  // sin(bed tilt), for erosion (E0)
   Plane thermal[4];            // material shed W, E, N, S (m over this cell) (E7)
+  Plane scour;                 // what the flow took off each cell this step (m), the toe a bank may fall into (E8)
   Plane flood[4];              // max depth, max speed, arrival, wet duration
   // flood mode's intermediates
   Water stage;                 // the Heun predictor U1

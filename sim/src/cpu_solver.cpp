@@ -56,6 +56,13 @@ Impl::Impl(const SimInput& input, const SimParams& params, int threadCount, bool
     dissolutionRate.push_back(c.dissolutionRate);
     tanTalus.push_back(c.tanTalus);
     weatheringRate.push_back(c.weatheringRatePerS);
+    criticalShear.push_back(c.criticalShearPa);
+    shearErodibility.push_back(c.shearErodibility);
+    tanFriction.push_back(c.tanFriction);
+    sinFriction.push_back(c.sinFriction);
+    cosFriction.push_back(c.cosFriction);
+    cohesionHeight.push_back(c.cohesionHeightM);
+    settling = c.settlingVelocityMS;  // the last layer's: deposits land there
   }
   for (int y = 0; y < h; ++y) {
     rowDx.push_back(float(grid.rowDxM[size_t(y)]));
@@ -135,6 +142,7 @@ void Impl::allocateFor(const SimParams& params) {
   if (params.thermalEnabled && thermal[0].empty()) {
     for (auto& t : thermal) t = Plane(w, h);
   }
+  if ((params.thermalEnabled || params.erosionEnabled) && scour.empty()) scour = Plane(w, h);
   if (params.waterModel == WaterModel::kFiniteVolume && anySuspended && den.empty()) den = Plane(w, h);
 }
 
@@ -378,13 +386,14 @@ void CpuSolver::onParamsChanged() {
   Impl& m = *impl_;
   const SimParams& next = params();
   // The thermal flux depends on these besides the cells: evaluate it everywhere once.
-  if (next.thermalEnabled != m.p.thermalEnabled || next.thermalRate != m.p.thermalRate ||
-      next.wetTalusScale != m.p.wetTalusScale || next.bankDepthM != m.p.bankDepthM ||
-      next.bankSlipRatePerS != m.p.bankSlipRatePerS || next.slowWaterMS != m.p.slowWaterMS) {
+  if (next.thermalEnabled != m.p.thermalEnabled || next.bankFillShare != m.p.bankFillShare ||
+      next.erosionEnabled != m.p.erosionEnabled) {
     m.thermalDirty = true;
   }
   m.p = next;
   m.allocateFor(next);
+  // No erosion, no toe scour (E8): what the last erosion pass left must not bring banks down.
+  if (!next.erosionEnabled && !m.scour.empty()) m.scour = cpu::Plane(m.w, m.h);
 }
 
 double CpuSolver::maxWaveSpeedMS() const { return double(impl_->maxWaveSpeed()); }

@@ -31,6 +31,16 @@ MaterialConstants materialConstants(const terrain::Material& m) {
   c.dissolutionRate = m.dissolutionRate;
   c.tanTalus = float(std::tan(double(m.talusAngleDeg) * std::numbers::pi / 180.0));
   c.weatheringRatePerS = m.weatheringRatePerS;
+  c.criticalShearPa = m.criticalShearPa;
+  c.shearErodibility = m.shearErodibility;
+  c.settlingVelocityMS = m.settlingVelocityMS;
+  const double phi = double(m.frictionAngleDeg) * std::numbers::pi / 180.0;
+  c.tanFriction = float(std::tan(phi));
+  c.sinFriction = float(std::sin(phi));
+  c.cosFriction = float(std::cos(phi));
+  // Culmann's planar failure: a bank of unit weight gamma = density g fails above the height
+  // (4 c' / gamma) sin(beta) cos(phi') / (1 - cos(beta - phi')) (e.g. Lohnes and Handy 1968).
+  c.cohesionHeightM = float(4.0 * double(m.cohesionPa) / (double(m.densityKgM3) * 9.81));
   return c;
 }
 

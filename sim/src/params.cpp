@@ -37,11 +37,8 @@ Status validateParams(const SimParams& p) {
                                                {"deepWaterM", p.deepWaterM},
                                                {"minSinTilt", p.minSinTilt},
                                                {"slowWaterMS", p.slowWaterMS},
-                                               {"thermalRate", p.thermalRate},
-                                               {"wetTalusScale", p.wetTalusScale},
-                                               {"bankDepthM", p.bankDepthM},
-                                               {"bankSlipRatePerS", p.bankSlipRatePerS},
-                                               {"maxErosionPerStepM", p.maxErosionPerStepM}};
+                                               {"waterDensityKgM3", p.waterDensityKgM3},
+                                               {"bankFillShare", p.bankFillShare}};
   for (const auto& [name, v] : all) STRATA_TRY_STATUS(require(std::isfinite(v), name, v, "a finite number"));
   STRATA_TRY_STATUS(require(p.maxDtS > 0, "maxDtS", p.maxDtS, "positive"));
   STRATA_TRY_STATUS(require(p.gravityMS2 > 0, "gravityMS2", p.gravityMS2, "positive"));
@@ -50,10 +47,14 @@ Status validateParams(const SimParams& p) {
     STRATA_TRY_STATUS(require(p.cflAlpha > 0 && p.cflAlpha <= 0.5f, "cflAlpha", p.cflAlpha,
                               "in (0, 0.5] in flood mode (positivity of the finite-volume scheme)"));
   }
-  STRATA_TRY_STATUS(require(p.thermalRate > 0 && p.thermalRate <= 1, "thermalRate", p.thermalRate, "in (0, 1]"));
+  if (p.erosionLaw != ErosionLaw::kShearStress && p.erosionLaw != ErosionLaw::kForceBased) {
+    return fail("sim params: erosionLaw " + std::to_string(int(p.erosionLaw)) +
+                " is not 0 (shear stress) or 1 (force-based)");
+  }
+  STRATA_TRY_STATUS(require(p.waterDensityKgM3 > 0, "waterDensityKgM3", p.waterDensityKgM3, "positive"));
+  STRATA_TRY_STATUS(
+      require(p.bankFillShare >= 0 && p.bankFillShare <= 1, "bankFillShare", p.bankFillShare, "in [0, 1]"));
   STRATA_TRY_STATUS(require(p.manningN >= 0, "manningN", p.manningN, ">= 0"));
-  STRATA_TRY_STATUS(require(p.bankDepthM >= 0, "bankDepthM", p.bankDepthM, ">= 0"));
-  STRATA_TRY_STATUS(require(p.bankSlipRatePerS >= 0, "bankSlipRatePerS", p.bankSlipRatePerS, ">= 0"));
   STRATA_TRY_STATUS(require(p.dryDepthM > 0, "dryDepthM", p.dryDepthM, "positive"));
   STRATA_TRY_STATUS(require(p.deepWaterM > 0, "deepWaterM", p.deepWaterM, "positive"));
   STRATA_TRY_STATUS(require(p.pipeAreaM2 > 0, "pipeAreaM2", p.pipeAreaM2, "positive"));
@@ -63,9 +64,7 @@ Status validateParams(const SimParams& p) {
                                 {"erosionRate", p.erosionRate},
                                 {"depositionRate", p.depositionRate},
                                 {"minSinTilt", p.minSinTilt},
-                                {"slowWaterMS", p.slowWaterMS},
-                                {"wetTalusScale", p.wetTalusScale},
-                                {"maxErosionPerStepM", p.maxErosionPerStepM}}) {
+                                {"slowWaterMS", p.slowWaterMS}}) {
     STRATA_TRY_STATUS(require(v >= 0, name, v, ">= 0"));
   }
   return {};

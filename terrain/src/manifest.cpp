@@ -351,6 +351,11 @@ std::string manifestToToml(const Manifest& m) {
     kv("talus_angle_deg", tomlFloat(readable(mat.talusAngleDeg)));
     kv("density_kg_m3", tomlFloat(readable(mat.densityKgM3)));
     kv("weathering_rate", tomlFloat(readable(mat.weatheringRatePerS)));
+    kv("critical_shear_pa", tomlFloat(readable(mat.criticalShearPa)));
+    kv("shear_erodibility", tomlFloat(readable(mat.shearErodibility)));
+    kv("settling_velocity", tomlFloat(readable(mat.settlingVelocityMS)));
+    kv("friction_angle_deg", tomlFloat(readable(mat.frictionAngleDeg)));
+    kv("cohesion_pa", tomlFloat(readable(mat.cohesionPa)));
   }
 
   for (int ty = 0; ty < m.tilesY; ++ty) {
@@ -471,14 +476,27 @@ Result<Manifest> parseManifest(const std::string& text, const std::string& path)
       mat.dissolutionRate = float(dr);
       mat.talusAngleDeg = float(ta);
       mat.densityKgM3 = float(rho);
-      // Stores written before the key existed: the default material of that name, else the default.
-      if (t["weathering_rate"].node()) {
-        STRATA_TRY(double wr, r.number(t["weathering_rate"], k + "weathering_rate", 0.0, 1e3));
-        mat.weatheringRatePerS = float(wr);
-      } else {
-        const auto defaults = defaultMaterials();
-        const int known = findMaterial(defaults, mat.name);
-        if (known >= 0) mat.weatheringRatePerS = defaults[size_t(known)].weatheringRatePerS;
+      // Keys newer than the store: the default material of that name, else the default.
+      const auto defaults = defaultMaterials();
+      const int known = findMaterial(defaults, mat.name);
+      const Material fallback = known >= 0 ? defaults[size_t(known)] : Material{};
+      const struct {
+        const char* key;
+        float Material::*field;
+        double hi;
+      } later[] = {{"weathering_rate", &Material::weatheringRatePerS, 1e3},
+                   {"critical_shear_pa", &Material::criticalShearPa, 1e9},
+                   {"shear_erodibility", &Material::shearErodibility, 1.0},
+                   {"settling_velocity", &Material::settlingVelocityMS, 100.0},
+                   {"friction_angle_deg", &Material::frictionAngleDeg, 90.0},
+                   {"cohesion_pa", &Material::cohesionPa, 1e12}};
+      for (const auto& f : later) {
+        if (t[f.key].node()) {
+          STRATA_TRY(double v, r.number(t[f.key], k + f.key, 0.0, f.hi));
+          mat.*f.field = float(v);
+        } else {
+          mat.*f.field = fallback.*f.field;
+        }
       }
       auto ok = validateMaterial(mat);
       if (!ok) return r.error(t.node(), k + "*", ok.message());

@@ -170,6 +170,24 @@ TEST(ScenarioDomain, UnknownMaterialIsRefused) {
       "/runs/t.toml:4: key 'terrain.layer[0].material': unknown material \"cheese\" (rock, soil, sand, sediment)");
 }
 
+// [materials.NAME] changes the constants of the layers of that material only; a name that is no
+// material is refused naming the table.
+TEST(ScenarioDomain, MaterialChangesReachTheLayersOfThatMaterial) {
+  auto d = domainOf("bbox_lonlat = [-112.5, 36.01, -112.001, 36.3]", kInflow,
+                    "[[terrain.layer]]\nmaterial = \"sand\"\nthickness = \"1 m\"\n"
+                    "[materials.sand]\ncritical_shear = \"0.4 Pa\"\ncohesion = \"1 kPa\"\n");
+  ASSERT_TRUE(d) << d.message();
+  ASSERT_EQ(d->input.materials.size(), 1u);
+  EXPECT_EQ(d->input.materials[0].name, "sand");
+  EXPECT_FLOAT_EQ(d->input.materials[0].criticalShearPa, 0.4f);
+  EXPECT_FLOAT_EQ(d->input.materials[0].cohesionPa, 1000.0f);
+  EXPECT_FLOAT_EQ(d->input.materials[0].settlingVelocityMS, terrain::defaultMaterials()[2].settlingVelocityMS);
+  auto bad = domainOf("bbox_lonlat = [-112.5, 36.01, -112.001, 36.3]", kInflow, "[materials.cheese]\ncohesion = 3\n");
+  ASSERT_FALSE(bad);
+  EXPECT_EQ(bad.message(),
+            "/runs/t.toml:3: key 'materials.cheese': unknown material \"cheese\" (rock, soil, sand, sediment)");
+}
+
 TEST(ScenarioDomain, DamBreakFillsThePolygonToItsSurface) {
   auto d = domainOf("bbox_lonlat = [-112.5, 36.01, -112.001, 36.3]",
                     "[[water.dam_break]]\npolygon_lonlat = [[-112.1, 36.05], [-112.02, 36.05], [-112.02, 36.1], "

@@ -63,10 +63,15 @@ struct HostileScenario {
     text("boundary = { west = \"open\", east = \"closed\", south = \"open\", north = \"open\" }");
     text("[erosion]");
     text("enabled = true");
+    text("law = \"force-based\"");
     line("erosion.capacity", "capacity = {}", {"0.05"});
     line("erosion.erosion_rate", "erosion_rate = {}", {"0.01"});
     line("erosion.deposition_rate", "deposition_rate = {}", {"0.01"});
-    line("erosion.dissolution_rate", "dissolution_rate = {}", {"0"});
+    text("[materials.sand]");
+    line("materials.sand.critical_shear", "critical_shear = {}", {"0.25"});
+    line("materials.sand.settling_velocity", "settling_velocity = {}", {"0.07"});
+    line("materials.sand.friction_angle", "friction_angle = {}", {"30"});
+    line("materials.sand.dissolution_rate", "dissolution_rate = {}", {"0"});
     text("[water]");
     line("water.evaporation", "evaporation = {}", {"2e-8"});
     text("[[water.inflow]]");
@@ -130,9 +135,11 @@ std::optional<Expectation> expectationFor(const Line& line, size_t pos, const st
   if (value == "0") {
     if (k == "model.manning_n") return Expectation{true, "", "no friction"};
     if (k == "erosion.capacity" || k == "erosion.erosion_rate" || k == "erosion.deposition_rate" ||
-        k == "erosion.dissolution_rate") {
+        k == "materials.sand.dissolution_rate") {
       return Expectation{true, "", "that process is off"};
     }
+    if (k == "materials.sand.critical_shear") return Expectation{true, "", "any flow entrains sand"};
+    if (k == "materials.sand.settling_velocity") return Expectation{true, "", "the load never settles"};
     if (k == "water.evaporation") return Expectation{true, "", "no evaporation"};
     if (k == "water.rain.rate") return Expectation{true, "", "no rain"};
     if (k == "water.rain.start") return Expectation{true, "", "rain from the start"};
@@ -253,8 +260,8 @@ TEST(ScenarioHostile, EveryNumberNonFiniteZeroNegativeOrHuge) {
       }
     }
   }
-  EXPECT_EQ(cases, 34 * 6);
-  EXPECT_EQ(accepted, 19);
+  EXPECT_EQ(cases, 37 * 6);
+  EXPECT_EQ(accepted, 21);
 }
 
 // Quantities with units go through the same checks.

@@ -122,7 +122,44 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"unknown slope limiter", "manning_n = 0.035", "manning_n = 0.035\nslopes = \"superbee\"",
                 "/data/runs/gc.toml:12: key 'model.slopes': expected \"minmod\" or \"mc\", got \"superbee\""},
         BadCase{"terrain change without erosion", "[time]", "[outputs]\nmaps = [\"terrain_change\"]\n[time]",
-                "/data/runs/gc.toml: outputs.maps asks for terrain_change but erosion is not enabled"}));
+                "/data/runs/gc.toml: outputs.maps asks for terrain_change but erosion is not enabled"},
+        BadCase{"unknown erosion law", "[time]", "[erosion]\nlaw = \"stream power\"\n[time]",
+                "/data/runs/gc.toml:22: key 'erosion.law': \"stream power\" is not \"shear\" or \"force-based\""},
+        BadCase{"force-based constants with the shear law", "[time]", "[erosion]\ncapacity = 0.05\n[time]",
+                "/data/runs/gc.toml:22: key 'erosion.capacity': belongs to law = \"force-based\"; the shear-stress "
+                "law takes its constants from the materials ([materials.NAME], docs/scenario.md)"},
+        BadCase{"dissolution is a material's", "[time]", "[erosion]\ndissolution_rate = 1e-6\n[time]",
+                "/data/runs/gc.toml:22: key 'erosion.dissolution_rate': dissolution is a material's constant: set "
+                "dissolution_rate in [materials.NAME] (docs/scenario.md)"},
+        BadCase{"a stress in metres", "[time]", "[materials.sand]\ncritical_shear = \"2 m\"\n[time]",
+                "/data/runs/gc.toml:22: key 'materials.sand.critical_shear': unit 'm' is a length, not a stress "
+                "(use one of Pa, kPa, MPa)"},
+        BadCase{"a friction angle of 90 degrees", "[time]", "[materials.sand]\nfriction_angle = 90\n[time]",
+                "/data/runs/gc.toml:22: key 'materials.sand.friction_angle': must be at most 89.9 degrees"},
+        BadCase{"an unknown material constant", "[time]", "[materials.sand]\nhardness = 3\n[time]",
+                "/data/runs/gc.toml:22: key 'materials.sand.hardness': unknown key (expected one of: critical_shear, "
+                "shear_erodibility, settling_velocity, friction_angle, cohesion, talus_angle, weathering_rate, "
+                "dissolution_rate, erodibility)"}));
+
+// Issue 30: the erosion law and the materials' constants in physical units, with units.
+TEST(Scenario, ReadsTheErosionLawAndMaterialConstants) {
+  auto s = parse(replaced(kGood, "[time]",
+                          "[erosion]\nenabled = true\n[materials.sand]\ncritical_shear = \"0.4 Pa\"\n"
+                          "settling_velocity = \"50 mm/s\"\ncohesion = \"2 kPa\"\nfriction_angle = 33\n[time]"));
+  ASSERT_TRUE(s) << s.message();
+  EXPECT_EQ(s->erosion.law, sim::ErosionLaw::kShearStress);  // the default
+  ASSERT_EQ(s->materials.size(), 1u);
+  EXPECT_EQ(s->materials[0].name, "sand");
+  EXPECT_DOUBLE_EQ(*s->materials[0].criticalShearPa, 0.4);
+  EXPECT_DOUBLE_EQ(*s->materials[0].settlingVelocityMS, 0.05);
+  EXPECT_DOUBLE_EQ(*s->materials[0].cohesionPa, 2000.0);
+  EXPECT_DOUBLE_EQ(*s->materials[0].frictionAngleDeg, 33.0);
+  EXPECT_FALSE(s->materials[0].shearErodibility);
+  s = parse(replaced(kGood, "[time]", "[erosion]\nlaw = \"force-based\"\ncapacity = 0.1\n[time]"));
+  ASSERT_TRUE(s) << s.message();
+  EXPECT_EQ(s->erosion.law, sim::ErosionLaw::kForceBased);
+  EXPECT_DOUBLE_EQ(s->erosion.capacity, 0.1);
+}
 
 TEST(Scenario, SlopeLimiterIsMinmodUnlessAskedForMc) {
   auto s = parse(kGood);
@@ -284,7 +321,7 @@ TEST(Scenario, TextTheTomlReaderMishandlesIsRefusedFirst) {
   ASSERT_FALSE(good);  // the key "x" is unknown, which is the only complaint
   EXPECT_EQ(good.message(),
             "/data/runs/gc.toml:4: key 'x': unknown key (expected one of: name, description, terrain, "
-            "region, model, erosion, water, time, outputs)");
+            "region, model, erosion, materials, water, time, outputs)");
   auto named = parse(replaced(kGood, "name = \"canyon flood\"", "name = \"Crue de l'Is\xc3\xa8re\" # \xc2\xa7"));
   ASSERT_TRUE(named) << named.message();
   EXPECT_EQ(named->name, "Crue de l'Is\xc3\xa8re");

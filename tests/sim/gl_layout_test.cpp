@@ -53,14 +53,14 @@ TEST(GpuLayouts, SimParamsMatchesGlsl) {
                                            STRATA_FIELD(SimParams, deepWaterM),
                                            STRATA_FIELD(SimParams, minSinTilt),
                                            STRATA_FIELD(SimParams, slowWaterMS),
-                                           STRATA_FIELD(SimParams, thermalRate),
-                                           STRATA_FIELD(SimParams, wetTalusScale),
-                                           STRATA_FIELD(SimParams, maxErosionPerStepM),
+                                           STRATA_FIELD(SimParams, erosionLaw),
+                                           STRATA_FIELD(SimParams, waterDensityKgM3),
+                                           STRATA_FIELD(SimParams, bankFillShare),
                                            STRATA_FIELD(SimParams, slopeLimiter),
-                                           STRATA_FIELD(SimParams, bankDepthM),
-                                           STRATA_FIELD(SimParams, bankSlipRatePerS),
                                            STRATA_FIELD(SimParams, pad0),
-                                           STRATA_FIELD(SimParams, pad1)});
+                                           STRATA_FIELD(SimParams, pad1),
+                                           STRATA_FIELD(SimParams, pad2),
+                                           STRATA_FIELD(SimParams, pad3)});
 }
 
 TEST(GpuLayouts, SimMaterialSourceAndLevelEntryMatchGlsl) {
@@ -68,7 +68,11 @@ TEST(GpuLayouts, SimMaterialSourceAndLevelEntryMatchGlsl) {
   using strata::sim::SourceEntry;
   expectSimLayout<SimMaterial>("SimMaterial",
                                {STRATA_FIELD(SimMaterial, erodibility), STRATA_FIELD(SimMaterial, dissolutionRate),
-                                STRATA_FIELD(SimMaterial, tanTalus), STRATA_FIELD(SimMaterial, weatheringRatePerS)});
+                                STRATA_FIELD(SimMaterial, tanTalus), STRATA_FIELD(SimMaterial, weatheringRatePerS),
+                                STRATA_FIELD(SimMaterial, criticalShearPa), STRATA_FIELD(SimMaterial, shearErodibility),
+                                STRATA_FIELD(SimMaterial, settlingVelocityMS), STRATA_FIELD(SimMaterial, tanFriction),
+                                STRATA_FIELD(SimMaterial, sinFriction), STRATA_FIELD(SimMaterial, cosFriction),
+                                STRATA_FIELD(SimMaterial, cohesionHeightM), STRATA_FIELD(SimMaterial, pad0)});
   // SourceEntry is 8 bytes: its std430 struct alignment is 4, not the 16 the generic parser
   // assumes for structs holding vec4s, so only the offsets are compared.
   size_t size = 0;

@@ -157,15 +157,15 @@ TEST(SimCpu, SkippingQuietBlocksChangesNoBit) {
     expectSameBits(every, skipping, std::string(c.name) + ", first half");
 
     // From outside, mid-run: water poured on a dry patch of the west bank (as a halo exchange
-    // writes cells), the rain raster's patch left alone but the evaporation and the thermal
-    // rate changed, and a third solver continuing from a checkpoint of the skipping one.
+    // writes cells), the rain raster's patch left alone but the evaporation and the bank fill
+    // share changed, and a third solver continuing from a checkpoint of the skipping one.
     CellBlock patch = every.readBlock(10, 100, 6, 5, kBlockState);
     for (size_t i = 0; i < patch.cells(); ++i) patch.state[4 * i] += 0.8f;
     every.writeBlock(patch);
     skipping.writeBlock(patch);
     SimParams later = c.params;
     later.evaporationMmPerHour = 20.0f;
-    later.thermalRate = 0.3f;
+    later.bankFillShare = 0.3f;
     ASSERT_TRUE(every.setParams(later));
     ASSERT_TRUE(skipping.setParams(later));
     CpuSolver resumed = make(in, c.params, CpuOptions{1, true});

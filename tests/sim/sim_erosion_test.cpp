@@ -61,8 +61,7 @@ TEST(SimErosionCpu, ThermalWeatheringReachesTalusAndConserves) {
   }
   SimParams p;
   p.thermalEnabled = 1;
-  p.thermalRate = 0.5f;
-  p.maxDtS = 1.0f;  // sand and sediment move ~0.1 of their excess a second (E7): 3000 s
+  p.maxDtS = 1.0f;  // an excess of sand or sediment relaxes as exp(-0.1 t) (E7): 3000 s
   auto sim = CpuSolver::create(in, p);
   ASSERT_TRUE(sim) << sim.message();
   sim->step(3000);
@@ -87,8 +86,7 @@ TEST(SimErosionCpu, ThermalWeatheringReachesTalusAndConserves) {
   }
   const double rel = std::abs(st.materialM3 - st.initialMaterialM3) / st.initialMaterialM3;
   std::printf("thermal: worst slope excess over talus %.3g (tan units), material rel change %.3g\n", worst, rel);
-  // Each step removes half the largest excess times thermalRate, so the excess decays
-  // geometrically; 1e-3 (0.06 degrees at 1 m cells) is far above float rounding and far below
+  // The excess decays as exp(-r t); 1e-3 (0.06 degrees at 1 m cells) is far above float rounding and far below
   // any slope a user could see.
   EXPECT_LT(worst, 1e-3);
   // Pure transfers between float thicknesses of a few metres: rounding only.
@@ -114,8 +112,8 @@ LayerChange layerChange(const std::vector<gis::Grid<float>>& before, const std::
 }
 
 TEST(SimErosionCpu, MaterialBalanceClosesWithEverythingOn) {
-  // Rain, a spring, erosion, deposition, dissolution, thermal weathering and bank slippage, an
-  // open edge that carries sediment out, 20 m of rock under 4 m of sand (thick layers: a 1e-7 m
+  // Rain, a spring, erosion (the shear-stress law), deposition, dissolution, thermal weathering
+  // and bank failure, an open edge that carries sediment out, 20 m of rock under 4 m of sand (thick layers: a 1e-7 m
   // pick-up is below half an ulp of 4 m, which used to leave the layer unchanged and create the
   // material in the load). Layers + suspended + what left = the start, over 10,000 steps.
   const int w = 16, h = 32;
@@ -132,7 +130,7 @@ TEST(SimErosionCpu, MaterialBalanceClosesWithEverythingOn) {
       "everything on: %lld steps, %.0f s, material %.4f m3, layers moved %.2f m3, suspended %.4f m3, out %.4f m3, "
       "balance %.3g m3 (rel %.3g)\n",
       st.steps, st.timeS, st.initialMaterialM3, moved.volumeM3, st.suspendedM3, st.sedimentOutflowM3, balance, rel);
-  EXPECT_GT(moved.volumeM3, 20.0);       // the processes really ran
+  EXPECT_GT(moved.volumeM3, 3.0);        // the processes really ran (measured 7.7 m^3)
   EXPECT_GT(st.sedimentOutflowM3, 0.1);  // and carried material out through the edge
   // Each transfer moves a value its giver can lose exactly (E9); what is left is float32
   // rounding of the receivers (the load, thin deposits): measured 4e-11 over 10,000 steps;
@@ -142,7 +140,7 @@ TEST(SimErosionCpu, MaterialBalanceClosesWithEverythingOn) {
 
 TEST(SimErosionCpu, RainFilmOnAGentleSlopeMovesNoMaterial) {
   // 50 mm/h on a dry 22-degree sand slope (0.4, below sand's 32-degree talus): a film of a few
-  // mm, not flowing water of real depth, so no bank slips (E8) and nothing exceeds its talus
+  // mm with erosion off: no toe is scoured, so no bank falls (E8), and nothing exceeds its talus
   // angle (E7). Before, every cell under rain counted as a wet bank at half the angle and the
   // whole slope crept down.
   const int w = 16, h = 24;
@@ -217,57 +215,6 @@ TEST(SimErosionCpu, SandFilmOnRockSlidesAndTheRockStays) {
   EXPECT_LT(rel, 1e-6);
 }
 
-// Bank material moved after 2,000 steps of bankedChannel with the given water.
-enum class BankWater { kNone, kStill, kFlowing };
-double bankSlump(BankWater water) {
-  const int w = 16, h = 32;
-  auto in = test::bankedChannel(w, h, 5.0f, 1.0f);
-  auto p = test::bankParams();
-  if (water == BankWater::kStill) {
-    // A lake at rest in a closed box, its surface 0.6 m above the channel's middle: 0.1-1.2 m deep
-    // in the channel, the lower banks under water too.
-    in.waterDepthM = gis::Grid<float>(w, h);
-    const float surface = float(in.baseM.at(w / 2, h / 2) - in.datumM) + 6.0f + 0.6f;
-    for (int y = 0; y < h; ++y) {
-      for (int x = 0; x < w; ++x) {
-        const float bed = float(double(in.baseM.at(x, y)) - in.datumM) + 5.0f + 1.0f;
-        in.waterDepthM.at(x, y) = std::max(0.0f, surface - bed);
-      }
-    }
-  }
-  if (water == BankWater::kFlowing) p.openEdges = kEdgeSouth;
-  auto sim = CpuSolver::create(in, p);
-  EXPECT_TRUE(sim) << sim.message();
-  if (!sim) return -1;
-  if (water == BankWater::kFlowing) {
-    EXPECT_TRUE(sim->addSource(test::channelSpring(w)));
-  }
-  const auto before = sim->readLayers();
-  sim->step(2000);
-  const auto moved = layerChange(before, sim->readLayers(), 4.0);
-  const auto v = sim->readVelocity();
-  float fastest = 0;
-  for (size_t i = 0; i < v.uMS.size(); ++i) fastest = std::max(fastest, std::hypot(v.uMS.data[i], v.vMS.data[i]));
-  std::printf("bank beside %s water: material moved %.4f m3 (largest change %.3g m), fastest water %.3g m/s\n",
-              water == BankWater::kNone    ? "no"
-              : water == BankWater::kStill ? "still"
-                                           : "flowing",
-              moved.volumeM3, moved.maxM, fastest);
-  return moved.volumeM3;
-}
-
-TEST(SimErosionCpu, BankSlumpsBesideFlowingWaterOnly) {
-  // The banks stand at 24 degrees: stable dry (sand's talus is 32), unstable where flowing water
-  // of real depth undercuts them (E8: half the angle). A spring's flow down the channel makes
-  // them slump into it; the same banks beside a lake at rest, or dry, do not move at all.
-  const double flowing = bankSlump(BankWater::kFlowing);
-  const double still = bankSlump(BankWater::kStill);
-  const double none = bankSlump(BankWater::kNone);
-  EXPECT_GT(flowing, 1.0);  // measured ~m^3 of the 2 x 32 bank cells' sand
-  EXPECT_EQ(still, 0.0);
-  EXPECT_EQ(none, 0.0);
-}
-
 // The deepest cut (m of material lost in one cell) a spring makes in 3,000 steps down a 5% slope
 // of 2 m cells whose top 3 m are sand (soft) or rock (hard).
 double springCut(bool soft) {
@@ -282,11 +229,7 @@ double springCut(bool soft) {
     for (int x = 0; x < w; ++x) in.baseM.at(x, y) = float(500.0 + 0.1 * (h - y) + 0.02 * std::abs(x - w / 2 + 0.5));
   }
   auto p = test::bankParams();
-  p.erosionEnabled = true;
-  p.capacityK = 0.05f;
-  p.erosionRate = 0.05f;
-  p.depositionRate = 0.3f;
-  p.deepWaterM = 2.0f;
+  p.erosionEnabled = true;  // the shear-stress law
   p.openEdges = kEdgeSouth;
   auto sim = CpuSolver::create(in, p);
   EXPECT_TRUE(sim) << sim.message();
@@ -310,10 +253,10 @@ double springCut(bool soft) {
 }
 
 TEST(SimErosionCpu, SpringCutsDeeperInSoftMaterial) {
-  // Same slope, same spring: the pick-up rate scales with the topmost layer's erodibility (E2:
-  // sand 1.0, rock 0.05), so the channel in sand is much deeper.
+  // Same slope, same spring: entrainment is k_d (tau - tau_c) of the topmost layer (E2): sand's
+  // 0.25 Pa is far below the spring's ~25 Pa, weathered rock's 150 Pa far above it.
   const double soft = springCut(true), hard = springCut(false);
-  EXPECT_GT(soft, 0.02);
+  EXPECT_GT(soft, 0.004);  // measured 8.6 mm in 25 minutes
   EXPECT_GT(soft, 5.0 * hard);
 }
 

@@ -1,9 +1,11 @@
 #pragma once
-// Rain-on-grid cases with known answers (issue 30; shared/VALIDATION.md), shared by the CPU tests,
-// the GL tests and the benchmarks: the kinematic-wave plane, the V-catchment (Di Giammarco, Todini
-// and Lamberti 1996) and their reference solutions.
+// Rain-on-grid and morphodynamic cases with known answers or bounds (issue 30;
+// shared/VALIDATION.md), shared by the CPU tests, the GL tests and the benchmarks: the
+// kinematic-wave plane, the V-catchment (Di Giammarco, Todini and Lamberti 1996) and their
+// reference solutions, a channel, a gorge and a valley for erosion and bank failure.
 #include <algorithm>
 #include <cmath>
+#include <random>
 #include <vector>
 
 #include <strata/sim/input.hpp>
@@ -145,6 +147,100 @@ inline std::vector<double> vCatchmentKinematic(double i, double tRainS, double t
     out.push_back(channel.step(dtS, 2.0 * qPlane + rain * channelM));
   }
   return out;
+}
+
+/// A straight channel 20 m wide (columns 4-7 of 5 m cells) falling 2 % southwards over `lengthM`,
+/// between banks rising 1 m a cell, cut in 2 m of `bedMaterial` (a default material's index) over
+/// 5 m of rock, with `depositMaterial`'s grains as the load and the deposits; the channel bed
+/// carries uniform noise of +-`noiseM` (a fixed seed). Datum 100 m; the south edge is open. Feed
+/// it with channelInflow().
+inline sim::SimInput noisyChannel(double lengthM, double noiseM, int bedMaterial, int depositMaterial) {
+  const double cell = 5.0;
+  const int w = 12, h = int(std::lround(lengthM / cell));
+  sim::SimInput in;
+  in.baseM = gis::Grid<float>(w, h);
+  in.rowDxM = {cell};
+  in.dyM = cell;
+  in.datumM = 100.0;
+  const auto all = terrain::defaultMaterials();
+  auto deposit = all[size_t(depositMaterial)];
+  deposit.name = "sediment";
+  in.materials = {all[0], all[size_t(bedMaterial)], deposit};
+  in.layersM = {gis::Grid<float>(w, h, 5.0f), gis::Grid<float>(w, h, 2.0f), gis::Grid<float>(w, h, 0.0f)};
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> noise(-noiseM, noiseM);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const int away = std::max({0, 4 - x, x - 7});
+      const double bump = away == 0 ? noise(rng) : 0.0;
+      in.baseM.at(x, y) = float(in.datumM + 0.02 * (h - y - 0.5) * cell + 1.0 * away + bump);
+    }
+  }
+  return in;
+}
+/// `m3s` over the channel's first row.
+inline sim::Source channelInflow(double m3s) {
+  sim::Source s;
+  for (int x = 4; x <= 7; ++x) s.cells.push_back({x, 0});
+  s.dischargeM3S = TimeSeries::constant(m3s);
+  return s;
+}
+
+/// A valley 1 km long falling 2 % southwards on cells of `cellM`: a floor two cells wide between
+/// walls of six cells a side rising at `wallDeg`. `sandValley`: everything is sand 10 m thick on
+/// 10 m of rock; else the walls are rock 20 m thick and the floor carries 1 m of sand on it (a
+/// gorge). Layers rock, sand, sediment; datum 100 m; the south edge is open. Feed it with
+/// valleyStream().
+inline sim::SimInput valley(double cellM, double wallDeg, bool sandValley) {
+  const int wall = 6, w = 2 * wall + 2, h = int(std::lround(1000.0 / cellM));
+  const double rise = cellM * std::tan(wallDeg * 3.14159265358979 / 180.0);
+  sim::SimInput in;
+  in.baseM = gis::Grid<float>(w, h);
+  in.rowDxM = {cellM};
+  in.dyM = cellM;
+  in.datumM = 100.0;
+  const auto all = terrain::defaultMaterials();
+  in.materials = {all[0], all[2], all[3]};
+  in.layersM = {gis::Grid<float>(w, h, 0.0f), gis::Grid<float>(w, h, 0.0f), gis::Grid<float>(w, h, 0.0f)};
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const int away = std::max({0, wall - x, x - (wall + 1)});
+      const double surface = in.datumM + 0.02 * (h - y - 0.5) * cellM + rise * away;
+      const bool floor = away == 0;
+      if (sandValley) {
+        in.baseM.at(x, y) = float(surface - 20.0);
+        in.layersM[0].at(x, y) = 10.0f;
+        in.layersM[1].at(x, y) = 10.0f;
+      } else {
+        in.baseM.at(x, y) = float(surface - 20.0 - (floor ? 1.0 : 0.0));
+        in.layersM[0].at(x, y) = 20.0f;
+        in.layersM[1].at(x, y) = floor ? 1.0f : 0.0f;
+      }
+    }
+  }
+  return in;
+}
+inline bool valleyFloor(int x) { return x == 6 || x == 7; }
+/// `m3s` into the valley floor's first row.
+inline sim::Source valleyStream(double m3s) {
+  sim::Source s;
+  s.cells = {{6, 0}, {7, 0}};
+  s.dischargeM3S = TimeSeries::constant(m3s);
+  return s;
+}
+
+/// Flood mode with erosion (the shear-stress law) and thermal weathering / bank failure, Manning
+/// n, CFL 0.45, a step cap, the south edge open.
+inline sim::SimParams erosionFloodParams(float manningN, float maxStepS, bool thermal) {
+  sim::SimParams p;
+  p.waterModel = sim::WaterModel::kFiniteVolume;
+  p.cflAlpha = 0.45f;
+  p.maxDtS = maxStepS;
+  p.manningN = manningN;
+  p.openEdges = sim::kEdgeSouth;
+  p.erosionEnabled = true;
+  p.thermalEnabled = thermal;
+  return p;
 }
 
 }  // namespace strata::test

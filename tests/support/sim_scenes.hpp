@@ -173,6 +173,7 @@ inline sim::SimParams floodParams() {
 inline sim::SimParams erosionParams() {
   sim::SimParams p;
   p.waterModel = sim::WaterModel::kVirtualPipes;
+  p.erosionLaw = sim::ErosionLaw::kForceBased;  // pipes have no Manning n to give a shear stress
   p.maxDtS = 0.05f;
   p.pipeAreaM2 = 16.0f;
   p.rainMmPerHour = 50.0f;
@@ -229,8 +230,8 @@ inline sim::Source channelSpring(int w) {
 }
 
 /// Flood mode with friction (Manning 0.035; the frictionless pipes run a spring's sheet down a
-/// slope at tens of m/s), CFL 0.45, steps of at most 0.5 s; thermal weathering and bank slippage
-/// on, erosion off; closed edges, no rain.
+/// slope at tens of m/s), CFL 0.45, steps of at most 0.5 s; thermal weathering and bank failure
+/// on, erosion off (so no toe is scoured and no bank falls); closed edges, no rain.
 inline sim::SimParams bankParams() {
   sim::SimParams p;
   p.waterModel = sim::WaterModel::kFiniteVolume;
@@ -240,21 +241,16 @@ inline sim::SimParams bankParams() {
   p.dryDepthM = 1e-3f;
   p.thermalEnabled = true;
   p.slowWaterMS = 0.05f;
-  p.bankSlipRatePerS = 0.1f;
   return p;
 }
 
-/// bankParams with everything on: rain (50 mm/h), erosion, deposition and dissolution, thermal
-/// weathering and bank slippage, an open south edge, and the scenarios' dry depth (1e-6 m: rain
-/// films carry tiny loads everywhere). Feed bankedChannel with channelSpring.
+/// bankParams with everything on: rain (50 mm/h), erosion (the shear-stress law), deposition and
+/// dissolution, thermal weathering and bank failure, an open south edge, and the scenarios' dry
+/// depth (1e-6 m: rain films carry tiny loads everywhere). Feed bankedChannel with channelSpring.
 inline sim::SimParams everythingOnParams() {
   sim::SimParams p = bankParams();
   p.erosionEnabled = true;
   p.rainMmPerHour = 50.0f;
-  p.capacityK = 0.05f;
-  p.erosionRate = 0.5f;
-  p.depositionRate = 0.3f;
-  p.deepWaterM = 2.0f;
   p.dryDepthM = 1e-6f;
   p.openEdges = sim::kEdgeSouth;
   return p;

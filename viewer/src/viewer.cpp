@@ -373,12 +373,14 @@ Status Viewer::rebuildSimulation(const gis::Grid<float>& waterM) {
   for (float v : in.baseM.data) lo = std::min(lo, double(v));
   in.datumM = std::floor(lo);
   // The model as a scenario's [model] and [erosion]: flood mode, open edges; erosion with the
-  // viewer's interactive preset (docs/viewer.md): rates high enough to see channels within
-  // seconds of play, and a 1 mm dry depth so films of rain do not erode.
+  // viewer's interactive preset (docs/viewer.md): the force-based law of terrain authoring, rates
+  // high enough to see channels within seconds of play, and a 1 mm dry depth so films of rain do
+  // not erode.
   scenario::Scenario s;
   s.model.manningN = 0.03;
   s.model.maxStepS = 10.0;
   s.erosion.enabled = reg.erosion;
+  s.erosion.law = sim::ErosionLaw::kForceBased;
   s.erosion.thermal = false;
   s.erosion.capacity = 0.05;
   s.erosion.erosionRate = 0.5;

@@ -28,17 +28,27 @@ GpuSimParams gpuParams(const SimParams& p, const CellGrid& grid, float dtS) {
   g.deepWaterM = p.deepWaterM;
   g.minSinTilt = p.minSinTilt;
   g.slowWaterMS = p.slowWaterMS;
-  g.thermalRate = p.thermalRate;
-  g.wetTalusScale = p.wetTalusScale;
-  g.maxErosionPerStepM = p.maxErosionPerStepM;
+  g.erosionLaw = int32_t(p.erosionLaw);
+  g.waterDensityKgM3 = p.waterDensityKgM3;
+  g.bankFillShare = p.bankFillShare;
   g.slopeLimiter = int32_t(p.slopeLimiter);
-  g.bankDepthM = p.bankDepthM;
-  g.bankSlipRatePerS = p.bankSlipRatePerS;
   return g;
 }
 
 GpuMaterial gpuMaterial(const MaterialConstants& m) {
-  return {m.erodibility, m.dissolutionRate, m.tanTalus, m.weatheringRatePerS};
+  GpuMaterial g;
+  g.erodibility = m.erodibility;
+  g.dissolutionRate = m.dissolutionRate;
+  g.tanTalus = m.tanTalus;
+  g.weatheringRatePerS = m.weatheringRatePerS;
+  g.criticalShearPa = m.criticalShearPa;
+  g.shearErodibility = m.shearErodibility;
+  g.settlingVelocityMS = m.settlingVelocityMS;
+  g.tanFriction = m.tanFriction;
+  g.sinFriction = m.sinFriction;
+  g.cosFriction = m.cosFriction;
+  g.cohesionHeightM = m.cohesionHeightM;
+  return g;
 }
 
 }  // namespace strata::sim

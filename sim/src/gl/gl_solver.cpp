@@ -30,7 +30,7 @@ struct GlSolver::Impl {
   int layers = 0;
 
   gl::Buffer params, materials, rowDx, base, bed, layerBuf, stateA, stateB, stage, flux, fluxDiag, faceX, faceY, tilt,
-      accum, rain, thermal, sourceEntries, maxSpeed, floodStats, fvLimit, levelEntries;
+      accum, rain, thermal, scour, sourceEntries, maxSpeed, floodStats, fvLimit, levelEntries;
   bool aIsCurrent = true;
   gl::Program pSources, pPointSources, pWaveSpeed, pPipeFlux, pPipeUpdate, pFvFace, pFvLimit, pFvUpdate, pErode,
       pThermalFlux, pThermalApply, pFloodStats, pLevel, pCopyRect, pBedRect;
@@ -59,6 +59,7 @@ struct GlSolver::Impl {
     accum.bind(slots::kAccum);
     rain.bind(slots::kRain);
     thermal.bind(slots::kThermal);
+    scour.bind(slots::kScour);
     sourceEntries.bind(slots::kSources);
     maxSpeed.bind(slots::kMaxSpeed);
     fvLimit.bind(slots::kFvLimit);
@@ -301,6 +302,8 @@ Result<GlSolver> GlSolver::create(const SimInput& input, const SimParams& params
   s.rain = gl::Buffer::from(std::span<const float>(rain));
   s.thermal = gl::Buffer(16 * n);
   s.thermal.fill(0u);
+  s.scour = gl::Buffer(4 * n);
+  s.scour.fill(0u);
   s.sourceEntries = gl::Buffer(sizeof(SourceEntry) * 16);
   s.maxSpeed = gl::Buffer(4);
   s.maxSpeedHost = gl::Buffer(4, nullptr, gl::BufferStorage::kReadback);
@@ -322,6 +325,8 @@ void GlSolver::onParamsChanged() {
   Impl& s = *impl_;
   s.p = gpuParams(params(), grid(), s.p.dtS);
   s.params.upload(0, sizeof(GpuSimParams), &s.p);
+  // No erosion, no toe scour (E8): what the last erosion pass left must not bring banks down.
+  if (!params().erosionEnabled) s.scour.fill(0u);
 }
 
 double GlSolver::maxWaveSpeedMS() const { return impl_->maxWaveSpeed(); }
@@ -339,9 +344,9 @@ size_t GlSolver::gpuBytes() const {
   const Impl& s = *impl_;
   size_t total = 0;
   for (const gl::Buffer* b :
-       {&s.params, &s.materials, &s.rowDx,   &s.base,          &s.bed,      &s.layerBuf,   &s.stateA,
-        &s.stateB, &s.stage,     &s.flux,    &s.fluxDiag,      &s.faceX,    &s.faceY,      &s.tilt,
-        &s.accum,  &s.rain,      &s.thermal, &s.sourceEntries, &s.maxSpeed, &s.floodStats, &s.fvLimit}) {
+       {&s.params,  &s.materials, &s.rowDx,         &s.base,     &s.bed,        &s.layerBuf, &s.stateA, &s.stateB,
+        &s.stage,   &s.flux,      &s.fluxDiag,      &s.faceX,    &s.faceY,      &s.tilt,     &s.accum,  &s.rain,
+        &s.thermal, &s.scour,     &s.sourceEntries, &s.maxSpeed, &s.floodStats, &s.fvLimit}) {
     total += b->size();
   }
   return total;

@@ -121,9 +121,21 @@ struct Scenario {
 
   struct {
     bool enabled = false;
-    double capacity = 0.05, erosionRate = 0.01, depositionRate = 0.01, dissolutionRate = 0.0;
+    /// E1-E3 (docs/sim-erosion.md): the materials' shear-stress constants, or the force-based
+    /// law's model constants below.
+    sim::ErosionLaw law = sim::ErosionLaw::kShearStress;
+    double capacity = 0.05, erosionRate = 0.01, depositionRate = 0.01;  ///< the force-based law's Kc, Ks, Kd
     bool thermal = true;
   } erosion;
+
+  /// [materials.NAME]: a material's constants changed for this run (docs/scenario.md); unset
+  /// fields keep the store's or the default's.
+  struct MaterialChange {
+    std::string name;
+    std::optional<double> criticalShearPa, shearErodibility, settlingVelocityMS, frictionAngleDeg, cohesionPa,
+        talusAngleDeg, weatheringRatePerS, dissolutionRate, erodibility;
+  };
+  std::vector<MaterialChange> materials;
 
   struct {
     std::vector<Inflow> inflows;
@@ -159,7 +171,8 @@ Result<Scenario> loadScenario(const std::filesystem::path& file);
 /// The same from text; `fileName` is used in messages and to resolve relative paths.
 Result<Scenario> parseScenario(std::string_view text, const std::filesystem::path& fileName);
 
-/// "6 h" -> 21600. `dimension` is "time", "length", "rate" (m/s), "discharge" (m3/s) or "speed".
+/// "6 h" -> 21600. `dimension` is "time", "length", "rate" (m/s), "discharge" (m3/s), "speed" or
+/// "stress" (Pa).
 Result<double> parseQuantity(std::string_view text, std::string_view dimension);
 
 /// "auto", "cpu" or "gpu" (the [model] backend key and the --backend option).

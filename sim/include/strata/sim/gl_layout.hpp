@@ -37,30 +37,37 @@ struct GpuSimParams {
   float deepWaterM = 1.0f;
   float minSinTilt = 0.05f;
   float slowWaterMS = 0.1f;
-  float thermalRate = 0.5f;
-  float wetTalusScale = 0.5f;
-  float maxErosionPerStepM = 0.01f;
+  int32_t erosionLaw = 0;
+  float waterDensityKgM3 = 1000.0f;
+  float bankFillShare = 0.5f;
   int32_t slopeLimiter = 0;
-  float bankDepthM = 0.1f;
-  float bankSlipRatePerS = 0.01f;
-  float pad0 = 0.0f, pad1 = 0.0f;  ///< std430 rounds the block to 16 bytes
+  float pad0 = 0.0f, pad1 = 0.0f, pad2 = 0.0f, pad3 = 0.0f;  ///< std430 rounds the block to 16 bytes
 };
 static_assert(sizeof(GpuSimParams) == 128);
 static_assert(offsetof(GpuSimParams, dyM) == 32);
 static_assert(offsetof(GpuSimParams, dtS) == 40);
 static_assert(offsetof(GpuSimParams, manningN) == 60);
 static_assert(offsetof(GpuSimParams, capacityK) == 72);
-static_assert(offsetof(GpuSimParams, maxErosionPerStepM) == 104);
+static_assert(offsetof(GpuSimParams, bankFillShare) == 104);
 
-/// std430 mirror of `SimMaterial`.
+/// std430 mirror of `SimMaterial` (MaterialConstants).
 struct GpuMaterial {
   float erodibility = 1.0f;
   float dissolutionRate = 0.0f;
   float tanTalus = 0.7f;
   float weatheringRatePerS = 0.1f;
+  float criticalShearPa = 1.0f;
+  float shearErodibility = 2e-7f;
+  float settlingVelocityMS = 0.02f;
+  float tanFriction = 0.58f;
+  float sinFriction = 0.5f;
+  float cosFriction = 0.87f;
+  float cohesionHeightM = 0.0f;
+  float pad0 = 0.0f;
 };
-static_assert(sizeof(GpuMaterial) == 16);
+static_assert(sizeof(GpuMaterial) == 48);
 static_assert(offsetof(GpuMaterial, tanTalus) == 8);
+static_assert(offsetof(GpuMaterial, cohesionHeightM) == 40);
 
 /// The block the kernels read, from the parameters, the grid and the current step.
 GpuSimParams gpuParams(const SimParams& params, const CellGrid& grid, float dtS);

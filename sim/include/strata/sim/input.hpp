@@ -41,13 +41,18 @@ struct LevelBoundary {
   TimeSeries stageM;                       ///< (time s, water surface elevation m, the reference of SimInput::baseM)
 };
 
-/// A material's constants as the erosion passes use them (E2, E4, E7): both backends take them
-/// from here, so they agree to the bit.
+/// A material's constants as the erosion passes use them (E1-E8): both backends take them from
+/// here, so they agree to the bit.
 struct MaterialConstants {
-  float erodibility = 1.0f;         ///< terrain::Material::erodibility (dimensionless)
-  float dissolutionRate = 0.0f;     ///< m of material per m of water per s
-  float tanTalus = 0.7f;            ///< tan(terrain::Material::talusAngleDeg)
-  float weatheringRatePerS = 0.1f;  ///< terrain::Material::weatheringRatePerS (1/s)
+  float erodibility = 1.0f;          ///< terrain::Material::erodibility (dimensionless, force-based law)
+  float dissolutionRate = 0.0f;      ///< m of material per m of water per s
+  float tanTalus = 0.7f;             ///< tan(terrain::Material::talusAngleDeg)
+  float weatheringRatePerS = 0.1f;   ///< terrain::Material::weatheringRatePerS (1/s)
+  float criticalShearPa = 1.0f;      ///< tau_c (Pa)
+  float shearErodibility = 2e-7f;    ///< k_d (m/(s Pa))
+  float settlingVelocityMS = 0.02f;  ///< w_s (m/s)
+  float tanFriction = 0.58f, sinFriction = 0.5f, cosFriction = 0.87f;  ///< of the wet bank's friction angle phi'
+  float cohesionHeightM = 0.0f;  ///< 4 c' / gamma (m): Culmann's critical bank height scale (E8)
 };
 MaterialConstants materialConstants(const terrain::Material& m);
 

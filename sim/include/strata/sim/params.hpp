@@ -22,6 +22,18 @@ enum class SlopeLimiter : int32_t {
   kMonotonizedCentral = 1,  ///< van Leer's MC: sharper fronts and smooth flow (Ritter front lag as dx^0.5, not dx^0.3)
 };
 
+/// What moves material between the bed and the water (docs/sim-erosion.md, E1-E3).
+enum class ErosionLaw : int32_t {
+  /// Entrainment from the excess bed shear stress of each material, E = k_d (tau - tau_c) with
+  /// Manning's tau = rho g n^2 |u|^2 / h^(1/3) (Partheniades 1965; Hanson and Simon 2001), and
+  /// deposition at the settling velocity, D = w_s c (Hairsine and Rose 1992): physical units,
+  /// the materials' constants (terrain::Material), needs flood mode's Manning n.
+  kShearStress = 0,
+  /// The seed systems' force-based capacity (Stava et al. 2008): C = Kc sin(tilt) |v| (1 - h /
+  /// deepWaterM), picked up at Ks, dropped at Kd. Model constants, for authoring terrain.
+  kForceBased = 1,
+};
+
 /// Bits of SimParams::openEdges: an open edge lets water flow out freely (and counts it);
 /// a closed one is a wall.
 enum EdgeBits : uint32_t { kEdgeWest = 1u, kEdgeEast = 2u, kEdgeNorth = 4u, kEdgeSouth = 8u };
@@ -33,7 +45,7 @@ struct SimParams {
   SlopeLimiter slopeLimiter = SlopeLimiter::kMinmod;  ///< flood mode's W21 slopes
   uint32_t openEdges = 0;                             ///< EdgeBits; 0 = closed box
   bool erosionEnabled = false;                        ///< erosion, deposition, dissolution and transport (E1-E6)
-  bool thermalEnabled = false;                        ///< thermal weathering and bank slippage (E7-E8)
+  bool thermalEnabled = false;                        ///< weathering of slopes and bank failure (E7-E8)
   bool diagonalPipes = false;         ///< pipes model with 8 pipes (diagonals too), no axis-aligned gullies (W1b)
   float gravityMS2 = 9.81f;           ///< g (m/s^2)
   float maxDtS = 0.05f;               ///< fixed step, or the upper bound of the adaptive one (s)
@@ -43,17 +55,18 @@ struct SimParams {
   float manningN = 0.0f;              ///< Manning's n (s m^-1/3), flood mode; 0 = frictionless (W19)
   float rainMmPerHour = 0.0f;         ///< uniform rain (mm/h), added to the rain raster
   float evaporationMmPerHour = 0.0f;  ///< evaporation from wet cells (mm/h) (W11)
-  float capacityK = 0.0f;             ///< sediment capacity constant Kc (s) (E1)
-  float erosionRate = 0.0f;           ///< Ks: fraction of the capacity deficit picked up per second (1/s) (E2)
-  float depositionRate = 0.0f;        ///< Kd: fraction of the excess dropped per second (1/s) (E3)
-  float deepWaterM = 1.0f;            ///< capacity falls linearly to 0 at this depth (m) (E1)
-  float minSinTilt = 0.05f;           ///< floor of sin(tilt) so flat beds still carry sediment (E1)
-  float slowWaterMS = 0.1f;           ///< dissolution acts where |v| is below this (m/s) (E4)
-  float thermalRate = 0.5f;           ///< cap on the share of the talus excess moved in one step, in (0,1] (E7)
-  float wetTalusScale = 0.5f;         ///< talus tangent multiplier for banks above flowing water (E8)
-  float bankDepthM = 0.1f;            ///< water deeper than this (and faster than slowWaterMS) undercuts a bank (E8)
-  float bankSlipRatePerS = 0.01f;     ///< rate at which an undercut bank slips (1/s) (E8)
-  float maxErosionPerStepM = 0.01f;   ///< cap on material moved by E2/E4 in one step (m)
+  ErosionLaw erosionLaw =
+      ErosionLaw::kShearStress;      ///< E1-E3 (the materials' constants, or the force-based ones below)
+  float waterDensityKgM3 = 1000.0f;  ///< rho of the bed shear stress (E1)
+  float capacityK = 0.0f;            ///< force-based law: sediment capacity constant Kc (s) (E1)
+  float erosionRate = 0.0f;          ///< force-based law: Ks, the capacity deficit's pick-up rate (1/s) (E2)
+  float depositionRate = 0.0f;       ///< force-based law: Kd, the excess's settling rate (1/s) (E3)
+  float deepWaterM = 1.0f;           ///< force-based law: capacity falls linearly to 0 at this depth (m) (E1)
+  float minSinTilt = 0.05f;          ///< force-based law: floor of sin(tilt) so flat beds still carry sediment (E1)
+  float slowWaterMS = 0.1f;          ///< dissolution acts where |v| is below this (m/s) (E4)
+  /// E8: the share of what the flow took off a cell in a step (its toe scour) that each bank
+  /// failing into it may bring down in that step (the slumped volume is bounded by the undercut).
+  float bankFillShare = 0.5f;
 };
 
 /// Checks the parameters (finite, ranges, the model's own constraints); the message names the
