@@ -27,7 +27,7 @@ if [ "${1:-}" = "--sanitize" ]; then
   # The longest tests (15 s or more in the normal build, several times that under the
   # sanitizers) run in the normal pass only; every code path they take is also taken by a
   # shorter test here. Keeps CI (both passes and the fuzzing) within about 25 minutes.
-  ctest_args=(-E 'StrataIngest\.(CtrlCStops|RefusesBadNumbers|TwoHalvesMosaic)|StrataExport\.NeverOverwrites|SimWaterCpu\.FloodRitterDryDamBreak|SimCpu\.SkippingQuietBlocksChangesNoBit|GlTest\.SimLakeAtRestStaysFlat|GlTest\.SimRainPlaneHoldsTheKinematicWaveAtEveryStep|SimRunoffCpu\.VCatchment')
+  ctest_args=(-E 'StrataIngest\.(CtrlCStops|RefusesBadNumbers|TwoHalvesMosaic)|StrataExport\.NeverOverwrites|SimWaterCpu\.FloodRitterDryDamBreak|SimCpu\.SkippingQuietBlocksChangesNoBit|GlTest\.SimLakeAtRestStaysFlat|GlTest\.SimRainPlaneHoldsTheKinematicWaveAtEveryStep|SimRunoffCpu\.VCatchment|SimMorphoCpu\.(Channel|RockGorge|SandBanks)')
 fi
 [ "${1:-}" = "--" ] && shift
 

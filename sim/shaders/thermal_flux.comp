@@ -47,10 +47,10 @@ void main() {
       const float e = dr - m.tanTalus * dist[d];
       const float weather = 0.5 * ((e > noise[d] ? e : 0.0) * share);
       const float ef = dr - m.tanFriction * dist[d];
+      // Culmann: drop > H_c, times len / drop, with sin(beta) = drop / len and
+      // len cos(beta - phi') = dist cos(phi') + drop sin(phi').
       const float len = sqrt(dr * dr + dist[d] * dist[d]);
-      const float sinB = dr / len, cosB = dist[d] / len;
-      const float cosBP = cosB * m.cosFriction + sinB * m.sinFriction;  // cos(beta - phi')
-      const bool fails = ef > noise[d] && dr * (1.0 - cosBP) > m.cohesionHeightM * (sinB * m.cosFriction);
+      const bool fails = ef > noise[d] && len - (dist[d] * m.cosFriction + dr * m.sinFriction) > m.cohesionHeightM * m.cosFriction;
       const float slump = fails ? min(0.5 * ef, credit[d]) : 0.0;
       want[d] = max(weather, slump);
       maxW = max(maxW, want[d]);

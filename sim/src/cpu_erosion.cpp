@@ -24,8 +24,9 @@ struct Stack {
 struct ErosionConst {
   float dt, dry, rhoGn2;  // rhoGn2: rho g n^2 of the bed shear stress (E1)
   bool forceBased;        // ErosionLaw::kForceBased
-  float deepWater, capacityK, minSinTilt, erosionRate, depositionRate, slowWater, settling;
-  const float *erodibility, *dissolutionRate, *criticalShear, *shearErodibility;  // per layer
+  float deepWater, capacityK, minSinTilt, dropShare, slowWater, settling;
+  // per layer; pickShare: the force-based law's 1 - exp(-Ks erodibility dt)
+  const float *pickShare, *dissolutionRate, *criticalShear, *shearErodibility;
 };
 
 struct ThermalConst {
@@ -142,16 +143,21 @@ inline float oneMinusExp(float a) {
 // exchange does not depend on it.
 inline float relaxShare(float l) {
   const float series = 1.0f - l * (0.5f - l * (1.0f / 6.0f));
-  const float exact = (1.0f - std::exp(-l)) / l;
-  return l < 1e-3f ? series : exact;
+  const float lw = maxOf(l, 1e-3f);  // never a division by 0, even on the side not used
+  const float exact = (1.0f - expNeg(lw)) / lw;
+  // The series below 1e-3 (no cancellation), as arithmetic: GCC 12 makes a branch of the select
+  // in the AVX2 clone, and the loop around it stops vectorising.
+  const float small = float(l < 1e-3f);
+  return exact + small * (series - exact);
 }
 
 // sim/shaders/erode.comp for one cell: E1-E3 (the step's net exchange between the bed and the
 // load), E4 (dissolution), E6 (settling where dry); what the flow took off the bed goes to
 // `scour` (E8's toe).
-template <int kL>
+template <int kL, bool kForceBased>
 inline void erodeCell(const ErosionConst& c, const Stack& st, float* s, float* bed, const float* base, const float* h,
-                      const float* hu, const float* hv, const float* tilt, float* scour, int x) {
+                      const float* hu, const float* hv, const float* tilt, float* scour, const float* shear,
+                      const float* relax, int x) {
   const int n = kL > 0 ? kL : st.count, sedimentLayer = n - 1;
   const float hx = h[x], sx = s[x];
   const bool wet = hx > c.dry;
@@ -160,22 +166,22 @@ inline void erodeCell(const ErosionConst& c, const Stack& st, float* s, float* b
   const float speed = std::sqrt(q2) / hw;
   const int top = topLayer<kL>(st, x);
   const float topLayerM = layerAt<kL>(st, x, top);
-  // E1-E3, shear-stress law: tau = rho g n^2 |u|^2 / h^(1/3); the load s relaxes towards
-  // E h / w_s at the rate w_s / h, entrainment E = k_d (tau - tau_c) of the topmost layer.
-  const float tau = c.rhoGn2 * (q2 / (hw * hw)) / std::pow(hw, 1.0f / 3.0f);
-  const float excess = maxOf(tau - materialAt<kL>(c.criticalShear, n, top), 0.0f);
-  const float entrain = top >= 0 ? materialAt<kL>(c.shearErodibility, n, top) * excess : 0.0f;
-  const float lambda = c.settling * c.dt / hw;
-  const float netShear = (entrain - c.settling * sx / hw) * c.dt * relaxShare(lambda);
-  // E1-E3, force-based law: capacity C from tilt and speed, falling to 0 in deep water; the load
-  // relaxes towards C at Ks erodibility (below it) or Kd (above it).
-  const float shallow = 1.0f - hx / c.deepWater;  // std::clamp(shallow, 0, 1), as values
-  const float depthFactor = shallow < 0.0f ? 0.0f : (1.0f < shallow ? 1.0f : shallow);
-  const float capacity = c.capacityK * maxOf(tilt[x], c.minSinTilt) * speed * depthFactor;
-  const float gap = capacity - sx;
-  const float rate = gap > 0.0f ? c.erosionRate * materialAt<kL>(c.erodibility, n, top) : c.depositionRate;
-  const float netForce = gap * oneMinusExp(rate * c.dt);
-  const float net = c.forceBased ? netForce : netShear;  // > 0: the flow takes from the bed
+  float net;  // > 0: the flow takes from the bed
+  if constexpr (!kForceBased) {
+    // E1-E3, shear-stress law: tau = rho g n^2 |u|^2 / h^(1/3); the load s relaxes towards
+    // E h / w_s at the rate w_s / h, entrainment E = k_d (tau - tau_c) of the topmost layer.
+    const float excess = maxOf(shear[x] - materialAt<kL>(c.criticalShear, n, top), 0.0f);
+    const float entrain = materialAt<kL>(c.shearErodibility, n, top) * excess;  // 0 for top = -1
+    net = (entrain - c.settling * sx / hw) * c.dt * relax[x];
+  } else {
+    // E1-E3, force-based law: capacity C from tilt and speed, falling to 0 in deep water; the
+    // load relaxes towards C at Ks erodibility (below it) or Kd (above it).
+    const float shallow = 1.0f - hx / c.deepWater;  // std::clamp(shallow, 0, 1), as values
+    const float depthFactor = shallow < 0.0f ? 0.0f : (1.0f < shallow ? 1.0f : shallow);
+    const float capacity = c.capacityK * maxOf(tilt[x], c.minSinTilt) * speed * depthFactor;
+    const float gap = capacity - sx;
+    net = gap * (gap > 0.0f ? materialAt<kL>(c.pickShare, n, top) : c.dropShare);
+  }
   // E2: the flow takes from the topmost layer.
   const float eroded = exactTake(topLayerM, minOf(maxOf(net, 0.0f), topLayerM));
   const bool erode = wet & (net > 0.0f) & (top >= 0);
@@ -205,20 +211,43 @@ inline void erodeCell(const ErosionConst& c, const Stack& st, float* s, float* b
 }  // namespace
 
 // erode.comp for the cells [x0, x1) of a row.
+// E1's bed shear stress and E2-E3's relaxation share of each cell of a row, for the shear-stress
+// law: plain arithmetic in a loop of its own, which vectorises (the layer walk of the cell loop
+// does not: GCC 12 keeps branches in it).
+STRATA_ROW_KERNEL void shearRow(const ErosionConst& c, const float* h, const float* hu, const float* hv, float* shear,
+                                float* relax, int x0, int x1) {
+#pragma omp simd
+  for (int x = x0; x < x1; ++x) {
+    const float hw = h[x] > c.dry ? h[x] : 1.0f;
+    const float q2 = hu[x] * hu[x] + hv[x] * hv[x];
+    shear[x] = c.rhoGn2 * (q2 / (hw * hw)) / cubeRoot(hw);  // rho g n^2 |u|^2 / h^(1/3)
+    relax[x] = relaxShare(c.settling * c.dt / hw);
+  }
+}
+
 STRATA_ROW_KERNEL void erosionRow(const ErosionConst& c, const Stack& st, float* s, float* bed, const float* base,
                                   const float* h, const float* hu, const float* hv, const float* tilt, float* scour,
-                                  int x0, int x1) {
-  withLayerCount(st.count, [&](auto kL) {
+                                  float* shear, float* relax, int x0, int x1) {
+  if (!c.forceBased) shearRow(c, h, hu, hv, shear, relax, x0, x1);
+  auto cells = [&](auto kForce) {
+    withLayerCount(st.count, [&](auto kL) {
 #pragma omp simd
-    for (int x = x0; x < x1; ++x) erodeCell<decltype(kL)::value>(c, st, s, bed, base, h, hu, hv, tilt, scour, x);
-  });
+      for (int x = x0; x < x1; ++x) {
+        erodeCell<decltype(kL)::value, decltype(kForce)::value>(c, st, s, bed, base, h, hu, hv, tilt, scour, shear,
+                                                                relax, x);
+      }
+    });
+  };
+  c.forceBased ? cells(std::true_type{}) : cells(std::false_type{});
 }
 
 // sim/shaders/erode.comp: E1-E4 (the exchange between bed and load, dissolution); E6 (settling
 // when dry); the toe scour of E8. Purely local: each cell reads and writes only itself. Runs over the active blocks: in
 // a quiet cell (no water, no load) it changes nothing.
 void Impl::erosionPass() {
-  forRuns(water, [&](const Run& r, int) {
+  pickShare.resize(erodibility.size());
+  for (size_t l = 0; l < erodibility.size(); ++l) pickShare[l] = oneMinusExp(p.erosionRate * erodibility[l] * dt);
+  forRuns(water, [&](const Run& r, int thread) {
     const ErosionConst c{dt,
                          p.dryDepthM,
                          p.waterDensityKgM3 * p.gravityMS2 * p.manningN * p.manningN,
@@ -226,18 +255,18 @@ void Impl::erosionPass() {
                          p.deepWaterM,
                          p.capacityK,
                          p.minSinTilt,
-                         p.erosionRate,
-                         p.depositionRate,
+                         oneMinusExp(p.depositionRate * dt),
                          p.slowWaterMS,
                          settling,
-                         erodibility.data(),
+                         pickShare.data(),
                          dissolutionRate.data(),
                          criticalShear.data(),
                          shearErodibility.data()};
     Water& u = now();
+    Plane& sc = erosionScratch[size_t(thread)];
     for (int y = r.y0; y < r.y1; ++y) {
       erosionRow(c, Stack{layers.row(y), layerStride, L}, u.s.row(y), bed.row(y), base.row(y), u.h.row(y), u.hu.row(y),
-                 u.hv.row(y), tilt.row(y), scour.row(y), r.x0, r.x1);
+                 u.hv.row(y), tilt.row(y), scour.row(y), sc.row(0), sc.row(1), r.x0, r.x1);
     }
   });
 }
@@ -269,10 +298,10 @@ inline LayerWants layerWants(const ThermalConst& c, int l, const bool in[4], con
     const float e = drop[d] - tanT * dist[d];
     const float weather = 0.5f * ((e > noise[d] ? e : 0.0f) * share);
     const float ef = drop[d] - tanF * dist[d];
+    // Culmann: drop > H_c, times len / drop (> 0 where ef > 0), with sin(beta) = drop / len and
+    // len cos(beta - phi') = dist cos(phi') + drop sin(phi'): no division.
     const float len = std::sqrt(drop[d] * drop[d] + dist[d] * dist[d]);
-    const float sinB = drop[d] / len, cosB = dist[d] / len;
-    const float cosBP = cosB * cosF + sinB * sinF;  // cos(beta - phi')
-    const bool fails = (ef > noise[d]) & (drop[d] * (1.0f - cosBP) > hc * (sinB * cosF));
+    const bool fails = (ef > noise[d]) & (len - (dist[d] * cosF + drop[d] * sinF) > hc * cosF);
     const float slump = fails ? minOf(0.5f * ef, credit[d]) : 0.0f;
     r.want[d] = in[d] ? maxOf(weather, slump) : 0.0f;
     r.maxW = maxOf(r.maxW, r.want[d]);
@@ -359,9 +388,12 @@ STRATA_ROW_KERNEL void thermalFluxRow(const ThermalConst& c, const ThermalRow& r
     constexpr int kLayers = decltype(kL)::value;
     forRowCells(x0, x1, c.w, r.y == 0 || r.y == c.h - 1,
                 [&](auto e, int x) { thermalFluxTopCell<decltype(e)::value, kLayers>(c, r, st, x); });
-    // Where the topmost layer sheds, it may go whole and the layers below shed too: the full cell.
+    // Where the topmost layer sheds all of itself (to rounding: what it sends may sum to a hair
+    // under the thickness), the layers below shed too: the full cell, whose first layer repeats
+    // the same arithmetic. Elsewhere the topmost layer's result is the cell's.
     for (int x = x0; x < x1; ++x) {
-      if ((r.out[0][x] != 0.0f) | (r.out[1][x] != 0.0f) | (r.out[2][x] != 0.0f) | (r.out[3][x] != 0.0f)) {
+      const float sent = r.out[0][x] + r.out[1][x] + r.out[2][x] + r.out[3][x];
+      if (sent > 0.0f && sent >= 0.999f * layerAt<kLayers>(st, x, topLayer<kLayers>(st, x))) {
         thermalFluxCell<true, kLayers>(c, r, st, x);
       }
     }

@@ -93,6 +93,7 @@ struct Impl {
   std::vector<float> tanFriction, sinFriction, cosFriction, cohesionHeight;
   float settling = 0.0f;              // w_s of the deposit (top) layer's material: the suspended load's (E3)
   std::vector<float> thermalShare;    // per layer: E7's share of the excess moved this step
+  std::vector<float> pickShare;       // per layer: the force-based law's share of the deficit picked up this step
   std::vector<float> rowDx, rowArea;  // per row: dx and the cell area dx * dy
   std::vector<float> faceWidthY;      // per y-face (height + 1): the mean of the two rows' dx
 
@@ -110,12 +111,13 @@ struct Impl {
   Plane scour;                 // what the flow took off each cell this step (m), the toe a bank may fall into (E8)
   Plane flood[4];              // max depth, max speed, arrival, wet duration
   // flood mode's intermediates
-  Water stage;                 // the Heun predictor U1
-  Faces faceX, faceY;          // (w + 1) x h and w x (h + 1) faces
-  Plane srcX, srcY;            // W23 bed source of the step (the predictor's, then the Heun mean)
-  Plane limit;                 // W25: the share of its outflow a cell can give
-  Plane den;                   // E5: max(h A, limited outflow dt), the volume a cell's sediment share is of
-  std::vector<Plane> scratch;  // per thread: the face pass's rows of primitives and face values
+  Water stage;                        // the Heun predictor U1
+  Faces faceX, faceY;                 // (w + 1) x h and w x (h + 1) faces
+  Plane srcX, srcY;                   // W23 bed source of the step (the predictor's, then the Heun mean)
+  Plane limit;                        // W25: the share of its outflow a cell can give
+  Plane den;                          // E5: max(h A, limited outflow dt), the volume a cell's sediment share is of
+  std::vector<Plane> scratch;         // per thread: the face pass's rows of primitives and face values
+  std::vector<Plane> erosionScratch;  // per thread: a row of E1's shear stress and one of E2-E3's relaxation share
 
   float dt = 0.0f;
   bool anySuspended = false;  // some cell may carry sediment (sediment transport can be skipped otherwise)

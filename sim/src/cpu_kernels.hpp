@@ -5,7 +5,9 @@
 // the bits the branchy form gives.
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 
 // The row kernels (the loops over a row's cells) are built twice, for baseline x86-64 (SSE2) and
 // for x86-64-v3 (AVX2), and the loader picks one for the machine (GCC's function multiversioning;
@@ -31,6 +33,40 @@ constexpr float kForceNoise = 16.0f * 1.1920929e-7f;
 // loop from vectorising.
 inline float minOf(float a, float b) { return b < a ? b : a; }
 inline float maxOf(float a, float b) { return a < b ? b : a; }
+
+// x^(1/3) for x > 0 (normal floats), in arithmetic a vector loop can hold (std::pow and std::cbrt
+// are scalar library calls, and a call stops GCC from vectorising the loop around it): the
+// exponent divided by 3 on the bits (within 4 % of the root), then four Newton steps
+// y <- (2 y + x / y^2) / 3, which square the relative error each: within 2 ulp of std::cbrt over
+// 1e-30 .. 1e30 (SimCpu.VectorMathMatchesTheLibrary). The GLSL kernels use pow().
+inline float cubeRoot(float x) {
+  const uint32_t bits = std::bit_cast<uint32_t>(x);
+  float y = std::bit_cast<float>(bits / 3u + 709921077u);
+  for (int i = 0; i < 4; ++i) y = (2.0f * y + x / (y * y)) * (1.0f / 3.0f);
+  return y;
+}
+
+// exp(-a) for a >= 0, in vector-loop arithmetic (as cubeRoot): a = n ln 2 + x with n the nearest
+// integer and |x| <= ln 2 / 2 (Cody and Waite's two-part ln 2, so x keeps its bits), e^-x by its
+// Taylor polynomial of degree 7 (remainder below 2e-9), 2^-n on the exponent bits; 0 beyond
+// a = 87 (below float's normal range). Within 2 ulp of std::exp
+// (SimCpu.VectorMathMatchesTheLibrary). The GLSL kernels use exp().
+inline float expNeg(float a) {
+  const float b = minOf(a, 87.0f);
+  const float n = float(int(b * 1.44269504f + 0.5f));  // b >= 0: truncation is the floor
+  const float x = (b - n * 0.693359375f) - n * -2.12194440e-4f;
+  float p = 1.0f / 5040.0f;
+  p = p * -x + 1.0f / 720.0f;
+  p = p * -x + 1.0f / 120.0f;
+  p = p * -x + 1.0f / 24.0f;
+  p = p * -x + 1.0f / 6.0f;
+  p = p * -x + 0.5f;
+  p = p * -x + 1.0f;
+  p = p * -x + 1.0f;
+  const float scale = std::bit_cast<float>(uint32_t(127 - int(n)) << 23);  // 2^-n, n <= 126
+  const float inRange = float(a < 87.0f);  // a select would become a branch in GCC 12's AVX2 clone
+  return inRange * (p * scale);
+}
 
 inline float velocityOf(float h, float q, float dry) {
   const float v = q / h;

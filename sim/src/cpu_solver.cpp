@@ -143,6 +143,9 @@ void Impl::allocateFor(const SimParams& params) {
     for (auto& t : thermal) t = Plane(w, h);
   }
   if ((params.thermalEnabled || params.erosionEnabled) && scour.empty()) scour = Plane(w, h);
+  if (params.erosionEnabled && erosionScratch.empty()) {
+    for (int t = 0; t < threads; ++t) erosionScratch.emplace_back(w, 2);
+  }
   if (params.waterModel == WaterModel::kFiniteVolume && anySuspended && den.empty()) den = Plane(w, h);
 }
 

@@ -324,7 +324,7 @@ namespace {
 // The face pass's per-thread rows (Impl::scratch), 16 floats of margin on either side: the
 // primitives h, eta, u, v of four rows (a ring indexed by row & 3), the x sides of one row (east
 // side h, eta, un, ut, then the west side) and the y sides of two rows (ring by row & 1: south
-// side, then north side). The update pass uses two rows of it for the friction.
+// side, then north side).
 constexpr int kScratchMargin = 16;
 inline float* primRow(Plane& s, int y, int comp) { return s.row((y & 3) * 4 + comp) + kScratchMargin; }
 inline float* xSideRow(Plane& s, int comp) { return s.row(16 + comp) + kScratchMargin; }
@@ -673,21 +673,18 @@ STRATA_ROW_KERNEL void fvUpdateRow(const FvConst& c, const FvRow& r, int x0, int
   }
 }
 
-// W19, semi-implicit Manning friction on a row's new state: the discharge divided by
-// 1 + dt g n^2 |u| / h^(4/3) where the cell is wet. The power is std::pow's (a scalar call, in a
-// loop of its own; `work` holds dt g n^2 |u| and h^(4/3) in between).
-STRATA_ROW_KERNEL void frictionRow(const float* h, float* hu, float* hv, float* dtgnSpeed, float* power, int x0, int x1,
-                                   float dtg, float n2, float dry) {
+// W19, implicit Manning friction on a row's new state: the discharge divided by
+// (1 + sqrt(1 + 4 dt g n^2 |u| / h^(4/3))) / 2 where the cell is wet (h^(4/3) = h cbrt(h) with
+// cubeRoot, which vectorises; fv_update.comp uses pow).
+STRATA_ROW_KERNEL void frictionRow(const float* h, float* hu, float* hv, int x0, int x1, float dtg, float n2,
+                                   float dry) {
 #pragma omp simd
   for (int x = x0; x < x1; ++x) {
     const float hx = h[x];
-    dtgnSpeed[x] = dtg * n2 * (std::sqrt(hu[x] * hu[x] + hv[x] * hv[x]) / hx);
-  }
-  for (int x = x0; x < x1; ++x) power[x] = h[x] > dry ? std::pow(h[x], 4.0f / 3.0f) : 1.0f;
-#pragma omp simd
-  for (int x = x0; x < x1; ++x) {
-    const float cf = 0.5f + 0.5f * std::sqrt(1.0f + 4.0f * (dtgnSpeed[x] / power[x]));
-    const bool wet = h[x] > dry;
+    const bool wet = hx > dry;
+    const float hw = wet ? hx : 1.0f;
+    const float dtgnSpeed = dtg * n2 * (std::sqrt(hu[x] * hu[x] + hv[x] * hv[x]) / hx);
+    const float cf = 0.5f + 0.5f * std::sqrt(1.0f + 4.0f * (dtgnSpeed / (hw * cubeRoot(hw))));
     hu[x] = wet ? hu[x] / cf : hu[x];
     hv[x] = wet ? hv[x] / cf : hv[x];
   }
@@ -698,7 +695,7 @@ STRATA_ROW_KERNEL void frictionRow(const float* h, float* hu, float* hv, float* 
 // U0 - dt (L(U0) + L(U1)) / 2 into next() (W22), then W19 (Manning friction), E5, E0.
 void Impl::fvUpdatePass(bool final) {
   const bool sed = anySuspended;
-  forRuns(water, [&](const Run& run, int thread) {
+  forRuns(water, [&](const Run& run, int) {
     const FvConst c{w, h, dt, p.gravityMS2, dy, p.dryDepthM};
     const float n2 = p.manningN * p.manningN;
     for (int y = run.y0; y < run.y1; ++y) {
@@ -753,10 +750,7 @@ void Impl::fvUpdatePass(bool final) {
       };
       forEdgesAndInterior(run.x0, run.x1, w, y == 0 || y == h - 1, edgeCell,
                           [&](int xa, int xb) { fvUpdateRow(c, r, xa, xb, final, sed); });
-      if (n2 > 0.0f) {
-        Plane& sc = scratch[size_t(thread)];
-        frictionRow(r.oh, r.ohu, r.ohv, sc.row(0), sc.row(1), run.x0, run.x1, dt * p.gravityMS2, n2, p.dryDepthM);
-      }
+      if (n2 > 0.0f) frictionRow(r.oh, r.ohu, r.ohv, run.x0, run.x1, dt * p.gravityMS2, n2, p.dryDepthM);
       if (!final) continue;
       if (p.erosionEnabled) tiltRows(y, run.x0, run.x1);
     }

@@ -4,6 +4,8 @@
 // through writeBlock, setParams and a restored checkpoint.
 #include <gtest/gtest.h>
 
+#include <bit>
+
 #include <cmath>
 #include <cstring>
 #include <string>
@@ -11,7 +13,9 @@
 
 #include <strata/sim/adaptive_solver.hpp>
 #include <strata/sim/cpu_solver.hpp>
+
 #include <strata/sim/tiled_solver.hpp>
+#include "../../sim/src/cpu_kernels.hpp"
 
 #include "sim_scenes.hpp"
 
@@ -232,6 +236,27 @@ TEST(SimCpu, RunnersHandTheirClockToTheirParts) {
   ASSERT_TRUE(adaptive) << adaptive.message();
   const auto [da, sa] = run(*adaptive);
   EXPECT_NEAR(sa.inflowM3, stats.inflowM3, 1e-4 * stats.inflowM3);
+}
+
+// The CPU kernels' vector-loop cube root and exponential (cpu_kernels.hpp) against the library's:
+// within 2 ulp over the range the passes feed them.
+TEST(SimCpu, VectorMathMatchesTheLibrary) {
+  auto ulps = [](float a, float b) {
+    return std::abs(double(std::bit_cast<int32_t>(a)) - double(std::bit_cast<int32_t>(b)));
+  };
+  double worstCbrt = 0, worstExp = 0;
+  for (double e = -30; e <= 30; e += 0.0137) {
+    const float x = float(std::pow(10.0, e));
+    worstCbrt = std::max(worstCbrt, ulps(cpu::cubeRoot(x), std::cbrt(x)));
+  }
+  for (double a = 0; a < 87; a += 0.00731) {
+    const float x = float(a);
+    worstExp = std::max(worstExp, ulps(cpu::expNeg(x), std::exp(-x)));
+  }
+  std::printf("cubeRoot within %.0f ulp of std::cbrt, expNeg within %.0f ulp of std::exp(-x)\n", worstCbrt, worstExp);
+  EXPECT_LE(worstCbrt, 2.0);
+  EXPECT_LE(worstExp, 2.0);
+  EXPECT_EQ(cpu::expNeg(100.0f), 0.0f);
 }
 
 }  // namespace
