@@ -1,7 +1,7 @@
 #version 450
 // One separable pass of the CDF 5/3 lifting transform over the region [0, uRegion) of an r32f
 // image, along x (uAxis 0) or y (uAxis 1), forward (uInverse 0) or inverse (uInverse 1).
-// Same formulas, in the same order, as terrain/src/procgen/wavelet.cpp (forward53/inverse53);
+// Same formulas, in the same order, as procgen/src/wavelet.cpp (forward53/inverse53);
 // `precise` forbids fused multiply-adds so every driver rounds the same way.
 layout(local_size_x = 16, local_size_y = 16) in;
 

@@ -2,7 +2,7 @@
 // One separable pass of the CDF 9/7 lifting transform over the region [0, uRegion) of an r32f
 // image, along x (uAxis 0) or y (uAxis 1), forward (uInverse 0) or inverse (uInverse 1). Each
 // invocation recomputes the lifting steps it depends on from the input (no intermediate
-// passes). Same formulas, in the same order, as terrain/src/procgen/wavelet.cpp
+// passes). Same formulas, in the same order, as procgen/src/wavelet.cpp
 // (forward97/inverse97); `precise` forbids fused multiply-adds.
 layout(local_size_x = 16, local_size_y = 16) in;
 

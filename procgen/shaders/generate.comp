@@ -1,5 +1,5 @@
 #version 450
-// Template of a user generation script (render/src/procgen/generator.cpp splices the user's
+// Template of a user generation script (procgen/src/generator.cpp splices the user's
 // GLSL in at the marker below). Level form: level(p, lvl) gives every coefficient of the
 // wavelet pyramid (Mallat layout), then the inverse transform runs. Height form: height(p)
 // gives every cell directly. p is in output cells (x right, y down), at the coefficient's centre.

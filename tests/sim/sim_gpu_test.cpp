@@ -1,6 +1,6 @@
 // The GPU simulation (sim/shaders/*.comp) on whatever GL the machine has (llvmpipe in CI):
 // the invariants the CPU reference is held to, and agreement with the CPU reference on the
-// same inputs (tests/terrain/sim_*_test.cpp pin the reference to analytic solutions).
+// same inputs (tests/sim/sim_*_test.cpp pin the reference to analytic solutions).
 #include <gtest/gtest.h>
 
 #include <chrono>

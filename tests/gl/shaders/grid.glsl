@@ -1,5 +1,5 @@
-// A raster grid as the compute kernels see it. Mirrors strata::render::GridParams
-// (render/include/strata/render/gpu_layouts.hpp); tests/render checks that the two agree.
+// A raster grid as the compute kernels see it. Mirrors strata::test::GridParams
+// (tests/gl/grid_params.hpp); tests/gl checks that the two agree.
 struct GridParams {
   ivec2 size;       // cells (x, y)
   vec2 cellSizeM;   // cell size in metres (x, y)

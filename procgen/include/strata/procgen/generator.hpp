@@ -16,7 +16,7 @@ namespace strata::procgen {
 
 /// The GLSL of one script and where it came from, so compile errors name the user's file/line.
 struct UserScript {
-  std::string fileName;  ///< named in compile errors, e.g. "scripts/mountains.toml"
+  std::string fileName;  ///< named in compile errors, e.g. "docs/examples/fbm_waves_mountain.toml"
   std::string glsl;      ///< defines `float height(vec2 p)` or `float level(vec2 p, int lvl)`
   int firstLine = 1;     ///< line of `glsl`'s first line in fileName
 };

@@ -2,7 +2,7 @@
 // CPU reference of the CDF 5/3 (LeGall) and CDF 9/7 biorthogonal wavelet transforms by lifting,
 // multi-level,
 // separable (rows then columns), with whole-sample symmetric extension so any size >= 2 works,
-// and the coefficients in Mallat layout. The GPU transform (render/procgen) computes the same
+// and the coefficients in Mallat layout. The GPU transform (procgen/shaders, wavelet_gpu.hpp) computes the same
 // formulas; docs/procgen.md has the maths. No GL here.
 
 #include <cstdint>
