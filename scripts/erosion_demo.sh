@@ -6,6 +6,6 @@
 # arguments go to `strata erode` (--resume after a Ctrl-C, --overwrite to run it again).
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
-"$root/scripts/setup.sh" >&2
+"$root/scripts/setup.sh" --target strata >&2  # only the program it runs (scripts/test.sh builds the rest)
 cd "$root"
 build/apps/strata erode scenarios/rainier_erosion.toml -o runs/rainier_erosion "$@"

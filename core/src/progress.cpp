@@ -18,6 +18,16 @@ bool stderrIsTerminal() {
   if (env && std::strcmp(env, "0") == 0) return false;
   return isatty(STDERR_FILENO) == 1;
 }
+// STRATA_PROGRESS_EVERY: seconds between log lines (0.1 .. 3600), else `fallback`.
+double logInterval(double fallback) {
+  const char* env = std::getenv("STRATA_PROGRESS_EVERY");
+  if (!env) return fallback;
+  char* end = nullptr;
+  const double v = std::strtod(env, &end);
+  return end != env && *end == '\0' && v >= 0.1 && v <= 3600 ? v : fallback;
+}
+constexpr double kRateSampleS = 1.0;  // rate samples at least this far apart
+constexpr double kRateWeight = 0.3;   // the newest sample's weight in the rate
 }  // namespace
 
 std::string formatDuration(double s) {
@@ -33,13 +43,15 @@ std::string formatDuration(double s) {
   return buf;
 }
 
-Progress::Progress(std::string label, double total, double logEverySeconds)
-    : label_(std::move(label)),
+Progress::Progress(std::string label, double total, double logEverySeconds, Clock clock)
+    : clock_(std::move(clock)),
+      label_(std::move(label)),
       total_(total),
-      logEvery_(logEverySeconds),
+      logEvery_(logInterval(logEverySeconds)),
       interactive_(stderrIsTerminal()),
-      start_(std::chrono::steady_clock::now()),
-      lastDraw_(start_) {}
+      start_(now()),
+      lastDraw_(start_),
+      lastSample_(start_) {}
 
 Progress::~Progress() {
   if (!finished_ && interactive_) std::fputc('\n', stderr);
@@ -47,22 +59,33 @@ Progress::~Progress() {
 
 double Progress::fraction() const { return total_ > 0 ? std::clamp(done_ / total_, 0.0, 1.0) : 0.0; }
 
-double Progress::elapsedSeconds() const {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-}
+double Progress::elapsedSeconds() const { return std::chrono::duration<double>(now() - start_).count(); }
 
 double Progress::etaSeconds() const {
   const double f = fraction();
   if (f <= 0) return -1;
-  return elapsedSeconds() * (1 - f) / f;
+  if (rate_ > 0) return std::max(0.0, total_ - done_) / rate_;
+  return elapsedSeconds() * (1 - f) / f;  // before the first rate sample: the mean so far
+}
+
+bool Progress::due() const {
+  const double since = std::chrono::duration<double>(now() - lastDraw_).count();
+  return since >= (interactive_ ? 0.1 : logEvery_);
 }
 
 void Progress::update(double done, const std::string& note) {
   done_ = done;
-  const auto now = std::chrono::steady_clock::now();
-  const double since = std::chrono::duration<double>(now - lastDraw_).count();
+  const auto t = now();
+  const double sampleAge = std::chrono::duration<double>(t - lastSample_).count();
+  if (sampleAge >= kRateSampleS) {
+    const double r = (done - sampledDone_) / sampleAge;
+    rate_ = rate_ > 0 ? kRateWeight * r + (1 - kRateWeight) * rate_ : r;
+    lastSample_ = t;
+    sampledDone_ = done;
+  }
+  const double since = std::chrono::duration<double>(t - lastDraw_).count();
   if (since < (interactive_ ? 0.1 : logEvery_)) return;
-  lastDraw_ = now;
+  lastDraw_ = t;
   draw(note, false);
 }
 

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -380,7 +381,8 @@ class Run {
   // interval is then abandoned: a resumed run replays it from the last checkpoint, bit for bit).
   // The last step before `endS` (and before a rain edge) is shortened to land on it; the step W10
   // chose is kept apart (chosenDtS), since a shortened one says nothing about the flow.
-  Result<bool> advanceTo(double endS) {
+  // `tick`, when given, runs after every step (progress: it must be cheap and not collective).
+  Result<bool> advanceTo(double endS, const std::function<void()>& tick = {}) {
     auto& sv = solver();
     // One rule for "t has reached a time": within 1e-9 of it, relative. (The edges were once
     // compared with another tolerance: a step ending within 6e-8 s before a rain edge at 60 s left
@@ -396,6 +398,7 @@ class Run {
         chosenDtS_ = sv.nextDt();
         minChosenDtS_ = std::min(minChosenDtS_, chosenDtS_);
         sv.stepWithDt(std::min(chosenDtS_, next - sv.timeS()));
+        if (tick) tick();
         if (ranks_.anyInterrupted()) return false;
       }
     }
@@ -418,11 +421,16 @@ class Run {
     Progress progress("spin-up " + name, longestS);
     constexpr int kChecks = 20, kWindow = 2;
     std::vector<sim::SimStats> at{sv.stats()};  // at each check so far
+    // Progress at its own pace (every 10 s of wall time in a log), not only at the checks: a
+    // twentieth of a long spin-up can take minutes on a slow machine.
+    auto tick = [&] {
+      if (progress.due()) progress.update(longestS + sv.timeS(), progressNote("t = -" + formatDuration(-sv.timeS())));
+    };
     for (int c = 1; c <= kChecks; ++c) {
-      STRATA_TRY(const bool done, advanceTo(c == kChecks ? 0.0 : -longestS + longestS * c / kChecks));
+      STRATA_TRY(const bool done, advanceTo(c == kChecks ? 0.0 : -longestS + longestS * c / kChecks, tick));
       if (!done) return fail("interrupted during the spin-up (before t = 0: nothing to resume from)");
       at.push_back(sv.stats());  // collective over ranks: every rank judges the same numbers
-      progress.update(longestS + sv.timeS(), "t = -" + formatDuration(-sv.timeS()));
+      progress.update(longestS + sv.timeS(), progressNote("t = -" + formatDuration(-sv.timeS())));
       if (c < kWindow) continue;
       const auto& from = at[size_t(c - kWindow)];
       const auto& to = at[size_t(c)];
@@ -449,6 +457,14 @@ class Run {
 
   /// The step W10 chose last (before any shortening to land on an output time or a rain edge).
   double chosenDtS() const { return chosenDtS_; }
+
+  /// A progress line's note: the model time given, the steps so far and the step W10 chose.
+  std::string progressNote(const std::string& time) {
+    char note[128];
+    std::snprintf(note, sizeof note, "%s, %lld steps, dt %.2f s", time.c_str(), solver().counterStats().steps,
+                  chosenDtS_);
+    return note;
+  }
 
   /// This process's pieces of the state (local: nothing is gathered).
   Result<std::vector<detail::Piece>> pieces() const {
@@ -900,20 +916,16 @@ Result<RunSummary> runScenario(const Scenario& s, const RunOptions& opt) {
   };
   Progress progress(opt.command + " " + name, s.durationS);
   while (interval < intervals) {
-    const double t0 = interval * s.outputIntervalS, t1 = std::min(s.durationS, (interval + 1) * s.outputIntervalS);
-    // Progress a few times an interval (a bar on a terminal, log lines otherwise).
-    constexpr int kReports = 20;
-    bool stopped = false;
-    for (int c = 0; c < kReports && !stopped; ++c) {
-      STRATA_TRY(const bool done, run.advanceTo(t0 + (t1 - t0) * (c + 1) / kReports));
-      stopped = !done;
-      const auto& sv = run.solver();
-      char note[96];
-      const auto counters = sv.counterStats();
-      std::snprintf(note, sizeof note, "t = %s, %lld steps, dt %.2f s", formatDuration(sv.timeS()).c_str(),
-                    counters.steps, run.chosenDtS());
-      progress.update(sv.timeS(), note);
-    }
+    const double t1 = std::min(s.durationS, (interval + 1) * s.outputIntervalS);
+    // Progress whenever it is due (a bar on a terminal, a log line every 10 s of wall time
+    // otherwise), step by step, and at the end of the interval.
+    auto tick = [&] {
+      if (progress.due())
+        progress.update(run.solver().timeS(), run.progressNote("t = " + formatDuration(run.solver().timeS())));
+    };
+    STRATA_TRY(const bool done, run.advanceTo(t1, tick));
+    const bool stopped = !done;
+    progress.update(run.solver().timeS(), run.progressNote("t = " + formatDuration(run.solver().timeS())));
     if (stopped) break;
 
     // The interval is complete: its row, maps, pictures and checkpoint. The stored water, and so
