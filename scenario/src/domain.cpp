@@ -984,15 +984,11 @@ Status checkModelParams(const Scenario& s, const sim::SimParams& p) {
       {"erosionRate", "erosion.erosion_rate"},
       {"depositionRate", "erosion.deposition_rate"},
   };
-  const std::string& m = status.message();
+  const Error& e = status.error();
   for (const auto& [field, key] : kKeys) {
-    const std::string name = std::string("sim params: ") + field + " = ";
-    if (m.rfind(name, 0) == 0) {
-      const auto must = m.find(": must be");
-      return fail(s.at(key) + "the model refuses it" + (must == std::string::npos ? "" : m.substr(must)));
-    }
+    if (e.field == field) return fail(s.at(key) + "the model refuses it" + (e.reason.empty() ? "" : ": " + e.reason));
   }
-  return fail(s.file.string() + ": the model refuses these parameters (" + m + ")");
+  return fail(s.file.string() + ": the model refuses these parameters (" + e.message + ")");
 }
 
 // Where fill_depressions' floods start: the region's cells on an open edge, and voids that are

@@ -6,22 +6,28 @@
 namespace strata::sim {
 namespace {
 
-// "sim params: <name> = <value>: must be <what>" unless `ok`.
+// "sim params: <name> = <value>: must be <what>" unless `ok`, naming the field (Error::field).
 Status require(bool ok, const char* name, float value, const char* what) {
   if (ok) return {};
-  return fail(std::string("sim params: ") + name + " = " + std::to_string(value) + ": must be " + what);
+  const std::string reason = std::string("must be ") + what;
+  return failField(std::string("sim params: ") + name + " = " + std::to_string(value) + ": " + reason, name, reason);
 }
 
 }  // namespace
 
 Status validateParams(const SimParams& p) {
   if (p.waterModel != WaterModel::kVirtualPipes && p.waterModel != WaterModel::kFiniteVolume) {
-    return fail("sim params: waterModel " + std::to_string(int(p.waterModel)) + " is not 0 (pipes) or 1 (flood)");
+    return failField("sim params: waterModel " + std::to_string(int(p.waterModel)) + " is not 0 (pipes) or 1 (flood)",
+                     "waterModel", "is not 0 (pipes) or 1 (flood)");
   }
   if (p.slopeLimiter != SlopeLimiter::kMinmod && p.slopeLimiter != SlopeLimiter::kMonotonizedCentral) {
-    return fail("sim params: slopeLimiter " + std::to_string(int(p.slopeLimiter)) + " is not 0 (minmod) or 1 (MC)");
+    return failField("sim params: slopeLimiter " + std::to_string(int(p.slopeLimiter)) + " is not 0 (minmod) or 1 (MC)",
+                     "slopeLimiter", "is not 0 (minmod) or 1 (MC)");
   }
-  if (p.openEdges > 15u) return fail("sim params: openEdges " + std::to_string(p.openEdges) + " is not a set of edges");
+  if (p.openEdges > 15u) {
+    return failField("sim params: openEdges " + std::to_string(p.openEdges) + " is not a set of edges", "openEdges",
+                     "is not a set of edges");
+  }
   // Every constant must be a finite number (NaN fails every comparison below as well).
   const std::pair<const char*, float> all[] = {{"gravityMS2", p.gravityMS2},
                                                {"maxDtS", p.maxDtS},
@@ -48,8 +54,9 @@ Status validateParams(const SimParams& p) {
                               "in (0, 0.5] in flood mode (positivity of the finite-volume scheme)"));
   }
   if (p.erosionLaw != ErosionLaw::kShearStress && p.erosionLaw != ErosionLaw::kForceBased) {
-    return fail("sim params: erosionLaw " + std::to_string(int(p.erosionLaw)) +
-                " is not 0 (shear stress) or 1 (force-based)");
+    return failField(
+        "sim params: erosionLaw " + std::to_string(int(p.erosionLaw)) + " is not 0 (shear stress) or 1 (force-based)",
+        "erosionLaw", "is not 0 (shear stress) or 1 (force-based)");
   }
   STRATA_TRY_STATUS(require(p.waterDensityKgM3 > 0, "waterDensityKgM3", p.waterDensityKgM3, "positive"));
   STRATA_TRY_STATUS(

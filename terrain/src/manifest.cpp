@@ -490,12 +490,12 @@ Result<Manifest> parseManifest(const std::string& text, const std::string& path)
                    {"settling_velocity", &Material::settlingVelocityMS, 100.0},
                    {"friction_angle_deg", &Material::frictionAngleDeg, 90.0},
                    {"cohesion_pa", &Material::cohesionPa, 1e12}};
-      for (const auto& f : later) {
-        if (t[f.key].node()) {
-          STRATA_TRY(double v, r.number(t[f.key], k + f.key, 0.0, f.hi));
-          mat.*f.field = float(v);
+      for (const auto& key : later) {
+        if (t[key.key].node()) {
+          STRATA_TRY(double v, r.number(t[key.key], k + key.key, 0.0, key.hi));
+          mat.*key.field = float(v);
         } else {
-          mat.*f.field = fallback.*f.field;
+          mat.*key.field = fallback.*key.field;
         }
       }
       auto ok = validateMaterial(mat);

@@ -259,5 +259,35 @@ TEST(SimCpu, VectorMathMatchesTheLibrary) {
   EXPECT_EQ(cpu::expNeg(100.0f), 0.0f);
 }
 
+// Issue 34: a refused parameter is named in the error's own field, so a scenario maps it to its
+// key without reading the message.
+TEST(SimParamsCheck, ARefusalNamesTheParameter) {
+  struct Case {
+    const char* field;
+    void (*spoil)(SimParams&);
+  };
+  const Case cases[] = {{"cflAlpha", [](SimParams& p) { p.cflAlpha = 0.9f; }},
+                        {"maxDtS", [](SimParams& p) { p.maxDtS = 0.0f; }},
+                        {"manningN", [](SimParams& p) { p.manningN = -1.0f; }},
+                        {"evaporationMmPerHour", [](SimParams& p) { p.evaporationMmPerHour = -1.0f; }},
+                        {"rainMmPerHour", [](SimParams& p) { p.rainMmPerHour = std::nanf(""); }},
+                        {"capacityK", [](SimParams& p) { p.capacityK = -1.0f; }},
+                        {"erosionRate", [](SimParams& p) { p.erosionRate = -1.0f; }},
+                        {"depositionRate", [](SimParams& p) { p.depositionRate = -1.0f; }},
+                        {"bankFillShare", [](SimParams& p) { p.bankFillShare = 2.0f; }},
+                        {"erosionLaw", [](SimParams& p) { p.erosionLaw = ErosionLaw(7); }}};
+  for (const auto& c : cases) {
+    SimParams p;
+    p.waterModel = WaterModel::kFiniteVolume;
+    p.cflAlpha = 0.45f;
+    c.spoil(p);
+    const auto st = validateParams(p);
+    ASSERT_FALSE(st.ok()) << c.field;
+    EXPECT_EQ(st.error().field, c.field) << st.message();
+    EXPECT_FALSE(st.error().reason.empty()) << c.field;
+    EXPECT_EQ(st.error().reason.find(c.field), std::string::npos) << st.error().reason;
+  }
+}
+
 }  // namespace
 }  // namespace strata::sim

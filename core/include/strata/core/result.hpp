@@ -11,13 +11,21 @@
 
 namespace strata {
 
-/// A failure on user data: one line, naming the thing and the problem.
+/// A failure on user data: one line, naming the thing and the problem. Code that checks named
+/// fields (a solver's parameters) also says which one and what is wrong with it, so a caller
+/// that knows the field by another name (a scenario key) can say so without reading the message.
 struct Error {
   std::string message;
+  std::string field;   ///< the parameter the error is about, when there is one
+  std::string reason;  ///< what is wrong with it ("must be positive"), without its name
 };
 
 /// Makes an Error; `return fail("dem.tif: not a raster");` converts into any Result<T>.
-inline Error fail(std::string message) { return Error{std::move(message)}; }
+inline Error fail(std::string message) { return Error{std::move(message), {}, {}}; }
+/// The same about the named `field`: `reason` is what is wrong with it.
+inline Error failField(std::string message, std::string field, std::string reason) {
+  return Error{std::move(message), std::move(field), std::move(reason)};
+}
 
 template <class T>
 class [[nodiscard]] Result {
