@@ -551,9 +551,12 @@ TEST_F(GlTest, ALateTileNeverStallsAFrameAndTheRenderConverges) {
   EXPECT_GT(total, 0);
   EXPECT_GT(s->store().requestsPending(), 0);
   // The cold frame costs less than ONE decode more than a frame with everything resident (the
-  // margin absorbs llvmpipe's frame-time noise on a loaded machine; measured: within ~10 ms),
-  // where the blocking frame below costs kDelayMs per tile level it decodes (5 here).
-  EXPECT_LT(firstMs, residentMs + kDelayMs);
+  // margin absorbs llvmpipe's frame-time noise on a loaded machine; measured: within ~10 ms on a
+  // quiet one), where the blocking frame below costs kDelayMs per tile level it decodes (5 here).
+  // On a loaded machine a resident frame takes ~470 ms and jitters by a quarter of that (a cold
+  // frame measured 500 ms beside it under a full ctest -j2), so the margin is also half a frame:
+  // still half of what blocking would add.
+  EXPECT_LT(firstMs, residentMs + std::max(kDelayMs, 0.5 * residentMs));
   EXPECT_GT(expectNoHole(*scene, cam, target, 0.95 * 30000), long(w * h / 3));
 
   // Frames go on while the loader works: none decodes, none has a hole.
