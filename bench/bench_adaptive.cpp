@@ -18,7 +18,7 @@
 
 #include <strata/gl/context.hpp>
 #include <strata/sim/adaptive_solver.hpp>
-#include <strata/sim/gl_solver.hpp>
+#include <strata/sim/gl/gl_solver.hpp>
 #include <strata/sim/tiled_solver.hpp>
 
 #include "canyon_flood.hpp"

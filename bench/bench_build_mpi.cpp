@@ -17,7 +17,7 @@
 #include <strata/scenario/domain.hpp>
 #include <strata/scenario/scenario.hpp>
 
-#include "../scenario/src/distributed.hpp"
+#include "../scenario/src/build_rows.hpp"
 #include "../scenario/src/domain_rows.hpp"
 #include "sleepy_barrier.hpp"
 

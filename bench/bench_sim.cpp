@@ -30,7 +30,7 @@
 #include <strata/gl/context.hpp>
 #include <strata/gl/state.hpp>
 #include <strata/sim/cpu_solver.hpp>
-#include <strata/sim/gl_solver.hpp>
+#include <strata/sim/gl/gl_solver.hpp>
 #include <strata/terrain/material.hpp>
 
 namespace {

@@ -28,7 +28,7 @@
 #include <vector>
 
 #include <strata/sim/cpu_solver.hpp>
-#include <strata/sim/distributed_solver.hpp>
+#include <strata/sim/mpi/distributed_solver.hpp>
 
 #include "canyon_flood.hpp"
 #include "sleepy_barrier.hpp"

@@ -7,7 +7,7 @@
 
 #include <strata/scenario/run.hpp>
 #include <strata/scenario/scenario.hpp>
-#include <strata/sim/distributed_solver.hpp>
+#include <strata/sim/mpi/ranks.hpp>
 
 #include "commands.hpp"
 
@@ -52,7 +52,8 @@ void addRunCommand(CLI::App& app, const char* name, const char* help, bool erosi
     };
     auto scenario = scenario::loadScenario(args->scenario);
     // Every rank reads the scenario; a rank that cannot fails the run on every rank.
-    const Status loaded = mpi.active ? sim::collectiveStatus(statusOf(scenario), MPI_COMM_WORLD) : statusOf(scenario);
+    const sim::Ranks ranks = mpi.active ? sim::Ranks::world() : sim::Ranks::single();
+    const Status loaded = ranks.agree(statusOf(scenario));
     if (!loaded) failWith(loaded.message(), 1);
     if (erosion && !scenario->erosion.enabled) {
       scenario->erosion.enabled = true;

@@ -10,8 +10,6 @@
 #include <strata/core/bytes.hpp>
 #include <strata/core/log.hpp>
 
-#include "distributed.hpp"
-
 namespace strata::scenario::detail {
 namespace {
 

@@ -7,10 +7,11 @@
 
 #include <strata/core/result.hpp>
 #include <strata/scenario/domain.hpp>
+#include <strata/sim/mpi/ranks.hpp>
 
 namespace strata::scenario::detail {
 
-class Ranks;
+using sim::Ranks;
 
 /// Carves each inflow's path to an open edge (domain.cpp says which path, and how) into d's base
 /// and bed, and sets d.breach (the same on every rank).

@@ -1,8 +1,7 @@
-#include "distributed.hpp"
+#include "build_rows.hpp"
 
 #include <mpi.h>
 
-#include <charconv>
 #include <climits>
 #include <cstdint>
 
@@ -10,7 +9,7 @@
 #include <strata/core/interrupt.hpp>
 #include <strata/gis/dem_io.hpp>
 #include <strata/gis/fill_depressions.hpp>
-#include <strata/sim/distributed_solver.hpp>
+#include <strata/sim/mpi/distributed_solver.hpp>
 
 #include "breach.hpp"
 #include "domain_rows.hpp"
@@ -55,133 +54,6 @@ Result<gis::Grid<float>> readInputWindow(const fs::path& file, const gis::CellRe
 }
 
 }  // namespace
-
-Ranks Ranks::world() {
-  Ranks r;
-  r.distributed_ = true;
-  MPI_Comm_rank(MPI_COMM_WORLD, &r.rank_);
-  MPI_Comm_size(MPI_COMM_WORLD, &r.size_);
-  return r;
-}
-
-Status Ranks::agree(const Status& local) const {
-  return distributed_ ? sim::collectiveStatus(local, MPI_COMM_WORLD) : local;
-}
-
-bool Ranks::anyInterrupted() const {
-  if (!distributed_) return interrupted();
-  int mine = interrupted() ? 1 : 0, any = 0;
-  MPI_Allreduce(&mine, &any, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
-  return any != 0;
-}
-
-std::string Ranks::fromLead(std::string bytes) const {
-  if (!distributed_) return bytes;
-  unsigned long long n = bytes.size();
-  MPI_Bcast(&n, 1, MPI_UNSIGNED_LONG_LONG, 0, MPI_COMM_WORLD);
-  bytes.resize(size_t(n));
-  // In pieces of at most INT_MAX bytes (MPI counts are int).
-  for (size_t at = 0; at < bytes.size(); at += size_t(INT_MAX)) {
-    MPI_Bcast(bytes.data() + at, int(std::min<size_t>(INT_MAX, bytes.size() - at)), MPI_CHAR, 0, MPI_COMM_WORLD);
-  }
-  return bytes;
-}
-
-std::pair<long long, long long> Ranks::minMax(long long value) const {
-  if (!distributed_) return {value, value};
-  long long lo = 0, hi = 0;
-  MPI_Allreduce(&value, &lo, 1, MPI_LONG_LONG, MPI_MIN, MPI_COMM_WORLD);
-  MPI_Allreduce(&value, &hi, 1, MPI_LONG_LONG, MPI_MAX, MPI_COMM_WORLD);
-  return {lo, hi};
-}
-
-bool Ranks::all(bool value) const { return minMax(value ? 1 : 0).first == 1; }
-
-void Ranks::sum(std::vector<sim::ExactSum>& sums) const {
-  if (distributed_) sim::allreduceExact(sums.data(), int(sums.size()), MPI_COMM_WORLD);
-}
-
-void Ranks::min(std::vector<double>& values) const {
-  if (distributed_) MPI_Allreduce(MPI_IN_PLACE, values.data(), int(values.size()), MPI_DOUBLE, MPI_MIN, MPI_COMM_WORLD);
-}
-
-void Ranks::max(std::vector<double>& values) const {
-  if (distributed_) MPI_Allreduce(MPI_IN_PLACE, values.data(), int(values.size()), MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
-}
-
-namespace {
-
-// Each rank's offset in a gather of `counts` bytes (under 2 GB in all: MPI counts are int).
-std::vector<int> offsetsOf(const std::vector<int>& counts) {
-  std::vector<int> offsets(counts.size());
-  size_t total = 0;
-  for (size_t r = 0; r < counts.size(); ++r) {
-    offsets[r] = int(total);
-    total += size_t(counts[r]);
-  }
-  STRATA_CHECK(total < size_t(INT_MAX)) << "a gather over the ranks exceeds 2 GB";
-  return offsets;
-}
-
-// The gathered bytes back as each rank's part.
-std::vector<std::string> partsOf(const std::string& all, const std::vector<int>& counts,
-                                 const std::vector<int>& offsets) {
-  std::vector<std::string> out;
-  for (size_t r = 0; r < counts.size(); ++r) out.push_back(all.substr(size_t(offsets[r]), size_t(counts[r])));
-  return out;
-}
-
-}  // namespace
-
-std::vector<std::string> Ranks::gatherToLead(const std::string& bytes) const {
-  if (!distributed_) return {bytes};
-  STRATA_CHECK(bytes.size() < size_t(INT_MAX)) << "a rank's part of a gather exceeds 2 GB";
-  int n = int(bytes.size());
-  std::vector<int> counts(static_cast<size_t>(size_)), offsets;
-  MPI_Gather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, MPI_COMM_WORLD);
-  std::string all;
-  if (lead()) {
-    offsets = offsetsOf(counts);
-    all.resize(size_t(offsets.back()) + size_t(counts.back()));
-  }
-  MPI_Gatherv(bytes.data(), n, MPI_CHAR, all.data(), counts.data(), offsets.data(), MPI_CHAR, 0, MPI_COMM_WORLD);
-  return lead() ? partsOf(all, counts, offsets) : std::vector<std::string>{};
-}
-
-std::vector<std::string> Ranks::allGatherBytes(const std::string& bytes) const {
-  if (!distributed_) return {bytes};
-  STRATA_CHECK(bytes.size() < size_t(INT_MAX)) << "a rank's part of a gather exceeds 2 GB";
-  int n = int(bytes.size());
-  std::vector<int> counts(static_cast<size_t>(size_));
-  MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, MPI_COMM_WORLD);
-  const std::vector<int> offsets = offsetsOf(counts);
-  std::string all(size_t(offsets.back()) + size_t(counts.back()), '\0');
-  MPI_Allgatherv(bytes.data(), n, MPI_CHAR, all.data(), counts.data(), offsets.data(), MPI_CHAR, MPI_COMM_WORLD);
-  return partsOf(all, counts, offsets);
-}
-
-std::pair<std::string, std::string> Ranks::swapWithNeighbours(const std::string& up, const std::string& down) const {
-  if (!distributed_) return {};
-  const int before = rank_ > 0 ? rank_ - 1 : MPI_PROC_NULL, after = rank_ + 1 < size_ ? rank_ + 1 : MPI_PROC_NULL;
-  STRATA_CHECK(up.size() < size_t(INT_MAX) && down.size() < size_t(INT_MAX)) << "a rank's part of a swap exceeds 2 GB";
-  int upCount = int(up.size()), downCount = int(down.size()), fromBefore = 0, fromAfter = 0;
-  MPI_Sendrecv(&upCount, 1, MPI_INT, before, 0, &fromAfter, 1, MPI_INT, after, 0, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
-  MPI_Sendrecv(&downCount, 1, MPI_INT, after, 1, &fromBefore, 1, MPI_INT, before, 1, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
-  std::pair<std::string, std::string> got{std::string(size_t(fromBefore), '\0'), std::string(size_t(fromAfter), '\0')};
-  MPI_Sendrecv(up.data(), upCount, MPI_CHAR, before, 2, got.second.data(), fromAfter, MPI_CHAR, after, 2,
-               MPI_COMM_WORLD, MPI_STATUS_IGNORE);
-  MPI_Sendrecv(down.data(), downCount, MPI_CHAR, after, 3, got.first.data(), fromBefore, MPI_CHAR, before, 3,
-               MPI_COMM_WORLD, MPI_STATUS_IGNORE);
-  return got;
-}
-
-std::vector<double> Ranks::allGather(const std::vector<double>& values) const {
-  if (!distributed_) return values;
-  std::vector<double> all(values.size() * size_t(size_));
-  MPI_Allgather(values.data(), int(values.size()), MPI_DOUBLE, all.data(), int(values.size()), MPI_DOUBLE,
-                MPI_COMM_WORLD);
-  return all;
-}
 
 std::vector<std::string> modelInputFiles(int layers) {
   std::vector<std::string> files{"input/base.tif", "input/water.tif", "input/rain.tif"};
@@ -438,28 +310,37 @@ sim::RegionSource modelInputSource(const fs::path& runDir, const ScenarioDomain&
   return region;
 }
 
-std::string rankCheckpointFile(int rank, int ranks) {
-  return "checkpoint." + std::to_string(rank) + "-of-" + std::to_string(ranks) + ".bin";
-}
-
-bool isRankCheckpointFile(std::string_view name, int* ranks) {
-  // "checkpoint." + at least "0-of-1" + ".bin" (checkpoint.bin, the one process's, is not one).
-  if (name.size() < 21 || !name.starts_with("checkpoint.") || !name.ends_with(".bin")) return false;
-  name.remove_prefix(11);
-  name.remove_suffix(4);
-  const auto of = name.find("-of-");
-  if (of == std::string_view::npos) return false;
-  int r = -1, n = 0;
-  const auto a = name.substr(0, of), b = name.substr(of + 4);
-  const auto ra = std::from_chars(a.data(), a.data() + a.size(), r);
-  const auto rb = std::from_chars(b.data(), b.data() + b.size(), n);
-  if (ra.ec != std::errc() || ra.ptr != a.data() + a.size() || rb.ec != std::errc() || rb.ptr != b.data() + b.size())
-    return false;
-  if (!(r >= 0 && n >= 1 && r < n) ||
-      rankCheckpointFile(r, n) != std::string("checkpoint.") + std::string(name) + ".bin")
-    return false;
-  if (ranks) *ranks = n;
-  return true;
-}
-
 }  // namespace strata::scenario::detail
+
+namespace strata::scenario {
+
+// One process builds the domain as one rank holding every row: one order of steps for both.
+Result<ScenarioDomain> buildDomain(const Scenario& s, uint64_t memoryBudgetBytes) {
+  STRATA_TRY(auto builder, detail::RowBuilder::plan(s, memoryBudgetBytes, 1, true));
+  STRATA_TRY(auto built, detail::buildByRows(builder, s, sim::Ranks::single()));
+  // The rows are the whole region; the shape holds what is not cells.
+  ScenarioDomain d = std::move(built.rows);
+  ScenarioDomain& shape = built.shape;
+  d.input.materials = shape.input.materials;
+  d.input.rowDxM = shape.input.rowDxM;
+  d.input.dyM = shape.input.dyM;
+  d.input.datumM = shape.input.datumM;
+  d.params = shape.params;
+  d.sources = std::move(shape.sources);
+  d.sourceNames = std::move(shape.sourceNames);
+  d.levels = std::move(shape.levels);
+  d.levelNames = std::move(shape.levelNames);
+  d.rainMmPerHour = shape.rainMmPerHour;
+  d.rainStartS = shape.rainStartS;
+  d.rainEndS = shape.rainEndS;
+  d.damBreakVolumeM3 = shape.damBreakVolumeM3;
+  d.totalAreaM2 = shape.totalAreaM2;
+  d.bedRangeM = shape.bedRangeM;
+  d.breach = shape.breach;
+  d.voidCells = shape.voidCells;
+  d.layerCellsTooSteep = std::move(shape.layerCellsTooSteep);
+  d.filled = shape.filled;
+  return d;
+}
+
+}  // namespace strata::scenario

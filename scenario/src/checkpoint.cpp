@@ -1,5 +1,7 @@
 #include "checkpoint.hpp"
 
+#include <charconv>
+
 #include <strata/core/bytes.hpp>
 #include <strata/sim/state_codec.hpp>
 
@@ -84,6 +86,30 @@ Result<Checkpoint> decodeCheckpoint(const std::filesystem::path& path, const Che
   if (!decoded) return fail(path.string() + ": corrupt checkpoint (" + decoded.message() + ")");
   c.state = std::move(decoded).value();
   return c;
+}
+
+std::string rankCheckpointFile(int rank, int ranks) {
+  return "checkpoint." + std::to_string(rank) + "-of-" + std::to_string(ranks) + ".bin";
+}
+
+bool isRankCheckpointFile(std::string_view name, int* ranks) {
+  // "checkpoint." + at least "0-of-1" + ".bin" (checkpoint.bin, the one process's, is not one).
+  if (name.size() < 21 || !name.starts_with("checkpoint.") || !name.ends_with(".bin")) return false;
+  name.remove_prefix(11);
+  name.remove_suffix(4);
+  const auto of = name.find("-of-");
+  if (of == std::string_view::npos) return false;
+  int r = -1, n = 0;
+  const auto a = name.substr(0, of), b = name.substr(of + 4);
+  const auto ra = std::from_chars(a.data(), a.data() + a.size(), r);
+  const auto rb = std::from_chars(b.data(), b.data() + b.size(), n);
+  if (ra.ec != std::errc() || ra.ptr != a.data() + a.size() || rb.ec != std::errc() || rb.ptr != b.data() + b.size())
+    return false;
+  if (!(r >= 0 && n >= 1 && r < n) ||
+      rankCheckpointFile(r, n) != std::string("checkpoint.") + std::string(name) + ".bin")
+    return false;
+  if (ranks) *ranks = n;
+  return true;
 }
 
 }  // namespace strata::scenario

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <strata/core/result.hpp>
@@ -28,6 +29,11 @@ struct Checkpoint {
   SpinUpSummary spinUp;  ///< for the report of a resumed run
   sim::SolverState state;
 };
+
+/// checkpoint.R-of-N.bin: rank R's part of a run checkpointed on N ranks.
+std::string rankCheckpointFile(int rank, int ranks);
+/// Whether `name` is such a file (any R and N); sets `ranks` to its N.
+bool isRankCheckpointFile(std::string_view name, int* ranks = nullptr);
 
 /// FNV-1a (64 bit) of `text`.
 uint64_t fnv1a(std::string_view text);

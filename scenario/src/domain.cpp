@@ -20,10 +20,7 @@
 #include <strata/terrain/material.hpp>
 #include <strata/terrain/tile_store.hpp>
 
-#include "breach.hpp"
-#include "distributed.hpp"
 #include "domain_rows.hpp"
-#include "settle.hpp"
 
 namespace strata::scenario {
 namespace {
@@ -563,16 +560,6 @@ void findVoids(ScenarioDomain& d) {
   }
 }
 
-Status handleVoids(const Scenario& s, const TerrainSource& source, ScenarioDomain& d) {
-  findVoids(d);
-  if (d.voidCells == 0) return {};
-  using V = decltype(s.terrain)::Voids;
-  if (s.terrain.voids == V::kRefuse) return refuseVoids(source, d.voidCells);
-  auto filled = gis::fillVoids(d.bed.values);
-  if (!filled) return fail(source.path() + ": " + filled.message());
-  return {};
-}
-
 // Step 3: the bed of rows [y0, y1) of the region's grid (all of them for the whole region),
 // resampled to region.cell_size (coarser cells take the lowest of the cells they cover: averaging
 // raises a canyon's narrow floor towards its rim and dams the river, docs/scenario.md),
@@ -1032,22 +1019,6 @@ sim::ExactSum raiseTo(const gis::Grid<float>& filled, int rows, ScenarioDomain& 
   return volume;
 }
 
-// [terrain] fill_depressions: every cell not draining to an open edge is raised to the level at
-// which it would spill (priority flood from the open edges, Barnes et al. 2014; gis::fillDepressions,
-// which also runs tile by tile over MPI ranks), so that no water is lost filling the pits a coarse
-// DEM has where the real ground has none. Cells outside a polygon region are walls and are not
-// crossed.
-Status fillDepressions(const Scenario& s, ScenarioDomain& d) {
-  if (!s.terrain.fillDepressions) return {};
-  const int w = d.inside.width, h = d.inside.height;
-  const auto drains = drainCells(s, d, h);
-  if (std::none_of(drains.data.begin(), drains.data.end(), [](uint8_t v) { return v != 0; })) {
-    return refuseNothingDrains(s);
-  }
-  raiseTo(gis::fillDepressions({&d.input.baseM, &d.inside, &drains}, {{0, 0, w, h}}), h, d);
-  return {};
-}
-
 // The lowest and highest bed of the region's cells of `d`'s first `rows` rows.
 std::array<float, 2> bedRange(const ScenarioDomain& d, int rows) {
   std::array<float, 2> r{std::numeric_limits<float>::max(), std::numeric_limits<float>::lowest()};
@@ -1137,41 +1108,6 @@ Error refusePlaceOnWalls(const Scenario& s, int index) {
   return placeError(s, place,
                     "it lies on cells without data, which voids = \"walls\" makes walls no water enters; move it, "
                     "or set [terrain] voids = \"fill\" or \"holes\"");
-}
-
-Result<ScenarioDomain> buildDomain(const Scenario& s, uint64_t memoryBudgetBytes) {
-  STRATA_TRY(auto plan, planRegion(s, memoryBudgetBytes, 1, true));
-  const int h = plan.grid.height;
-  ScenarioDomain d;
-  std::vector<StoredLayer> storeLayers;
-  STRATA_TRY_STATUS(readBed(s, plan, 0, h, d, storeLayers));
-  STRATA_TRY_STATUS(handleVoids(s, plan.source, d));
-  maskRegion(s, plan.frame, d);
-  STRATA_TRY_STATUS(measureRegion(plan, d));
-  STRATA_TRY(const float lowest, stackLayers(s, plan, storeLayers, d));
-  d.input.datumM = std::floor(double(lowest));
-  detail::settleAtRest(s, detail::Ranks::single(), h, h, d);
-  if (s.erosion.enabled && !hasLooseMaterial(d)) return refuseNoLooseMaterial(s);
-  d.params = modelParams(s);
-  STRATA_TRY_STATUS(checkModelParams(s, d.params));
-  // The region's cells for places: the polygon's (a void wall under a place is refused below).
-  const RegionCells region{
-      plan.grid.width, h, nullptr,
-      plan.frame.polygonPx.empty() ? std::vector<std::array<double, 2>>{} : plan.frame.toRegion(plan.frame.polygonPx)};
-  STRATA_TRY_STATUS(placeInflows(s, plan, region, d));
-  STRATA_TRY_STATUS(detail::breachInflowPaths(s, detail::Ranks::single(), {0, h}, d.sources, d.sourceNames, d));
-  STRATA_TRY_STATUS(fillDepressions(s, d));
-  STRATA_TRY_STATUS(placeLevels(s, plan, region, d));
-  STRATA_TRY_STATUS(checkLevelStages(s, lowestLevelBeds(s, d, d)));
-  addVoidHoles(voidHoleCells(s, d, h), d);
-  STRATA_TRY_STATUS(placeRain(s, plan, d));
-  STRATA_TRY(const auto dams, damBreakCells(s, plan, region));
-  if (const int wall = firstPlaceOnWalls(s, d.sources, d.levels, dams, d, h); wall >= 0) {
-    return refusePlaceOnWalls(s, wall);
-  }
-  STRATA_TRY_STATUS(checkDamBreaks(s, placeDamBreaks(s, dams, d)));
-  d.bedRangeM = bedRange(d, h);
-  return d;
 }
 
 // ---- Built rows by rows -------------------------------------------------------------------------

@@ -12,12 +12,13 @@
 
 #include <strata/core/result.hpp>
 #include <strata/gis/dem_io.hpp>
+#include <strata/sim/mpi/ranks.hpp>
 #include <strata/sim/region.hpp>
 #include <strata/sim/solver.hpp>
 
-#include "distributed.hpp"
-
 namespace strata::scenario::detail {
+
+using sim::Ranks;
 
 /// A rectangle of the region this process holds and the state on it.
 struct Piece {

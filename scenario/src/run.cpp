@@ -23,11 +23,11 @@
 #include <strata/scenario/domain.hpp>
 #include <strata/scenario/report.hpp>
 #include <strata/sim/cpu_solver.hpp>
-#include <strata/sim/distributed_solver.hpp>
-#include <strata/sim/gl_solver.hpp>
+#include <strata/sim/gl/gl_solver.hpp>
+#include <strata/sim/mpi/distributed_solver.hpp>
 
+#include "build_rows.hpp"
 #include "checkpoint.hpp"
-#include "distributed.hpp"
 #include "domain_rows.hpp"
 #include "pieces.hpp"
 
@@ -707,7 +707,7 @@ std::vector<std::string> runFolderOutputs(const fs::path& runDir) {
   std::vector<std::string> parts;
   for (const auto& e : fs::directory_iterator(runDir, ec)) {
     const std::string name = e.path().filename().string();
-    if (detail::isRankCheckpointFile(name)) parts.push_back(name);
+    if (isRankCheckpointFile(name)) parts.push_back(name);
   }
   std::sort(parts.begin(), parts.end());
   out.insert(out.end(), parts.begin(), parts.end());
@@ -723,7 +723,7 @@ std::vector<std::string> runFolderTemporaries(const fs::path& runDir) {
       const std::string name = e.path().filename().string();
       const std::string rel = std::string(sub) + (*sub ? "/" : "");
       const auto tmp = name.find(".tmp");
-      const bool rankPart = !*sub && tmp != std::string::npos && detail::isRankCheckpointFile(name.substr(0, tmp)) &&
+      const bool rankPart = !*sub && tmp != std::string::npos && isRankCheckpointFile(name.substr(0, tmp)) &&
                             isTemporaryOf(name, name.substr(0, tmp));
       const bool ours =
           rankPart || std::any_of(files.begin(), files.end(), [&](const std::string& f) {
@@ -758,7 +758,7 @@ std::string checkpointHint(const fs::path& dir, const Ranks& ranks) {
   std::error_code ec;
   for (const auto& e : fs::directory_iterator(dir, ec)) {
     int n = 0;
-    if (detail::isRankCheckpointFile(e.path().filename().string(), &n) && n != ranks.size()) {
+    if (isRankCheckpointFile(e.path().filename().string(), &n) && n != ranks.size()) {
       return " (the run was checkpointed on " + std::to_string(n) + " MPI ranks: resume it with mpirun -np " +
              std::to_string(n) + ")";
     }
@@ -834,7 +834,7 @@ Result<RunSummary> runScenario(const Scenario& s, const RunOptions& opt) {
   }
   const CheckpointOwner owner{opt.command, fnv1a(scenarioText)};
   const fs::path checkpointPath =
-      opt.outDir / (ranks.distributed() ? detail::rankCheckpointFile(ranks.rank(), ranks.size()) : "checkpoint.bin");
+      opt.outDir / (ranks.distributed() ? rankCheckpointFile(ranks.rank(), ranks.size()) : "checkpoint.bin");
 
   STRATA_TRY_STATUS(startSolver(engine, domain, ranks, opt.outDir));
   engine.solver->enableFloodStats(float(s.outputs.wetThresholdM));
@@ -979,7 +979,7 @@ Result<RunSummary> runScenario(const Scenario& s, const RunOptions& opt) {
   }
   summary.files = {"scenario.toml", "series.csv"};
   if (ranks.distributed()) {
-    for (int r = 0; r < ranks.size(); ++r) summary.files.push_back(detail::rankCheckpointFile(r, ranks.size()));
+    for (int r = 0; r < ranks.size(); ++r) summary.files.push_back(rankCheckpointFile(r, ranks.size()));
     for (const auto& f : detail::modelInputFiles(int(run.domain().input.materials.size()))) {
       if (fs::exists(opt.outDir / f)) summary.files.push_back(f);
     }

@@ -4,8 +4,6 @@
 
 #include <strata/core/bytes.hpp>
 
-#include "distributed.hpp"
-
 namespace strata::scenario::detail {
 
 // Thermal weathering (E7, docs/sim-erosion.md) tests a cell's topmost layer: it sheds when the bed

@@ -3,10 +3,11 @@
 // (docs/scenario.md, "Layers"; docs/distributed.md, "Built by the ranks").
 
 #include <strata/scenario/domain.hpp>
+#include <strata/sim/mpi/ranks.hpp>
 
 namespace strata::scenario::detail {
 
-class Ranks;
+using sim::Ranks;
 
 /// Leaves each at_rest layer off the cells where it could not rest (domain.cpp says when), and
 /// sets d.layerCellsTooSteep to this rank's counts (add them over the ranks).

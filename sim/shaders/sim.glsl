@@ -1,6 +1,6 @@
 // The water / erosion simulation as the compute kernels see it. SimParams, SimMaterial and
-// SourceEntry mirror sim/include/strata/sim/gl_layout.hpp; tests/gl/gpu_layouts_test.cpp checks
-// that they agree. Buffer bindings are fixed here (slots: sim/include/strata/sim/shader_slots.hpp);
+// SourceEntry mirror sim/include/strata/sim/gl/gl_layout.hpp; tests/gl/gpu_layouts_test.cpp checks
+// that they agree. Buffer bindings are fixed here (slots: sim/include/strata/sim/gl/shader_slots.hpp);
 // sim/src/gl/gl_solver.cpp binds them. Equation numbers (W.., E..) refer to docs/sim-water.md and
 // docs/sim-erosion.md; sim/src/cpu_*.cpp is the same code in C++.
 struct SimParams {

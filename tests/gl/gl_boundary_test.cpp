@@ -24,7 +24,8 @@ const fs::path kRoot = STRATA_SOURCE_DIR;
 // check what the layer set up).
 const std::vector<std::string> kGlAllowed = {"gl/", "tests/gl/gl_context_test.cpp"};
 
-// Shader folders whose binding slots are declared in C++ (<library>/include/strata/<library>/shader_slots.hpp).
+// Shader folders whose binding slots are declared in C++ (<library>/include/strata/<library>/shader_slots.hpp;
+// sim/include/strata/sim/gl/shader_slots.hpp for sim).
 const std::vector<std::string> kSlotShaderFolders = {"render/shaders", "viewer/shaders", "procgen/shaders",
                                                      "sim/shaders"};
 

@@ -20,7 +20,7 @@
 #include <strata/scenario/scenario.hpp>
 
 #include "../../scenario/src/breach.hpp"
-#include "../../scenario/src/distributed.hpp"
+#include "../../scenario/src/build_rows.hpp"
 #include "../../scenario/src/domain_rows.hpp"
 #include "mpi_support.hpp"
 #include "scenario_fixture.hpp"

@@ -3,14 +3,14 @@
 #include <gtest/gtest.h>
 
 #include <strata/sim/bookkeeping.hpp>
-#include <strata/sim/gl_layout.hpp>
+#include <strata/sim/gl/gl_layout.hpp>
 
 #include "glsl_layout.hpp"
 
 namespace strata::test {
 namespace {
 
-// The GL backend's std430 blocks (sim/gl_layout.hpp, sim/bookkeeping.hpp) against
+// The GL backend's std430 blocks (sim/gl/gl_layout.hpp, sim/bookkeeping.hpp) against
 // sim/shaders/sim.glsl.
 template <class T>
 void expectSimLayout(const std::string& name, const std::vector<Field>& cpp) {

@@ -11,7 +11,7 @@
 #include <tuple>
 #include <vector>
 
-#include <strata/sim/distributed_solver.hpp>
+#include <strata/sim/mpi/distributed_solver.hpp>
 
 #include "mpi_support.hpp"
 #include "sim_scenes.hpp"

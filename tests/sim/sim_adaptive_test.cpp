@@ -8,7 +8,7 @@
 #include <cmath>
 
 #include <strata/sim/adaptive_solver.hpp>
-#include <strata/sim/gl_solver.hpp>
+#include <strata/sim/gl/gl_solver.hpp>
 
 #include "canyon_flood.hpp"
 #include "gl_fixture.hpp"

@@ -7,8 +7,8 @@
 #include <cmath>
 
 #include <strata/sim/cpu_solver.hpp>
-#include <strata/sim/gl_solver.hpp>
-#include <strata/sim/shader_slots.hpp>
+#include <strata/sim/gl/gl_solver.hpp>
+#include <strata/sim/gl/shader_slots.hpp>
 #include <strata/sim/tiled_solver.hpp>
 
 #include "gl_fixture.hpp"
@@ -36,7 +36,7 @@ double seconds(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-// Every kernel's buffer blocks sit on the slots sim/shader_slots.hpp declares (the GL backend
+// Every kernel's buffer blocks sit on the slots sim/gl/shader_slots.hpp declares (the GL backend
 // binds through the same table), and every slot and kernel file is used.
 TEST_F(GlTest, SimKernelsUseTheSlotsDeclaredInCpp) {
   std::vector<test::SlotProgram> programs;

@@ -10,7 +10,7 @@
 #include <string>
 
 #include <strata/gl/context.hpp>
-#include <strata/sim/gl_solver.hpp>
+#include <strata/sim/gl/gl_solver.hpp>
 
 #include "mpi_compare.hpp"
 

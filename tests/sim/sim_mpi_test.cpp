@@ -18,10 +18,11 @@
 #include <vector>
 
 #include <strata/sim/cpu_solver.hpp>
-#include <strata/sim/distributed_solver.hpp>
+#include <strata/sim/mpi/distributed_solver.hpp>
 #include <strata/sim/state_codec.hpp>
 
 #include <strata/sim/exact_sum.hpp>
+#include <strata/sim/mpi/ranks.hpp>
 #include "../../sim/src/mpi/decomposition.hpp"
 #include "mpi_compare.hpp"
 

@@ -1,4 +1,4 @@
-#include <strata/sim/gl_layout.hpp>
+#include <strata/sim/gl/gl_layout.hpp>
 
 namespace strata::sim {
 

@@ -1,7 +1,7 @@
 // Host side of the GL backend: owns the buffers, binds them at the slots declared in
 // sim/shaders/sim.glsl, and dispatches the passes in the order CpuSolver::runStep runs them, with
 // a shader-storage barrier between passes.
-#include <strata/sim/gl_solver.hpp>
+#include <strata/sim/gl/gl_solver.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -12,8 +12,8 @@
 #include <strata/gl/context.hpp>
 #include <strata/gl/objects.hpp>
 #include <strata/gl/state.hpp>
-#include <strata/sim/gl_layout.hpp>
-#include <strata/sim/shader_slots.hpp>
+#include <strata/sim/gl/gl_layout.hpp>
+#include <strata/sim/gl/shader_slots.hpp>
 
 namespace strata::sim {
 

@@ -1,4 +1,4 @@
-#include <strata/sim/distributed_solver.hpp>
+#include <strata/sim/mpi/distributed_solver.hpp>
 
 #include <algorithm>
 #include <climits>
@@ -9,6 +9,7 @@
 #include <strata/sim/state_codec.hpp>
 
 #include <strata/sim/exact_sum.hpp>
+#include <strata/sim/mpi/ranks.hpp>
 #include "decomposition.hpp"
 #include "tile_common.hpp"
 
@@ -101,37 +102,6 @@ class Timer {
 };
 
 }  // namespace
-
-Status collectiveStatus(const Status& local, MPI_Comm comm) {
-  int rank = 0;
-  MPI_Comm_rank(comm, &rank);
-  int failing = local.ok() ? INT_MAX : rank, first = INT_MAX;
-  MPI_Allreduce(&failing, &first, 1, MPI_INT, MPI_MIN, comm);
-  if (first == INT_MAX) return {};
-  std::string msg = local.ok() ? std::string() : local.message();
-  int len = int(msg.size());
-  MPI_Bcast(&len, 1, MPI_INT, first, comm);
-  msg.resize(size_t(len));
-  MPI_Bcast(msg.data(), len, MPI_CHAR, first, comm);
-  return fail(first == 0 ? msg : "rank " + std::to_string(first) + ": " + msg);
-}
-
-void allreduceExact(ExactSum* sums, int n, MPI_Comm comm) {
-  MPI_Datatype type;
-  MPI_Type_contiguous(int(sizeof(ExactSum)), MPI_BYTE, &type);
-  MPI_Type_commit(&type);
-  MPI_Op op;
-  MPI_Op_create(
-      [](void* in, void* inout, int* len, MPI_Datatype*) {
-        const auto* a = static_cast<const ExactSum*>(in);
-        auto* b = static_cast<ExactSum*>(inout);
-        for (int i = 0; i < *len; ++i) b[i] += a[i];
-      },
-      1, &op);
-  MPI_Allreduce(MPI_IN_PLACE, sums, n, type, op, comm);
-  MPI_Op_free(&op);
-  MPI_Type_free(&type);
-}
 
 // -------------------------------------------------------------------------------------------------
 
@@ -272,7 +242,7 @@ struct DistributedSolver::Impl {
     for (size_t k = 0; k < blocks.size(); ++k) localIndex[size_t(blocks[k].id)] = int(k);
     if (blockBackend.empty() && !blocks.empty()) blockBackend = blocks[0].solver->backendName();
     plan(params);
-    return collectiveStatus(status, comm);
+    return Ranks::of(comm).agree(status);
   }
 
   // Who sends what to whom each step, from `owner`.
@@ -794,7 +764,7 @@ Result<RebalanceReport> DistributedSolver::rebalance() {
     arrived.push_back(std::move(b).value());
   }
   MPI_Waitall(int(requests.size()), requests.data(), MPI_STATUSES_IGNORE);
-  status = collectiveStatus(status, m.comm);
+  status = Ranks::of(m.comm).agree(status);
   if (!status) return status.error();
   // Blocks that stay keep their idle state; those that arrive start active (always exact).
   m.owner = next;
@@ -1016,7 +986,7 @@ Status DistributedSolver::restoreCells(const SolverState& in) {
     status = fail("distributed: the saved state's blocks do not match its block grid (rank " + std::to_string(m.rank) +
                   " has " + std::to_string(in.parts.size()) + " parts)");
   }
-  STRATA_TRY_STATUS(collectiveStatus(status, m.comm));
+  STRATA_TRY_STATUS(Ranks::of(m.comm).agree(status));
   if (owner != m.owner) {
     m.owner = owner;
     STRATA_TRY_STATUS(m.adoptOwners(params(), sources(), levels(), floodThresholdM(), {}));
@@ -1030,7 +1000,7 @@ Status DistributedSolver::restoreCells(const SolverState& in) {
     }
   }
   m.invalidate();
-  return collectiveStatus(status, m.comm);
+  return Ranks::of(m.comm).agree(status);
 }
 
 // -------------------------------------------------------------------------------------------------

@@ -2,10 +2,8 @@
 // Sums whose result does not depend on the order of the terms, nor so on how cells are spread
 // over ranks: each term (a double) is rounded once to a multiple of 2^-64 and added as a 128-bit
 // integer, and integer addition is associative. Range: |sum| < 2^63 (9.2e18 m^3, more than the
-// oceans); each term is off by at most 2^-65 (2.7e-20 m^3). Reduced over ranks with one MPI
-// operation (Allreduce of `ExactSum` values).
-#include <mpi.h>
-
+// oceans); each term is off by at most 2^-65 (2.7e-20 m^3). Reduced over MPI ranks by
+// allreduceExact (strata/sim/mpi/ranks.hpp): this header needs no MPI.
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -34,8 +32,5 @@ struct ExactSum {
   double value() const { return bad ? std::numeric_limits<double>::quiet_NaN() : double(fixed) * 0x1p-64; }
 };
 static_assert(sizeof(ExactSum) == 32);
-
-/// Allreduce of `n` ExactSums in place over `comm` (collective).
-void allreduceExact(ExactSum* sums, int n, MPI_Comm comm);
 
 }  // namespace strata::sim

@@ -2,7 +2,7 @@
 // What a user chooses about a water / erosion run: the model and its constants (docs/sim-water.md,
 // docs/sim-erosion.md; equation numbers W1.., E1.. refer to them). Plain values: the grid is in
 // SimInput, the solver's state in the solver, and the GL backend derives its std430 block from
-// these in one place (sim/gl_layout.hpp).
+// these in one place (sim/gl/gl_layout.hpp).
 
 #include <cstdint>
 

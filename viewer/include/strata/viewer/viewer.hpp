@@ -14,7 +14,7 @@
 #include <strata/gis/raster.hpp>
 #include <strata/render/overlay.hpp>
 #include <strata/render/terrain_renderer.hpp>
-#include <strata/sim/gl_solver.hpp>
+#include <strata/sim/gl/gl_solver.hpp>
 #include <strata/viewer/camera_controller.hpp>
 #include <strata/viewer/command.hpp>
 #include <strata/viewer/terrain_editor.hpp>

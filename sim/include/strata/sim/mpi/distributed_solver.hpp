@@ -142,10 +142,6 @@ class DistributedSolver final : public Solver {
   std::unique_ptr<Impl> impl_;
 };
 
-/// Collective: success on every rank, or the failure of the lowest failing rank on every rank (its
-/// message, after "rank R: " for R > 0), so that no rank is left waiting in a collective call.
-Status collectiveStatus(const Status& local, MPI_Comm comm);
-
 /// Collective: the rank of this process among the ranks of `comm` on the same node
 /// (MPI_COMM_TYPE_SHARED).
 int localRank(MPI_Comm comm);
