@@ -272,7 +272,7 @@ void glHaloStrip(benchmark::State& state) {
   }
   for (auto _ : state) {
     ts::CellBlock b = sim->readBlock(n - 16, 0, 8, n, ts::kBlockHalo);
-    b.x0 = 0;
+    b.rect.x = 0;
     sim->writeBlock(b);
   }
   state.counters["bytes_per_strip"] = double(n) * 8 * (16 + 16 + 16);

@@ -547,7 +547,7 @@ Status CpuSolver::restoreCells(const SolverState& in) {
     return fail("sim: the saved state is of a different grid (" + std::to_string(in.state.size() / 4) +
                 " cells, this simulation has " + std::to_string(n) + ")");
   }
-  CellBlock b{0, 0, m.w, m.h, in.state, in.flux, in.fluxDiag, in.layers, in.accum};
+  CellBlock b{{0, 0, m.w, m.h}, in.state, in.flux, in.fluxDiag, in.layers, in.accum};
   writeBlock(b);
   m.markAll();
   return {};
@@ -555,7 +555,7 @@ Status CpuSolver::restoreCells(const SolverState& in) {
 
 CellBlock CpuSolver::readBlock(int x0, int y0, int width, int height, unsigned parts) const {
   const Impl& m = *impl_;
-  CellBlock b{x0, y0, width, height, {}, {}, {}, {}, {}};
+  CellBlock b{{x0, y0, width, height}, {}, {}, {}, {}, {}};
   STRATA_CHECK(blockFits(b, m.w, m.h, m.L)) << "readBlock (" << x0 << ", " << y0 << ") " << width << "x" << height
                                             << " outside the " << m.w << "x" << m.h << " grid";
   const auto& u = m.now();
@@ -604,28 +604,29 @@ void CpuSolver::writeBlock(const CellBlock& b) {
   cpu::Plane* const diagPlanes[4] = {&m.fluxDiag[0], &m.fluxDiag[1], &m.fluxDiag[2], &m.fluxDiag[3]};
   cpu::Plane* const accumPlanes[8] = {&m.accum[0], &m.accum[1], &m.accum[2], &m.accum[3],
                                       &m.accum[4], &m.accum[5], &m.accum[6], &m.accum[7]};
-  if (!b.state.empty()) cellsToPlanes(b.state.data(), b.x0, b.y0, b.width, b.height, statePlanes);
-  if (!b.flux.empty()) cellsToPlanes(b.flux.data(), b.x0, b.y0, b.width, b.height, fluxPlanes);
-  if (!b.fluxDiag.empty()) cellsToPlanes(b.fluxDiag.data(), b.x0, b.y0, b.width, b.height, diagPlanes);
-  if (!b.accum.empty()) cellsToPlanes(b.accum.data(), b.x0, b.y0, b.width, b.height, accumPlanes);
+  if (!b.state.empty()) cellsToPlanes(b.state.data(), b.rect.x, b.rect.y, b.rect.width, b.rect.height, statePlanes);
+  if (!b.flux.empty()) cellsToPlanes(b.flux.data(), b.rect.x, b.rect.y, b.rect.width, b.rect.height, fluxPlanes);
+  if (!b.fluxDiag.empty())
+    cellsToPlanes(b.fluxDiag.data(), b.rect.x, b.rect.y, b.rect.width, b.rect.height, diagPlanes);
+  if (!b.accum.empty()) cellsToPlanes(b.accum.data(), b.rect.x, b.rect.y, b.rect.width, b.rect.height, accumPlanes);
   if (!b.layers.empty()) {
     for (int l = 0; l < m.L; ++l) {
-      for (int y = 0; y < b.height; ++y) {
-        for (int x = 0; x < b.width; ++x) {
-          m.layers.at(b.x0 + x, l * m.h + b.y0 + y) =
-              b.layers[size_t(l) * cells + size_t(y) * size_t(b.width) + size_t(x)];
+      for (int y = 0; y < b.rect.height; ++y) {
+        for (int x = 0; x < b.rect.width; ++x) {
+          m.layers.at(b.rect.x + x, l * m.h + b.rect.y + y) =
+              b.layers[size_t(l) * cells + size_t(y) * size_t(b.rect.width) + size_t(x)];
         }
       }
     }
-    for (int y = 0; y < b.height; ++y) {
-      for (int x = 0; x < b.width; ++x) m.recomputeBed(b.x0 + x, b.y0 + y);
+    for (int y = 0; y < b.rect.height; ++y) {
+      for (int x = 0; x < b.rect.width; ++x) m.recomputeBed(b.rect.x + x, b.rect.y + y);
     }
   }
   // The blocks written run in the next two steps (their other state buffer and intermediates
   // are stale), and their flags follow the new cells.
-  if (b.width == 0 || b.height == 0) return;
-  for (int by = b.y0 / cpu::kBlock; by <= (b.y0 + b.height - 1) / cpu::kBlock; ++by) {
-    for (int bx = b.x0 / cpu::kBlock; bx <= (b.x0 + b.width - 1) / cpu::kBlock; ++bx) {
+  if (b.rect.width == 0 || b.rect.height == 0) return;
+  for (int by = b.rect.y / cpu::kBlock; by <= (b.rect.y + b.rect.height - 1) / cpu::kBlock; ++by) {
+    for (int bx = b.rect.x / cpu::kBlock; bx <= (b.rect.x + b.rect.width - 1) / cpu::kBlock; ++bx) {
       const size_t k = size_t(by * m.bw + bx);
       m.forced[k] = 1;
       m.thermalForced[k] = 1;
@@ -633,8 +634,8 @@ void CpuSolver::writeBlock(const CellBlock& b) {
       m.evapResidual[k] = m.blockEvapResidual(bx, by);
     }
   }
-  for (int y = b.y0; y < b.y0 + b.height && !m.anySuspended && !b.state.empty(); ++y) {
-    for (int x = b.x0; x < b.x0 + b.width; ++x)
+  for (int y = b.rect.y; y < b.rect.y + b.rect.height && !m.anySuspended && !b.state.empty(); ++y) {
+    for (int x = b.rect.x; x < b.rect.x + b.rect.width; ++x)
       m.anySuspended = m.anySuspended || u.s.at(x, y) != 0.0f || std::signbit(u.s.at(x, y));
   }
   m.allocateFor(m.p);

@@ -150,13 +150,26 @@ Solver::Totals Solver::totals() const {
   return t;
 }
 
+// A checkpoint's per-cell arrays as the parts of a block of the whole grid: the same fields in
+// the same order (CellBlock::forEachPart).
+namespace {
+template <class State, class F>
+void forEachStatePart(State& s, F&& f) {
+  f(s.state);
+  f(s.flux);
+  f(s.fluxDiag);
+  f(s.layers);
+  f(s.accum);
+}
+}  // namespace
+
 void Solver::saveCells(SolverState& out) const {
   CellBlock b = readBlock(0, 0, grid_.width, grid_.height, kBlockAll);
-  out.state = std::move(b.state);
-  out.flux = std::move(b.flux);
-  out.fluxDiag = std::move(b.fluxDiag);
-  out.layers = std::move(b.layers);
-  out.accum = std::move(b.accum);
+  std::vector<std::vector<float>*> parts;
+  CellBlock::forEachPart(b, grid_.layers,
+                         [&](unsigned, std::vector<float>& v, size_t, size_t) { parts.push_back(&v); });
+  size_t k = 0;
+  forEachStatePart(out, [&](std::vector<float>& v) { v = std::move(*parts[k++]); });
 }
 
 Status Solver::restoreCells(const SolverState& in) {
@@ -167,7 +180,12 @@ Status Solver::restoreCells(const SolverState& in) {
     return fail("sim: the saved state is of a different grid or model (" + std::to_string(in.state.size() / 4) +
                 " cells, this simulation has " + std::to_string(n) + ")");
   }
-  writeBlock(CellBlock{0, 0, grid_.width, grid_.height, in.state, in.flux, in.fluxDiag, in.layers, in.accum});
+  CellBlock b{{0, 0, grid_.width, grid_.height}, {}, {}, {}, {}, {}};
+  std::vector<const std::vector<float>*> parts;
+  forEachStatePart(in, [&](const std::vector<float>& v) { parts.push_back(&v); });
+  size_t k = 0;
+  CellBlock::forEachPart(b, grid_.layers, [&](unsigned, std::vector<float>& v, size_t, size_t) { v = *parts[k++]; });
+  writeBlock(b);
   return {};
 }
 
@@ -201,10 +219,38 @@ SimStats Solver::stats() const {
 
 bool blockFits(const CellBlock& b, int width, int height, int layers) {
   const size_t n = b.cells();
-  auto sized = [&](const std::vector<float>& v, size_t per) { return v.empty() || v.size() == per * n; };
-  return b.x0 >= 0 && b.y0 >= 0 && b.width >= 0 && b.height >= 0 && b.x0 + b.width <= width &&
-         b.y0 + b.height <= height && sized(b.state, 4) && sized(b.flux, 4) && sized(b.fluxDiag, 4) &&
-         sized(b.layers, size_t(layers)) && sized(b.accum, 8);
+  const gis::CellRect& r = b.rect;
+  bool fits =
+      r.x >= 0 && r.y >= 0 && r.width >= 0 && r.height >= 0 && r.x + r.width <= width && r.y + r.height <= height;
+  CellBlock::forEachPart(b, layers, [&](unsigned, const std::vector<float>& v, size_t per, size_t planes) {
+    fits = fits && (v.empty() || v.size() == per * planes * n);
+  });
+  return fits;
+}
+
+void copyOverlap(const CellBlock& src, CellBlock& dst, int layers) {
+  const gis::CellRect r = src.rect.intersected(dst.rect);
+  if (r.empty()) return;
+  const size_t srcCells = src.cells(), dstCells = dst.cells();
+  // The parts of `src`, by position in the one list, into the same parts of `dst`.
+  std::vector<const std::vector<float>*> from;
+  CellBlock::forEachPart(src, layers,
+                         [&](unsigned, const std::vector<float>& v, size_t, size_t) { from.push_back(&v); });
+  size_t k = 0;
+  CellBlock::forEachPart(dst, layers, [&](unsigned, std::vector<float>& d, size_t per, size_t planes) {
+    const std::vector<float>& s = *from[k++];
+    if (s.empty()) return;
+    d.resize(per * planes * dstCells);
+    for (size_t p = 0; p < planes; ++p) {
+      for (int y = 0; y < r.height; ++y) {
+        const size_t si =
+            p * srcCells + size_t(r.y - src.rect.y + y) * size_t(src.rect.width) + size_t(r.x - src.rect.x);
+        const size_t di =
+            p * dstCells + size_t(r.y - dst.rect.y + y) * size_t(dst.rect.width) + size_t(r.x - dst.rect.x);
+        std::copy_n(&s[per * si], per * size_t(r.width), &d[per * di]);
+      }
+    }
+  });
 }
 
 std::vector<float> initialFloodStatsCells(size_t cells) {

@@ -124,15 +124,15 @@ void TiledSolver::exchangeHalos() {
       const int y0 = std::max(t.ey0, src.y0), y1 = std::min(t.ey1, src.y1);
       if (x0 >= x1 || y0 >= y1) continue;
       CellBlock b = src.solver->readBlock(x0 - src.ex0, y0 - src.ey0, x1 - x0, y1 - y0, kBlockHalo);
-      b.x0 = x0;
-      b.y0 = y0;
+      b.rect.x = x0;
+      b.rect.y = y0;
       pieces.push_back({k, std::move(b)});
     }
   }
   for (auto& p : pieces) {
     const Tile& t = tiles_[p.tile];
-    p.block.x0 -= t.ex0;
-    p.block.y0 -= t.ey0;
+    p.block.rect.x -= t.ex0;
+    p.block.rect.y -= t.ey0;
     tiles_[p.tile].solver->writeBlock(p.block);
   }
 }
@@ -149,63 +149,28 @@ gis::Grid<float> TiledSolver::readBed() const {
 }
 
 CellBlock TiledSolver::readBlock(int x0, int y0, int width, int height, unsigned parts) const {
-  CellBlock out{x0, y0, width, height, {}, {}, {}, {}, {}};
+  CellBlock out{{x0, y0, width, height}, {}, {}, {}, {}, {}};
   STRATA_CHECK(blockFits(out, grid().width, grid().height, grid().layers)) << "readBlock outside the grid";
-  const size_t cells = out.cells();
-  const int L = grid().layers;
   for (const auto& t : tiles_) {
-    const int bx0 = std::max(x0, t.x0), bx1 = std::min(x0 + width, t.x1);
-    const int by0 = std::max(y0, t.y0), by1 = std::min(y0 + height, t.y1);
-    if (bx0 >= bx1 || by0 >= by1) continue;
-    const CellBlock b = t.solver->readBlock(bx0 - t.ex0, by0 - t.ey0, bx1 - bx0, by1 - by0, parts);
-    auto place = [&](std::vector<float>& dst, const std::vector<float>& src, size_t per, size_t planes) {
-      if (src.empty()) return;
-      dst.resize(per * planes * cells);
-      const size_t bcells = b.cells();
-      for (size_t p = 0; p < planes; ++p) {
-        for (int y = 0; y < b.height; ++y) {
-          const size_t s = p * bcells + size_t(y) * size_t(b.width);
-          const size_t d = p * cells + size_t(by0 - y0 + y) * size_t(width) + size_t(bx0 - x0);
-          std::copy_n(&src[per * s], per * size_t(b.width), &dst[per * d]);
-        }
-      }
-    };
-    place(out.state, b.state, 4, 1);
-    place(out.flux, b.flux, 4, 1);
-    place(out.fluxDiag, b.fluxDiag, 4, 1);
-    place(out.layers, b.layers, 1, size_t(L));
-    place(out.accum, b.accum, 8, 1);
+    const gis::CellRect own = out.rect.intersected({t.x0, t.y0, t.x1 - t.x0, t.y1 - t.y0});
+    if (own.empty()) continue;
+    CellBlock b = t.solver->readBlock(own.x - t.ex0, own.y - t.ey0, own.width, own.height, parts);
+    b.rect = own;  // in the grid's coordinates
+    copyOverlap(b, out, grid().layers);
   }
   return out;
 }
 
 void TiledSolver::writeBlock(const CellBlock& block) {
   STRATA_CHECK(blockFits(block, grid().width, grid().height, grid().layers)) << "writeBlock outside the grid";
-  const size_t cells = block.cells();
-  const int L = grid().layers;
   // Every tile that sees a cell of the block (interior or halo) takes it.
   for (auto& t : tiles_) {
-    const int bx0 = std::max(block.x0, t.ex0), bx1 = std::min(block.x0 + block.width, t.ex1);
-    const int by0 = std::max(block.y0, t.ey0), by1 = std::min(block.y0 + block.height, t.ey1);
-    if (bx0 >= bx1 || by0 >= by1) continue;
-    CellBlock b{bx0 - t.ex0, by0 - t.ey0, bx1 - bx0, by1 - by0, {}, {}, {}, {}, {}};
-    auto take = [&](std::vector<float>& dst, const std::vector<float>& src, size_t per, size_t planes) {
-      if (src.empty()) return;
-      const size_t bcells = b.cells();
-      dst.resize(per * planes * bcells);
-      for (size_t p = 0; p < planes; ++p) {
-        for (int y = 0; y < b.height; ++y) {
-          const size_t d = p * bcells + size_t(y) * size_t(b.width);
-          const size_t s = p * cells + size_t(by0 - block.y0 + y) * size_t(block.width) + size_t(bx0 - block.x0);
-          std::copy_n(&src[per * s], per * size_t(b.width), &dst[per * d]);
-        }
-      }
-    };
-    take(b.state, block.state, 4, 1);
-    take(b.flux, block.flux, 4, 1);
-    take(b.fluxDiag, block.fluxDiag, 4, 1);
-    take(b.layers, block.layers, 1, size_t(L));
-    take(b.accum, block.accum, 8, 1);
+    const gis::CellRect seen = block.rect.intersected({t.ex0, t.ey0, t.ex1 - t.ex0, t.ey1 - t.ey0});
+    if (seen.empty()) continue;
+    CellBlock b{seen, {}, {}, {}, {}, {}};
+    copyOverlap(block, b, grid().layers);
+    b.rect.x -= t.ex0;  // in the tile's coordinates
+    b.rect.y -= t.ey0;
     t.solver->writeBlock(b);
   }
 }

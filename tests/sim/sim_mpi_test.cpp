@@ -368,7 +368,7 @@ TEST(SimDistributed, LocalReadsCoverTheGridOnceAndEqualOneProcess) {
     }
     const CellBlock mine = sim->readLocal(r, kBlockState | kBlockLayers);
     const CellBlock theirs = ref->readBlock(r.x, r.y, r.width, r.height, kBlockState | kBlockLayers);
-    EXPECT_EQ(mine.x0, r.x);
+    EXPECT_EQ(mine.rect.x, r.x);
     EXPECT_TRUE(sameBits(mine.state, theirs.state));
     EXPECT_TRUE(sameBits(mine.layers, theirs.layers));
     const FloodStats f = sim->readLocalFloodStats(r), g = cropFloodStats(refFlood, r);

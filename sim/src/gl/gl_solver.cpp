@@ -4,6 +4,7 @@
 #include <strata/sim/gl/gl_solver.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <cstring>
@@ -352,28 +353,31 @@ size_t GlSolver::gpuBytes() const {
   return total;
 }
 
+// The buffer of each part of a CellBlock, in CellBlock::forEachPart's order (the diagonal pipes'
+// only with them).
+namespace {
+template <class Impl>
+std::array<gl::Buffer*, 5> partBuffers(Impl& s, bool diag) {
+  return {&s.curMut(), &s.flux, diag ? &s.fluxDiag : nullptr, &s.layerBuf, &s.accum};
+}
+}  // namespace
+
 CellBlock GlSolver::readBlock(int x0, int y0, int width, int height, unsigned parts) const {
   const int w = grid().width, L = grid().layers;
-  CellBlock b{x0, y0, width, height, {}, {}, {}, {}, {}};
+  CellBlock b{{x0, y0, width, height}, {}, {}, {}, {}, {}};
   STRATA_CHECK(blockFits(b, w, grid().height, L))
       << "readBlock (" << x0 << ", " << y0 << ") " << width << "x" << height << " outside the grid";
   Impl& s = *impl_;
   readBarrier();
-  const size_t cells = b.cells();
-  if (parts & kBlockState) b.state.resize(4 * cells);
-  if (parts & kBlockFlux) b.flux.resize(4 * cells);
-  if ((parts & kBlockFlux) && params().diagonalPipes) b.fluxDiag.resize(4 * cells);
-  if (parts & kBlockLayers) b.layers.resize(size_t(L) * cells);
-  if (parts & kBlockAccum) b.accum.resize(8 * cells);
   // One transfer per part (whole rows, or packed on the GPU first).
-  auto read = [&](const gl::Buffer& buf, size_t per, size_t planes, std::vector<float>& out) {
-    if (!out.empty()) s.downloadRect(buf, Impl::Rect{per, planes, x0, y0, width, height}, out.data());
-  };
-  read(s.cur(), 4, 1, b.state);
-  read(s.flux, 4, 1, b.flux);
-  read(s.fluxDiag, 4, 1, b.fluxDiag);
-  read(s.accum, 8, 1, b.accum);
-  read(s.layerBuf, 1, size_t(L), b.layers);
+  const auto buffers = partBuffers(s, params().diagonalPipes);
+  size_t k = 0;
+  CellBlock::forEachPart(b, L, [&](unsigned bit, std::vector<float>& out, size_t per, size_t planes) {
+    gl::Buffer* buf = buffers[k++];
+    if (!(parts & bit) || !buf) return;
+    out.resize(per * planes * b.cells());
+    s.downloadRect(*buf, Impl::Rect{per, planes, x0, y0, width, height}, out.data());
+  });
   return b;
 }
 
@@ -382,15 +386,14 @@ void GlSolver::writeBlock(const CellBlock& b) {
   STRATA_CHECK(blockFits(b, w, grid().height, L)) << "writeBlock: sizes do not match the block or the grid";
   Impl& s = *impl_;
   readBarrier();
-  auto write = [&](gl::Buffer& buf, size_t per, size_t planes, const std::vector<float>& in) {
-    if (!in.empty()) s.uploadRect(buf, Impl::Rect{per, planes, b.x0, b.y0, b.width, b.height}, in.data());
-  };
-  write(s.curMut(), 4, 1, b.state);
-  write(s.flux, 4, 1, b.flux);
-  write(s.fluxDiag, 4, 1, b.fluxDiag);
-  write(s.accum, 8, 1, b.accum);
-  write(s.layerBuf, 1, size_t(L), b.layers);
-  if (!b.layers.empty()) s.recomputeBed(b.x0, b.y0, b.width, b.height);
+  const auto buffers = partBuffers(s, params().diagonalPipes);
+  const gis::CellRect& r = b.rect;
+  size_t k = 0;
+  CellBlock::forEachPart(b, L, [&](unsigned, const std::vector<float>& in, size_t per, size_t planes) {
+    gl::Buffer* buf = buffers[k++];
+    if (!in.empty() && buf) s.uploadRect(*buf, Impl::Rect{per, planes, r.x, r.y, r.width, r.height}, in.data());
+  });
+  if (!b.layers.empty()) s.recomputeBed(r.x, r.y, r.width, r.height);
 }
 
 SolverFactory glSolverFactory() {

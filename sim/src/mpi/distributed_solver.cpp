@@ -33,60 +33,38 @@ bool allZeroBits(const float* v, size_t n) {
   return true;
 }
 
-// Floats per cell of the parts of a block, in the order they are packed: state, flux, diagonal
-// flux, layers (layer-major within a piece), accumulators.
+// Floats per cell of the parts of a block that `parts` asks for (the diagonal flux with `diag`),
+// in CellBlock's order: what pack() writes per cell.
 size_t floatsPerCell(unsigned parts, bool diag, int layers) {
   size_t n = 0;
-  if (parts & kBlockState) n += 4;
-  if (parts & kBlockFlux) n += diag ? 8 : 4;
-  if (parts & kBlockLayers) n += size_t(layers);
-  if (parts & kBlockAccum) n += 8;
+  const CellBlock none;
+  int k = 0;
+  CellBlock::forEachPart(none, layers, [&](unsigned bit, const std::vector<float>&, size_t per, size_t planes) {
+    const bool isDiag = k++ == 2;
+    if ((parts & bit) && (!isDiag || diag)) n += per * planes;
+  });
   return n;
 }
 
+// The parts `b` has, one after the other (each as the block holds it).
 void pack(const CellBlock& b, std::vector<float>& out) {
-  for (const auto* v : {&b.state, &b.flux, &b.fluxDiag, &b.layers, &b.accum})
-    out.insert(out.end(), v->begin(), v->end());
+  CellBlock::forEachPart(
+      b, 0, [&](unsigned, const std::vector<float>& v, size_t, size_t) { out.insert(out.end(), v.begin(), v.end()); });
 }
 
 // The parts of a `rect` block read from `in` (as pack() wrote it); returns the floats used.
 size_t unpack(const float* in, const CellRect& rect, unsigned parts, bool diag, int layers, CellBlock& b) {
-  b = CellBlock{rect.x, rect.y, rect.width, rect.height, {}, {}, {}, {}, {}};
+  b = CellBlock{rect, {}, {}, {}, {}, {}};
   const size_t cells = b.cells();
   size_t at = 0;
-  auto take = [&](std::vector<float>& v, size_t per) {
-    v.assign(in + at, in + at + per * cells);
-    at += per * cells;
-  };
-  if (parts & kBlockState) take(b.state, 4);
-  if (parts & kBlockFlux) take(b.flux, 4);
-  if ((parts & kBlockFlux) && diag) take(b.fluxDiag, 4);
-  if (parts & kBlockLayers) take(b.layers, size_t(layers));
-  if (parts & kBlockAccum) take(b.accum, 8);
+  int k = 0;
+  CellBlock::forEachPart(b, layers, [&](unsigned bit, std::vector<float>& v, size_t per, size_t planes) {
+    const bool isDiag = k++ == 2;
+    if (!(parts & bit) || (isDiag && !diag)) return;
+    v.assign(in + at, in + at + per * planes * cells);
+    at += per * planes * cells;
+  });
   return at;
-}
-
-// Copies the cells of `src` (a block of some rectangle) that fall in `dstRect` into `dst`, a block
-// of dstRect (both per-cell interleaved, layers layer-major).
-void place(const CellBlock& src, CellBlock& dst, int layers) {
-  const CellRect r = intersect({src.x0, src.y0, src.width, src.height}, {dst.x0, dst.y0, dst.width, dst.height});
-  if (r.empty()) return;
-  auto copy = [&](const std::vector<float>& s, std::vector<float>& d, size_t per, size_t planes) {
-    if (s.empty()) return;
-    d.resize(per * planes * dst.cells());
-    for (size_t p = 0; p < planes; ++p) {
-      for (int y = 0; y < r.height; ++y) {
-        const size_t si = p * src.cells() + size_t(r.y - src.y0 + y) * size_t(src.width) + size_t(r.x - src.x0);
-        const size_t di = p * dst.cells() + size_t(r.y - dst.y0 + y) * size_t(dst.width) + size_t(r.x - dst.x0);
-        std::copy_n(&s[per * si], per * size_t(r.width), &d[per * di]);
-      }
-    }
-  };
-  copy(src.state, dst.state, 4, 1);
-  copy(src.flux, dst.flux, 4, 1);
-  copy(src.fluxDiag, dst.fluxDiag, 4, 1);
-  copy(src.layers, dst.layers, 1, size_t(layers));
-  copy(src.accum, dst.accum, 8, 1);
 }
 
 class Timer {
@@ -363,8 +341,8 @@ struct DistributedSolver::Impl {
       Block& d = block(p.dst);
       const CellRect r = s.local(p.rect);
       CellBlock piece = s.solver->readBlock(r.x, r.y, r.width, r.height, kBlockHalo);
-      piece.x0 = p.rect.x - d.extent.x;
-      piece.y0 = p.rect.y - d.extent.y;
+      piece.rect.x = p.rect.x - d.extent.x;
+      piece.rect.y = p.rect.y - d.extent.y;
       noteIncoming(d, piece);
       d.solver->writeBlock(piece);
       counters.haloBytesLocal += double(haloFloats(params)) * 4.0 * double(piece.cells());
@@ -425,7 +403,7 @@ struct DistributedSolver::Impl {
       const CellRect r{int(all[at]), int(all[at + 1]), int(all[at + 2]), int(all[at + 3])};
       CellBlock piece;
       at += 4 + unpack(all.data() + at + 4, r, parts, diag(params), layers(), piece);
-      place(piece, out, layers());
+      copyOverlap(piece, out, layers());
     }
     return out;
   }
@@ -581,8 +559,8 @@ CellBlock DistributedSolver::readLocal(const CellRect& rect, unsigned parts) con
   const auto& b = impl_->holding(rect);
   const CellRect l = b.local(rect);
   CellBlock out = b.solver->readBlock(l.x, l.y, l.width, l.height, parts);
-  out.x0 = rect.x;
-  out.y0 = rect.y;
+  out.rect.x = rect.x;
+  out.rect.y = rect.y;
   return out;
 }
 
@@ -819,41 +797,36 @@ SimStats DistributedSolver::stats() const {
 }
 
 CellBlock DistributedSolver::readBlock(int x0, int y0, int width, int height, unsigned parts) const {
-  CellBlock probe{x0, y0, width, height, {}, {}, {}, {}, {}};
+  CellBlock probe{{x0, y0, width, height}, {}, {}, {}, {}, {}};
   STRATA_CHECK(blockFits(probe, grid().width, grid().height, grid().layers)) << "readBlock outside the grid";
   return impl_->gather({x0, y0, width, height}, parts, params());
 }
 
 void DistributedSolver::writeBlock(const CellBlock& block) {
   Impl& m = *impl_;
-  // Rank 0's block to every rank: its rectangle, which parts it has, then the parts.
-  int header[9] = {block.x0,
-                   block.y0,
-                   block.width,
-                   block.height,
-                   int(block.state.size()),
-                   int(block.flux.size()),
-                   int(block.fluxDiag.size()),
-                   int(block.layers.size()),
-                   int(block.accum.size())};
+  // Rank 0's block to every rank: its rectangle, the size of each of its parts, then the parts.
+  int header[9] = {block.rect.x, block.rect.y, block.rect.width, block.rect.height};
+  int k = 4;
+  CellBlock::forEachPart(block, grid().layers,
+                         [&](unsigned, const std::vector<float>& v, size_t, size_t) { header[k++] = int(v.size()); });
   if (m.rank == 0) {
     STRATA_CHECK(blockFits(block, grid().width, grid().height, grid().layers)) << "writeBlock outside the grid";
   }
   MPI_Bcast(header, 9, MPI_INT, 0, m.comm);
-  CellBlock b = m.rank == 0 ? block : CellBlock{header[0], header[1], header[2], header[3], {}, {}, {}, {}, {}};
-  int k = 4;
-  for (auto* v : {&b.state, &b.flux, &b.fluxDiag, &b.layers, &b.accum}) {
-    v->resize(size_t(header[k++]));
-    MPI_Bcast(v->data(), int(v->size()), MPI_FLOAT, 0, m.comm);
-  }
+  CellBlock b = m.rank == 0 ? block : CellBlock{{header[0], header[1], header[2], header[3]}, {}, {}, {}, {}, {}};
+  k = 4;
+  CellBlock::forEachPart(b, grid().layers, [&](unsigned, std::vector<float>& v, size_t, size_t) {
+    v.resize(size_t(header[k++]));
+    MPI_Bcast(v.data(), int(v.size()), MPI_FLOAT, 0, m.comm);
+  });
   // Every block that sees a cell of it (interior or halo) takes it.
   for (auto& blk : m.blocks) {
-    const CellRect r = intersect({b.x0, b.y0, b.width, b.height}, blk.extent);
+    const CellRect r = b.rect.intersected(blk.extent);
     if (r.empty()) continue;
-    CellBlock part{r.x, r.y, r.width, r.height, {}, {}, {}, {}, {}};
-    place(b, part, grid().layers);
-    part.x0 -= blk.extent.x;
-    part.y0 -= blk.extent.y;
+    CellBlock part{r, {}, {}, {}, {}, {}};
+    copyOverlap(b, part, grid().layers);
+    part.rect.x -= blk.extent.x;
+    part.rect.y -= blk.extent.y;
     blk.solver->writeBlock(part);
   }
   m.invalidate();

@@ -71,14 +71,32 @@ enum BlockParts : unsigned {
 /// The persistent state of a rectangle of cells: what a halo exchange (tiles, ranks) carries.
 /// An empty part is not read or, in writeBlock(), left as it is.
 struct CellBlock {
-  int x0 = 0, y0 = 0, width = 0, height = 0;  ///< the cells [x0, x0 + width) x [y0, y0 + height)
-  std::vector<float> state;                   ///< 4 per cell: depth h, suspended s, discharges hu, hv
-  std::vector<float> flux;                    ///< 4 per cell: pipe outflows W, E, N, S (m^3/s)
-  std::vector<float> fluxDiag;                ///< 4 per cell: diagonal pipes NW, NE, SW, SE (with them)
-  std::vector<float> layers;                  ///< layer-major: layers[l * cells + cell] (m)
-  std::vector<float> accum;                   ///< 8 per cell: compensated sums (SolverState::accum)
-  size_t cells() const { return size_t(width) * size_t(height); }
+  gis::CellRect rect;           ///< the cells [x, x + width) x [y, y + height)
+  std::vector<float> state;     ///< 4 per cell: depth h, suspended s, discharges hu, hv
+  std::vector<float> flux;      ///< 4 per cell: pipe outflows W, E, N, S (m^3/s)
+  std::vector<float> fluxDiag;  ///< 4 per cell: diagonal pipes NW, NE, SW, SE (with them)
+  std::vector<float> layers;    ///< layer-major: layers[l * cells + cell] (m)
+  std::vector<float> accum;     ///< 8 per cell: compensated sums (SolverState::accum)
+  size_t cells() const { return size_t(rect.width) * size_t(rect.height); }
+
+  /// The one list of a block's parts: f(part's BlockParts bit, its values, floats per cell of a
+  /// plane, planes) for each, in one order (the layers are `layers` planes, layer-major; the
+  /// others one plane of interleaved floats). Whatever walks the parts (fits, copies, encodings,
+  /// checkpoints) walks this.
+  template <class Block, class F>
+  static void forEachPart(Block& b, int layers, F&& f) {
+    f(kBlockState, b.state, size_t(4), size_t(1));
+    f(kBlockFlux, b.flux, size_t(4), size_t(1));
+    f(kBlockFlux, b.fluxDiag, size_t(4), size_t(1));
+    f(kBlockLayers, b.layers, size_t(1), size_t(layers));
+    f(kBlockAccum, b.accum, size_t(8), size_t(1));
+  }
 };
+
+/// Copies what `src` holds of the cells in both rectangles into `dst` (each part `src` has,
+/// sized to dst.rect where `dst` lacks it); both rectangles in the same coordinates. The one
+/// overlap copy: tiles' and ranks' halos, and reads and writes of blocks that span parts.
+void copyOverlap(const CellBlock& src, CellBlock& dst, int layers);
 
 /// A solver's own counters: time, steps and the budgets of what it added.
 struct SolverCounters {
