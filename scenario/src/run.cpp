@@ -769,258 +769,324 @@ std::string checkpointHint(const fs::path& dir, const Ranks& ranks) {
   return "";
 }
 
-}  // namespace
+// One run of a scenario, as runScenario's named steps. Every step is collective over the ranks:
+// each rank takes it, and a failure on any rank fails it on all (Ranks::agree).
+class Session {
+ public:
+  Session(const Scenario& s, const RunOptions& opt)
+      : s_(s), opt_(opt), ranks_(opt.distributed ? Ranks::world() : Ranks::single()), name_(displayName(s.name)) {}
 
-Result<RunSummary> runScenario(const Scenario& s, const RunOptions& opt) {
-  const auto wallStart = std::chrono::steady_clock::now();
-  const Ranks ranks = opt.distributed ? Ranks::world() : Ranks::single();
-  // Derived sizes first: the interval count (64-bit, bounded; the parser checked it for files,
-  // a scenario built in code is checked here) and, in buildDomain, the grid against memory.
-  const double intervalCount = std::ceil(s.durationS / s.outputIntervalS - 1e-9);
-  if (!(s.durationS > 0 && intervalCount >= 1 && intervalCount <= double(kMaxOutputIntervals))) {
-    char msg[160];
-    std::snprintf(msg, sizeof msg, "%.3g output intervals over the duration (1 to %lld)", intervalCount,
-                  kMaxOutputIntervals);
-    return fail(s.at("time.output_interval") + msg);
-  }
-  const int intervals = int(intervalCount);
-  // The domain. In one process: built whole. Over MPI ranks: each rank builds its own rows from
-  // its windows of the DEM or store (domain_rows.hpp; the region needs a row per rank), writes
-  // them into input/ (the model input the run's blocks read) and runs on the domain's shape.
-  STRATA_TRY(auto engine, startContext(opt.backend.value_or(s.model.backend), opt.pictures, ranks));
-  ScenarioDomain domain;
-  std::optional<detail::RowsBuilt> rows;
-  if (ranks.distributed()) {
-    auto planned = detail::RowBuilder::plan(s, opt.memoryBudgetBytes, ranks.size(), opt.pictures);
-    STRATA_TRY_STATUS(ranks.agree(statusOf(planned)));
-    STRATA_TRY(rows, detail::buildByRows(*planned, s, ranks));
-  } else {
-    STRATA_TRY(domain, buildDomain(s, opt.memoryBudgetBytes));
-  }
-
-  Status status;
-  std::optional<FileLock> lock;  // held by the lead for the whole run
-  if (ranks.lead()) {
-    auto taken = takeRunFolder(opt);
-    status = statusOf(taken);
-    if (taken) {
-      lock.emplace(std::move(taken).value());
-      std::error_code ec;
-      fs::create_directories(opt.outDir / "maps", ec);
-      if (ec) status = fail(opt.outDir.string() + ": cannot create the run folder: " + ec.message());
+  // Derived sizes first: the interval count (64-bit, bounded; the parser checked it for files, a
+  // scenario built in code is checked here) and, in the domain build, the grid against memory.
+  Status countIntervals() {
+    const double count = std::ceil(s_.durationS / s_.outputIntervalS - 1e-9);
+    if (!(s_.durationS > 0 && count >= 1 && count <= double(kMaxOutputIntervals))) {
+      char msg[160];
+      std::snprintf(msg, sizeof msg, "%.3g output intervals over the duration (1 to %lld)", count, kMaxOutputIntervals);
+      return fail(s_.at("time.output_interval") + msg);
     }
-  }
-  STRATA_TRY_STATUS(ranks.agree(status));
-  const std::string scenarioText = ranks.fromLead(ranks.lead() ? slurp(s.file) : std::string());
-  // Pictures and plots draw the bed: the elevation map, written once the domain is built.
-  const bool elevation = opt.pictures || opt.plots;
-  if (rows) {
-    STRATA_TRY_STATUS(detail::writeRows(ranks, opt.outDir, *rows, elevation));
-    domain = std::move(rows->shape);
-    rows.reset();  // this rank's rows: read back from input/ by its blocks
-  } else if (elevation) {
-    STRATA_TRY_STATUS(detail::writeRaster(ranks, opt.outDir / "maps" / "elevation.tif", domain.bed.georef, {},
-                                          {{0, 0, domain.bed.values}}));
-  }
-  const std::string name = displayName(s.name);
-  if (ranks.lead()) {
-    const auto& g = domain.bed.georef;
-    log::info(opt.command) << name << ": " << g.width << " x " << g.height << " cells, " << domain.totalAreaM2 / 1e6
-                           << " km^2, " << domain.sources.size() << " inflow(s), " << domain.levels.size()
-                           << " fixed level(s), " << formatDuration(s.durationS) << " simulated"
-                           << (ranks.distributed()
-                                   ? ", built by the " + std::to_string(ranks.size()) + " ranks row by row"
-                                   : std::string());
-  }
-  const CheckpointOwner owner{opt.command, fnv1a(scenarioText)};
-  const fs::path checkpointPath =
-      opt.outDir / (ranks.distributed() ? rankCheckpointFile(ranks.rank(), ranks.size()) : "checkpoint.bin");
-
-  STRATA_TRY_STATUS(startSolver(engine, domain, ranks, opt.outDir));
-  engine.solver->enableFloodStats(float(s.outputs.wetThresholdM));
-  Run run(s, opt, ranks, std::move(domain), std::move(engine));
-  log::info(opt.command) << "running on " << run.backendName();
-
-  installInterruptHandler();
-  SpinUpSummary spinUp;
-  if (s.spinUpS > 0 && !opt.resume) {
-    STRATA_TRY(spinUp, run.spinUp(s.spinUpS, s.spinUpTolerance, name));
+    intervals_ = int(count);
+    return {};
   }
 
-  // Pictures: the state read on every rank at every `stride`-th cell, drawn by the lead.
-  std::optional<Pictures> pictures;
-  const int stride = detail::pictureStride(run.solver().grid().width, run.solver().grid().height, opt.pictureCells);
-  auto drawPicture = [&](const std::vector<detail::Piece>& pieces, const char* file) -> Status {
-    auto state = run.pictureState(pieces, stride);
-    return ranks.agree(pictures ? pictures->draw(std::move(state), opt.outDir / "pictures" / file) : Status{});
-  };
-  if (opt.pictures) {
-    if (ranks.lead()) {
+  // The GL context (before anything is written), the domain and the run folder. In one process
+  // the domain is built whole. Over MPI ranks each rank builds its own rows from its windows of
+  // the DEM or store (build_rows.hpp; the region needs a row per rank), writes them into input/
+  // (the model input the run's blocks read) and runs on the domain's shape.
+  Status buildDomain() {
+    STRATA_TRY(engine_, startContext(opt_.backend.value_or(s_.model.backend), opt_.pictures, ranks_));
+    std::optional<detail::RowsBuilt> rows;
+    if (ranks_.distributed()) {
+      auto planned = detail::RowBuilder::plan(s_, opt_.memoryBudgetBytes, ranks_.size(), opt_.pictures);
+      STRATA_TRY_STATUS(ranks_.agree(statusOf(planned)));
+      STRATA_TRY(rows, detail::buildByRows(*planned, s_, ranks_));
+    } else {
+      STRATA_TRY(domain_, scenario::buildDomain(s_, opt_.memoryBudgetBytes));
+    }
+    STRATA_TRY_STATUS(takeFolder());
+    scenarioText_ = ranks_.fromLead(ranks_.lead() ? slurp(s_.file) : std::string());
+    // Pictures and plots draw the bed: the elevation map, written once the domain is built.
+    const bool elevation = opt_.pictures || opt_.plots;
+    if (rows) {
+      STRATA_TRY_STATUS(detail::writeRows(ranks_, opt_.outDir, *rows, elevation));
+      domain_ = std::move(rows->shape);  // this rank's rows: read back from input/ by its blocks
+    } else if (elevation) {
+      STRATA_TRY_STATUS(detail::writeRaster(ranks_, opt_.outDir / "maps" / "elevation.tif", domain_.bed.georef, {},
+                                            {{0, 0, domain_.bed.values}}));
+    }
+    if (ranks_.lead()) {
+      const auto& g = domain_.bed.georef;
+      log::info(opt_.command) << name_ << ": " << g.width << " x " << g.height << " cells, "
+                              << domain_.totalAreaM2 / 1e6 << " km^2, " << domain_.sources.size() << " inflow(s), "
+                              << domain_.levels.size() << " fixed level(s), " << formatDuration(s_.durationS)
+                              << " simulated"
+                              << (ranks_.distributed()
+                                      ? ", built by the " + std::to_string(ranks_.size()) + " ranks row by row"
+                                      : std::string());
+    }
+    return {};
+  }
+
+  // The solver on the built domain, with its flood statistics.
+  Status startSolver() {
+    STRATA_TRY_STATUS(scenario::startSolver(engine_, domain_, ranks_, opt_.outDir));
+    engine_.solver->enableFloodStats(float(s_.outputs.wetThresholdM));
+    run_.emplace(s_, opt_, ranks_, std::move(domain_), std::move(engine_));
+    log::info(opt_.command) << "running on " << run_->backendName();
+    installInterruptHandler();
+    return {};
+  }
+
+  // The spin-up (a fresh run only: a resumed run's is in its checkpoint).
+  Status spinUp() {
+    if (s_.spinUpS > 0 && !opt_.resume) {
+      STRATA_TRY(spinUp_, run_->spinUp(s_.spinUpS, s_.spinUpTolerance, name_));
+    }
+    return {};
+  }
+
+  // Pictures: the state read on every rank at every `stride_`-th cell, drawn by the lead; the
+  // "before" picture of a fresh run.
+  Status openPictures() {
+    if (!opt_.pictures) return {};
+    stride_ = detail::pictureStride(run_->solver().grid().width, run_->solver().grid().height, opt_.pictureCells);
+    Status status;
+    if (ranks_.lead()) {
       std::error_code ec;
-      fs::create_directories(opt.outDir / "pictures", ec);
-      auto bed = detail::readStrided(opt.outDir / "maps" / "elevation.tif", stride);
+      fs::create_directories(opt_.outDir / "pictures", ec);
+      auto bed = detail::readStrided(opt_.outDir / "maps" / "elevation.tif", stride_);
       status = statusOf(bed);
       if (bed) {
-        auto p = Pictures::create(run.domain(), *bed, stride, s.erosion.enabled, s.outputs.wetThresholdM);
-        if (p) pictures.emplace(std::move(p).value());
+        auto p = Pictures::create(run_->domain(), *bed, stride_, s_.erosion.enabled, s_.outputs.wetThresholdM);
+        if (p) pictures_.emplace(std::move(p).value());
         status = statusOf(p);
       }
     }
-    STRATA_TRY_STATUS(ranks.agree(status));
-    if (!opt.resume) {
-      auto pieces = run.pieces();
-      STRATA_TRY_STATUS(ranks.agree(statusOf(pieces)));
-      STRATA_TRY_STATUS(drawPicture(*pieces, "before.png"));
-    }
+    STRATA_TRY_STATUS(ranks_.agree(status));
+    if (opt_.resume) return {};
+    auto pieces = run_->pieces();
+    STRATA_TRY_STATUS(ranks_.agree(statusOf(pieces)));
+    return drawPicture(*pieces, "before.png");
   }
 
-  RunSummary summary;
-  summary.backend = run.backendName();
-  summary.ranks = ranks.size();
-  int interval = 0;
-  double earlierWallS = 0;  // of the sessions before a resume
-  if (opt.resume) {
-    // Each rank its own part; all of the same interval.
+  // A resumed run continues from its checkpoint (each rank its own part, all of the same
+  // interval); a fresh one records its scenario.
+  Status resumeOrBegin() {
+    summary_.backend = run_->backendName();
+    summary_.ranks = ranks_.size();
+    if (!opt_.resume) {
+      return ranks_.agree(ranks_.lead() ? writeFileAtomic(opt_.outDir / "scenario.toml", scenarioText_) : Status{});
+    }
     Checkpoint c;
-    status = {};
-    if (!fs::exists(checkpointPath)) {
-      status = fail(checkpointPath.string() + ": no checkpoint to resume from" + checkpointHint(opt.outDir, ranks));
+    Status status;
+    if (!fs::exists(checkpointPath())) {
+      status = fail(checkpointPath().string() + ": no checkpoint to resume from" + checkpointHint(opt_.outDir, ranks_));
     } else {
-      auto decoded = decodeCheckpoint(checkpointPath, owner);
+      auto decoded = decodeCheckpoint(checkpointPath(), owner());
       if (decoded) c = std::move(decoded).value();
       status = statusOf(decoded);
     }
-    STRATA_TRY_STATUS(ranks.agree(status));
-    const auto [first, last] = ranks.minMax(c.interval);
+    STRATA_TRY_STATUS(ranks_.agree(status));
+    const auto [first, last] = ranks_.minMax(c.interval);
     if (first != last) {
-      return fail(opt.outDir.string() + ": the ranks' checkpoint parts are of different intervals (" +
+      return fail(opt_.outDir.string() + ": the ranks' checkpoint parts are of different intervals (" +
                   std::to_string(first) + " to " + std::to_string(last) + "): the run was stopped while writing them");
     }
-    if (c.interval > intervals) return fail(checkpointPath.string() + ": more intervals than the scenario has");
-    STRATA_TRY_STATUS(run.solver().restoreState(c.state));
-    STRATA_TRY_STATUS(run.setRain(c.state.counters.timeS));
-    interval = c.interval;
-    earlierWallS = c.wallS;
-    spinUp = c.spinUp;
-    summary.series = std::move(c.series);
-    log::info(opt.command) << "resuming at " << formatDuration(run.solver().timeS()) << " (interval " << interval
-                           << ")";
-  } else {
-    STRATA_TRY_STATUS(
-        ranks.agree(ranks.lead() ? writeFileAtomic(opt.outDir / "scenario.toml", scenarioText) : Status{}));
+    if (c.interval > intervals_) return fail(checkpointPath().string() + ": more intervals than the scenario has");
+    STRATA_TRY_STATUS(run_->solver().restoreState(c.state));
+    STRATA_TRY_STATUS(run_->setRain(c.state.counters.timeS));
+    interval_ = c.interval;
+    earlierWallS_ = c.wallS;
+    spinUp_ = c.spinUp;
+    summary_.series = std::move(c.series);
+    log::info(opt_.command) << "resuming at " << formatDuration(run_->solver().timeS()) << " (interval " << interval_
+                            << ")";
+    return {};
   }
-  summary.spinUp = spinUp;
 
-  auto wallSoFar = [&] {
-    return earlierWallS + std::chrono::duration<double>(std::chrono::steady_clock::now() - wallStart).count();
-  };
-  Progress progress(opt.command + " " + name, s.durationS);
-  while (interval < intervals) {
-    const double t1 = std::min(s.durationS, (interval + 1) * s.outputIntervalS);
-    // Progress whenever it is due (a bar on a terminal, a log line every 10 s of wall time
-    // otherwise), step by step, and at the end of the interval.
-    auto tick = [&] {
-      if (progress.due())
-        progress.update(run.solver().timeS(), run.progressNote("t = " + formatDuration(run.solver().timeS())));
-    };
-    STRATA_TRY(const bool done, run.advanceTo(t1, tick));
-    const bool stopped = !done;
-    progress.update(run.solver().timeS(), run.progressNote("t = " + formatDuration(run.solver().timeS())));
-    if (stopped) break;
+  // The output intervals: each advanced to its end with progress, then closed (its row, maps,
+  // pictures and checkpoint). Stops early when interrupted or asked to.
+  Status runIntervals() {
+    Progress progress(opt_.command + " " + name_, s_.durationS);
+    auto note = [&] { return run_->progressNote("t = " + formatDuration(run_->solver().timeS())); };
+    while (interval_ < intervals_) {
+      const double t1 = std::min(s_.durationS, (interval_ + 1) * s_.outputIntervalS);
+      // Progress whenever it is due (a bar on a terminal, a log line every 10 s of wall time
+      // otherwise), step by step, and at the end of the interval.
+      auto tick = [&] {
+        if (progress.due()) progress.update(run_->solver().timeS(), note());
+      };
+      STRATA_TRY(const bool done, run_->advanceTo(t1, tick));
+      progress.update(run_->solver().timeS(), note());
+      if (!done) break;
+      STRATA_TRY_STATUS(closeInterval());
+      if (opt_.stopAfterIntervals >= 0 && interval_ >= opt_.stopAfterIntervals && interval_ < intervals_) break;
+    }
+    summary_.completed = interval_ >= intervals_;
+    if (summary_.completed) {
+      progress.finish(std::to_string(run_->solver().stats().steps) + " steps");
+    } else {
+      log::warn(opt_.command) << "stopped at "
+                              << formatDuration(summary_.series.empty() ? 0 : summary_.series.back().timeS)
+                              << "; outputs are those of that interval; continue with --resume";
+    }
+    return {};
+  }
 
-    // The interval is complete: its row, maps, pictures and checkpoint. The stored water, and so
-    // which interval is the peak, is the same exact sum on every rank. Each rank reads its own
-    // pieces of the state; only pictures gather the depth to the lead.
-    auto pieces = run.pieces();
-    STRATA_TRY_STATUS(ranks.agree(statusOf(pieces)));
-    const SeriesRow row = run.row(*pieces);
-    summary.series.push_back(row);
-    ++interval;
-    if (opt.pictures) {
-      // The peak picture is redrawn whenever the stored water reaches a new high at an interval.
-      const bool peak = std::all_of(summary.series.begin(), summary.series.end(),
-                                    [&](const SeriesRow& r) { return r.waterM3 <= row.waterM3; });
-      const bool last = interval == intervals;
-      if (peak) STRATA_TRY_STATUS(drawPicture(*pieces, "peak.png"));
-      if (last) {
-        STRATA_TRY_STATUS(drawPicture(*pieces, "after.png"));
-        const auto maxDepth = run.maxDepthStrided(*pieces, stride);
-        STRATA_TRY_STATUS(ranks.agree(
-            pictures ? pictures->drawMaxDepth(maxDepth, pictures->georef(), opt.outDir / "pictures" / "max_depth.png")
-                     : Status{}));
+  // The summary, the files written, the budgets, and (by the lead) the plots and the report.
+  Result<RunSummary> finish() {
+    const auto st = run_->solver().stats();
+    summary_.simulatedS = st.timeS;
+    summary_.steps = st.steps;
+    summary_.wallS = wallSoFar();
+    summary_.spinUp = spinUp_;
+    summary_.files = {"scenario.toml", "series.csv"};
+    if (ranks_.distributed()) {
+      for (int r = 0; r < ranks_.size(); ++r) summary_.files.push_back(rankCheckpointFile(r, ranks_.size()));
+      for (const auto& f : detail::modelInputFiles(int(run_->domain().input.materials.size()))) {
+        if (fs::exists(opt_.outDir / f)) summary_.files.push_back(f);
+      }
+    } else {
+      summary_.files.push_back("checkpoint.bin");
+    }
+    const auto maps = run_->mapFiles();
+    summary_.files.insert(summary_.files.end(), maps.begin(), maps.end());
+    std::vector<std::string> pictureFiles;
+    for (const char* p : {"pictures/before.png", "pictures/peak.png", "pictures/after.png", "pictures/max_depth.png"}) {
+      if (fs::exists(opt_.outDir / p)) pictureFiles.push_back(p);
+    }
+    summary_.files.insert(summary_.files.end(), pictureFiles.begin(), pictureFiles.end());
+    auto pieces = run_->pieces();
+    STRATA_TRY_STATUS(ranks_.agree(statusOf(pieces)));
+    if (s_.erosion.enabled) {
+      summary_.material = run_->materialBudget(*pieces);
+      for (int k = 1; k <= kMaxLayerMaps; ++k) {
+        if (fs::exists(opt_.outDir / layerMapFile(k))) summary_.files.push_back(layerMapFile(k));
       }
     }
-    status = run.writeMaps(*pieces);
-    if (status.ok() && ranks.lead()) status = writeFileAtomic(opt.outDir / "series.csv", seriesCsv(summary.series));
-    STRATA_TRY_STATUS(ranks.agree(status));
+    const FloodSummary flood = run_->floodSummary(*pieces);
+    if (!ranks_.lead()) return summary_;  // the lead writes the plots and the report
+    if (opt_.plots) {
+      STRATA_TRY(auto plots, writePlots(opt_.outDir, summary_.completed));
+      summary_.files.insert(summary_.files.end(), plots.begin(), plots.end());
+    }
+    STRATA_TRY_STATUS(writeReport(opt_.outDir, ReportInput{s_, run_->domain(), summary_, flood, run_->backendName(),
+                                                           pictureFiles, maxDepthLegend()}));
+    summary_.files.push_back("report.md");
+    return summary_;
+  }
+
+ private:
+  // The run folder, taken by the lead for the whole run (its lock), with its maps/ folder.
+  Status takeFolder() {
+    Status status;
+    if (ranks_.lead()) {
+      auto taken = takeRunFolder(opt_);
+      status = statusOf(taken);
+      if (taken) {
+        lock_.emplace(std::move(taken).value());
+        std::error_code ec;
+        fs::create_directories(opt_.outDir / "maps", ec);
+        if (ec) status = fail(opt_.outDir.string() + ": cannot create the run folder: " + ec.message());
+      }
+    }
+    return ranks_.agree(status);
+  }
+
+  // A complete interval: its row, maps, pictures and checkpoint. The stored water, and so which
+  // interval is the peak, is the same exact sum on every rank. Each rank reads its own pieces of
+  // the state; only pictures gather the depth to the lead.
+  Status closeInterval() {
+    auto pieces = run_->pieces();
+    STRATA_TRY_STATUS(ranks_.agree(statusOf(pieces)));
+    const SeriesRow row = run_->row(*pieces);
+    summary_.series.push_back(row);
+    ++interval_;
+    if (opt_.pictures) {
+      // The peak picture is redrawn whenever the stored water reaches a new high at an interval.
+      const bool peak = std::all_of(summary_.series.begin(), summary_.series.end(),
+                                    [&](const SeriesRow& r) { return r.waterM3 <= row.waterM3; });
+      if (peak) STRATA_TRY_STATUS(drawPicture(*pieces, "peak.png"));
+      if (interval_ == intervals_) {
+        STRATA_TRY_STATUS(drawPicture(*pieces, "after.png"));
+        const auto maxDepth = run_->maxDepthStrided(*pieces, stride_);
+        STRATA_TRY_STATUS(ranks_.agree(pictures_ ? pictures_->drawMaxDepth(maxDepth, pictures_->georef(),
+                                                                           opt_.outDir / "pictures" / "max_depth.png")
+                                                 : Status{}));
+      }
+    }
+    Status status = run_->writeMaps(*pieces);
+    if (status.ok() && ranks_.lead()) status = writeFileAtomic(opt_.outDir / "series.csv", seriesCsv(summary_.series));
+    STRATA_TRY_STATUS(ranks_.agree(status));
     // Over MPI ranks the blocks are dealt again by their work before each checkpoint.
-    if (auto* d = run.distributed()) {
+    if (auto* d = run_->distributed()) {
       STRATA_TRY(const auto moved, d->rebalance());
       if (moved.blocksMoved > 0) {
-        log::info(opt.command) << "re-balanced: " << moved.blocksMoved << " blocks moved, busiest rank "
-                               << moved.imbalanceBefore << " -> " << moved.imbalanceAfter << " x the mean, "
-                               << moved.seconds << " s";
+        log::info(opt_.command) << "re-balanced: " << moved.blocksMoved << " blocks moved, busiest rank "
+                                << moved.imbalanceBefore << " -> " << moved.imbalanceAfter << " x the mean, "
+                                << moved.seconds << " s";
       }
     }
-    const Checkpoint c{interval, wallSoFar(), summary.series, spinUp, run.solver().saveState()};
-    STRATA_TRY_STATUS(ranks.agree(writeFileAtomic(checkpointPath, encodeCheckpoint(owner, c))));
-    if (opt.stopAfterIntervals >= 0 && interval >= opt.stopAfterIntervals && interval < intervals) break;
+    const Checkpoint c{interval_, wallSoFar(), summary_.series, spinUp_, run_->solver().saveState()};
+    return ranks_.agree(writeFileAtomic(checkpointPath(), encodeCheckpoint(owner(), c)));
   }
-  const auto st = run.solver().stats();
-  summary.completed = interval >= intervals;
-  summary.simulatedS = st.timeS;
-  summary.steps = st.steps;
-  summary.wallS = wallSoFar();
-  if (summary.completed) {
-    progress.finish(std::to_string(st.steps) + " steps");
-  } else {
-    log::warn(opt.command) << "stopped at " << formatDuration(summary.series.empty() ? 0 : summary.series.back().timeS)
-                           << "; outputs are those of that interval; continue with --resume";
+
+  Status drawPicture(const std::vector<detail::Piece>& pieces, const char* file) {
+    auto state = run_->pictureState(pieces, stride_);
+    return ranks_.agree(pictures_ ? pictures_->draw(std::move(state), opt_.outDir / "pictures" / file) : Status{});
   }
-  summary.files = {"scenario.toml", "series.csv"};
-  if (ranks.distributed()) {
-    for (int r = 0; r < ranks.size(); ++r) summary.files.push_back(rankCheckpointFile(r, ranks.size()));
-    for (const auto& f : detail::modelInputFiles(int(run.domain().input.materials.size()))) {
-      if (fs::exists(opt.outDir / f)) summary.files.push_back(f);
-    }
-  } else {
-    summary.files.push_back("checkpoint.bin");
-  }
-  const auto maps = run.mapFiles();
-  summary.files.insert(summary.files.end(), maps.begin(), maps.end());
-  std::string maxDepthLegend;
-  if (pictures && summary.completed) {
+
+  std::string maxDepthLegend() const {
+    if (!pictures_ || !summary_.completed) return {};
     char text[200];
-    const auto r = pictures->maxDepthRange();
+    const auto r = pictures_->maxDepthRange();
     std::snprintf(text, sizeof text,
                   "`max_depth.png`: the largest depth each cell had, from %.2f m (dark purple; shallower cells "
                   "not drawn) to %.1f m and more (yellow).",
                   r[0], r[1]);
-    maxDepthLegend = text;
+    return text;
   }
-  std::vector<std::string> pictureFiles;
-  for (const char* p : {"pictures/before.png", "pictures/peak.png", "pictures/after.png", "pictures/max_depth.png"}) {
-    if (fs::exists(opt.outDir / p)) pictureFiles.push_back(p);
+
+  CheckpointOwner owner() const { return {opt_.command, fnv1a(scenarioText_)}; }
+  fs::path checkpointPath() const {
+    return opt_.outDir /
+           (ranks_.distributed() ? rankCheckpointFile(ranks_.rank(), ranks_.size()) : std::string("checkpoint.bin"));
   }
-  summary.files.insert(summary.files.end(), pictureFiles.begin(), pictureFiles.end());
-  auto finalPieces = run.pieces();
-  STRATA_TRY_STATUS(ranks.agree(statusOf(finalPieces)));
-  if (s.erosion.enabled) {
-    summary.material = run.materialBudget(*finalPieces);
-    for (int k = 1; k <= kMaxLayerMaps; ++k) {
-      if (fs::exists(opt.outDir / layerMapFile(k))) summary.files.push_back(layerMapFile(k));
-    }
+  double wallSoFar() const {
+    return earlierWallS_ + std::chrono::duration<double>(std::chrono::steady_clock::now() - wallStart_).count();
   }
-  const FloodSummary flood = run.floodSummary(*finalPieces);
-  if (!ranks.lead()) return summary;  // the lead writes the plots and the report
-  if (opt.plots) {
-    STRATA_TRY(auto plots, writePlots(opt.outDir, summary.completed));
-    summary.files.insert(summary.files.end(), plots.begin(), plots.end());
-  }
-  STRATA_TRY_STATUS(writeReport(
-      opt.outDir, ReportInput{s, run.domain(), summary, flood, run.backendName(), pictureFiles, maxDepthLegend}));
-  summary.files.push_back("report.md");
-  return summary;
+
+  const Scenario& s_;
+  const RunOptions& opt_;
+  const Ranks ranks_;
+  const std::string name_;
+  const std::chrono::steady_clock::time_point wallStart_ = std::chrono::steady_clock::now();
+  int intervals_ = 0;
+  Engine engine_;                 // until the run takes it
+  ScenarioDomain domain_;         // until the run takes it
+  std::optional<FileLock> lock_;  // held by the lead for the whole run
+  std::string scenarioText_;
+  std::optional<Run> run_;
+  std::optional<Pictures> pictures_;
+  int stride_ = 1;
+  SpinUpSummary spinUp_;
+  RunSummary summary_;
+  int interval_ = 0;
+  double earlierWallS_ = 0;  // of the sessions before a resume
+};
+
+}  // namespace
+
+Result<RunSummary> runScenario(const Scenario& s, const RunOptions& opt) {
+  Session run(s, opt);
+  STRATA_TRY_STATUS(run.countIntervals());
+  STRATA_TRY_STATUS(run.buildDomain());
+  STRATA_TRY_STATUS(run.startSolver());
+  STRATA_TRY_STATUS(run.spinUp());
+  STRATA_TRY_STATUS(run.openPictures());
+  STRATA_TRY_STATUS(run.resumeOrBegin());
+  STRATA_TRY_STATUS(run.runIntervals());
+  return run.finish();
 }
 
 }  // namespace strata::scenario
