@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
 #include <cstdio>
@@ -10,11 +11,32 @@
 
 namespace strata {
 
+Status requireRegularFile(const std::filesystem::path& path, std::string_view what) {
+  std::error_code ec;
+  const auto st = std::filesystem::status(path, ec);
+  if (!std::filesystem::exists(st)) return fail(path.string() + ": no such file");
+  if (std::filesystem::is_directory(st)) return fail(path.string() + ": is a directory, not " + std::string(what));
+  if (!std::filesystem::is_regular_file(st)) {
+    return fail(path.string() + ": is not a regular file (a FIFO, socket or device), not " + std::string(what));
+  }
+  return {};
+}
+
 std::filesystem::path temporaryPathFor(const std::filesystem::path& target) {
   static std::atomic<int> counter{0};
   auto tmp = target;
   tmp += ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
   return tmp;
+}
+
+bool isTemporaryNameOf(std::string_view name, std::string_view file) {
+  if (!name.starts_with(file) || !name.substr(file.size()).starts_with(".tmp-")) return false;
+  const std::string_view rest = name.substr(file.size() + 5);
+  auto digits = [](std::string_view v) {
+    return !v.empty() && std::all_of(v.begin(), v.end(), [](char c) { return c >= '0' && c <= '9'; });
+  };
+  const auto dash = rest.find('-');
+  return dash != std::string_view::npos && digits(rest.substr(0, dash)) && digits(rest.substr(dash + 1));
 }
 
 Status commitTemporary(const std::filesystem::path& temporary, const std::filesystem::path& target) {

@@ -1,5 +1,7 @@
 #include "gdal_util.hpp"
 
+#include <strata/core/files.hpp>
+
 #include <cpl_conv.h>
 #include <cpl_error.h>
 #include <cpl_vsi.h>
@@ -54,9 +56,7 @@ Result<DatasetPtr> openRaster(const std::string& path) {
   ensureGdal();
   const bool virtualPath = path.rfind("/vsi", 0) == 0;
   if (!virtualPath) {
-    std::error_code ec;
-    if (!std::filesystem::exists(path, ec)) return fail(path + ": no such file");
-    if (std::filesystem::is_directory(path, ec)) return fail(path + ": is a directory, not a raster file");
+    STRATA_TRY_STATUS(requireRegularFile(path, "a raster file"));
   } else {
     VSIStatBufL st;
     if (VSIStatL(path.c_str(), &st) != 0) return fail(path + ": no such file");

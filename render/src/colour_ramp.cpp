@@ -7,6 +7,8 @@
 #include <numeric>
 #include <sstream>
 
+#include <strata/core/files.hpp>
+
 namespace strata::render {
 
 glm::vec3 ColourRamp::at(float elevationM) const {
@@ -20,6 +22,7 @@ glm::vec3 ColourRamp::at(float elevationM) const {
 }
 
 Result<ColourRamp> loadColourRamp(const std::string& path, float minM, float maxM) {
+  STRATA_TRY_STATUS(requireRegularFile(path, "a colour ramp"));
   std::ifstream in(path);
   if (!in) return fail(path + ": cannot open the colour ramp");
   std::vector<std::pair<float, glm::vec3>> stops;

@@ -5,6 +5,8 @@
 #include <fstream>
 #include <sstream>
 
+#include <strata/core/files.hpp>
+
 namespace strata::render {
 
 Result<FlightPath> FlightPath::parse(const std::string& text, const std::string& source) {
@@ -42,6 +44,7 @@ Result<FlightPath> FlightPath::parse(const std::string& text, const std::string&
 }
 
 Result<FlightPath> FlightPath::load(const std::string& path) {
+  STRATA_TRY_STATUS(requireRegularFile(path, "a keyframe file"));
   std::ifstream in(path);
   if (!in) return fail(path + ": cannot open the keyframe file");
   std::stringstream text;

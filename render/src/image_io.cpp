@@ -2,6 +2,8 @@
 
 #include <OpenImageIO/imageio.h>
 
+#include <strata/core/files.hpp>
+
 namespace strata::render {
 namespace {
 
@@ -35,6 +37,7 @@ Status writeImageFloat(const std::string& path, int width, int height, int chann
 }
 
 Result<Image8> readImage8(const std::string& path) {
+  STRATA_TRY_STATUS(requireRegularFile(path, "an image"));
   auto in = OIIO::ImageInput::open(path);
   if (!in) return fail(path + ": cannot read: " + OIIO::geterror());
   const auto& spec = in->spec();

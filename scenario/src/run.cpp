@@ -77,18 +77,14 @@ std::vector<std::string> runFolderFiles() {
 bool isTemporaryOf(const std::string& name, const std::string& file) {
   const std::string stem = fs::path(file).stem().string();
   if (file.ends_with(".png") && name == stem + ".tmp.png") return true;
-  if (!name.starts_with(file + ".tmp")) return false;
-  std::string_view rest(name);
-  rest.remove_prefix(file.size() + 4);
-  if (rest.ends_with(".png")) rest.remove_suffix(4);
-  auto digits = [](std::string_view v) {
-    return !v.empty() && std::all_of(v.begin(), v.end(), [](char c) { return c >= '0' && c <= '9'; });
-  };
-  if (digits(rest)) return true;  // .tmpPID
-  if (!rest.starts_with("-")) return false;
-  rest.remove_prefix(1);
-  const auto dash = rest.find('-');
-  return dash != std::string_view::npos && digits(rest.substr(0, dash)) && digits(rest.substr(dash + 1));
+  if (isTemporaryNameOf(name, file)) return true;
+  if (file.ends_with(".png") && name.ends_with(".png") && isTemporaryNameOf(name.substr(0, name.size() - 4), file)) {
+    return true;
+  }
+  // .tmpPID
+  const std::string_view rest = std::string_view(name).substr(std::min(name.size(), file.size() + 4));
+  return name.starts_with(file + ".tmp") && !rest.empty() &&
+         std::all_of(rest.begin(), rest.end(), [](char c) { return c >= '0' && c <= '9'; });
 }
 
 // A run's name as progress lines and logs show it: at most 60 characters, no control characters

@@ -444,9 +444,12 @@ Status TileStore::commit() {
     const std::string name = e.path().filename().string();
     if (e.is_regular_file(ec) && isTileFileName(name) && !live.count(name)) fs::remove(e.path(), ec);
   }
-  const std::string tmpPrefix = std::string(detail::kManifestName) + ".tmp";
+  // The manifest's own temporaries only (writeFileAtomic's manifest.toml.tmp-PID-N): a user's
+  // manifest.toml.tmp-mydraft stays.
   for (const auto& e : fs::directory_iterator(I.dir, ec)) {
-    if (e.is_regular_file(ec) && e.path().filename().string().rfind(tmpPrefix, 0) == 0) fs::remove(e.path(), ec);
+    if (e.is_regular_file(ec) && isTemporaryNameOf(e.path().filename().string(), detail::kManifestName)) {
+      fs::remove(e.path(), ec);
+    }
   }
   return {};
 }

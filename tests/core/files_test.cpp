@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 #include <sys/resource.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -80,6 +81,23 @@ TEST(Files, OverTheFileSizeLimitTheMessageNamesTheFile) {
 
 // One writer: a second lock on the same file is refused, within one process too (flock locks
 // belong to the open file), naming the holder; the lock goes with its holder.
+// Inputs are stat'ed, never opened, before they are read: a FIFO (whose open waits for a writer),
+// a folder or a missing name is refused in a line naming it; a link to a file is a file.
+TEST(Files, OnlyRegularFilesAreInputs) {
+  const auto dir = test::tempDir("regular");
+  std::ofstream(dir / "dem.tif") << "x";
+  std::filesystem::create_symlink(dir / "dem.tif", dir / "link.tif");
+  ASSERT_EQ(::mkfifo((dir / "fifo.tif").c_str(), 0644), 0);
+  EXPECT_TRUE(requireRegularFile(dir / "dem.tif", "a raster file"));
+  EXPECT_TRUE(requireRegularFile(dir / "link.tif", "a raster file"));
+  EXPECT_EQ(requireRegularFile(dir / "fifo.tif", "a raster file").message(),
+            (dir / "fifo.tif").string() + ": is not a regular file (a FIFO, socket or device), not a raster file");
+  EXPECT_EQ(requireRegularFile(dir, "a raster file").message(), dir.string() + ": is a directory, not a raster file");
+  EXPECT_EQ(requireRegularFile(dir / "nope.tif", "a raster file").message(),
+            (dir / "nope.tif").string() + ": no such file");
+  EXPECT_FALSE(requireRegularFile("/dev/null", "a colour ramp"));
+}
+
 TEST(FileLock, ASecondHolderIsRefusedUntilTheFirstLetsGo) {
   const auto dir = test::tempDir("lock");
   const auto path = dir / "run.lock";

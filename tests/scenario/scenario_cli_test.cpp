@@ -6,9 +6,11 @@
 #include <gtest/gtest.h>
 #include <link.h>
 #include <sys/resource.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <csignal>
 #include <cstdlib>
@@ -149,6 +151,40 @@ TEST(StrataCli, AFloodRunsOverMpiRanks) {
   // Only the run commands spread over ranks; the message comes once.
   EXPECT_EQ(strata({"info", "flood.toml"}, dir, out, 0, mpiEnv(), mpirun(2)), 2) << out;
   EXPECT_EQ(count("strata: only `strata flood` and `strata erode` run over MPI ranks (2 ranks given)"), 1u) << out;
+}
+
+// Issue 33: a FIFO named as an input (a DEM to describe, a drape, a scenario's DEM, the scenario
+// itself) is refused at once in one line naming it; opening it would wait for a writer forever.
+TEST(StrataCli, AFifoGivenAsAnInputIsRefusedAtOnce) {
+  const auto dir = strata::test::tempDir("cli-fifo");
+  ASSERT_EQ(::mkfifo((dir / "f.tif").c_str(), 0644), 0) << std::strerror(errno);
+  std::string text = scenarioText();
+  const auto dem = text.find("dem = \"") + 7;
+  text.replace(dem, text.find('"', dem) - dem, (dir / "f.tif").string());
+  std::ofstream(dir / "fifo-dem.toml") << text;
+  ASSERT_EQ(::mkfifo((dir / "fifo.toml").c_str(), 0644), 0) << std::strerror(errno);
+  const std::vector<std::vector<std::string>> runs = {
+      {"info", "f.tif"},
+      {"render", "synthetic:16", "-o", "x.png", "--drape", "f.tif"},
+      {"flood", "fifo-dem.toml", "-o", "run", "--no-pictures", "--no-plots"},
+      {"flood", "fifo.toml", "-o", "run2", "--no-pictures", "--no-plots"},
+  };
+  for (const auto& args : runs) {
+    const pid_t pid = spawn(args, dir, dir / "fifo.log");
+    int status = 0;
+    const bool ended = waitUntil([&] { return ::waitpid(pid, &status, WNOHANG) == pid; }, 2.0);
+    if (!ended) {
+      ::kill(pid, SIGKILL);
+      waitFor(pid);
+    }
+    ASSERT_TRUE(ended) << args[0] << " " << args[1] << ": still running after 2 s";
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) != 0) << args[0];
+    const std::string out = slurp(dir / "fifo.log");
+    const std::string fifo = args[1] == "fifo.toml" ? "fifo.toml" : "f.tif";
+    EXPECT_NE(out.find(fifo + ": is not a regular file (a FIFO, socket or device)"), std::string::npos)
+        << args[0] << ": " << out;
+    EXPECT_EQ(std::count(out.begin(), out.end(), '\n'), 1) << args[0] << ": " << out;
+  }
 }
 
 TEST(StrataCli, TwoFloodsIntoOneFolderOneIsRefused) {

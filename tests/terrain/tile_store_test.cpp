@@ -511,6 +511,20 @@ TEST(TileStore, AWriterKilledBeforeItsCommitLeavesTheEarlierStore) {
   EXPECT_FALSE(fs::exists(newFile));
 }
 
+// Issue 33: a commit sweeps the manifest temporaries a killed writer left (writeFileAtomic's
+// manifest.toml.tmp-PID-N) and nothing else: a user's file named alike stays.
+TEST(TileStore, ACommitRemovesOnlyItsOwnTemporaries) {
+  const auto dir = test::tempDir("store");
+  auto store = ingestScene(dir, 2 * kFootprint, kFootprint, smallScene());
+  std::ofstream(dir / "manifest.toml.tmp-4242-0") << "format = \"strata-tile-st";
+  std::ofstream(dir / "manifest.toml.tmp-mydraft") << "my notes";
+  std::ofstream(dir / "manifest.toml.tmp-1-2-3") << "mine too";
+  ASSERT_TRUE(store.commit());
+  EXPECT_FALSE(fs::exists(dir / "manifest.toml.tmp-4242-0"));
+  EXPECT_TRUE(fs::exists(dir / "manifest.toml.tmp-mydraft"));
+  EXPECT_TRUE(fs::exists(dir / "manifest.toml.tmp-1-2-3"));
+}
+
 TEST(TileStore, AWriterKilledMidStreamLeavesACommittedVersion) {
   const auto dir = test::tempDir("store");
   SyntheticScene s = smallScene();

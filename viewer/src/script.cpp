@@ -5,6 +5,8 @@
 
 #include <strata/viewer/command.hpp>
 
+#include <strata/core/files.hpp>
+
 namespace strata::viewer {
 namespace {
 
@@ -133,6 +135,7 @@ Result<std::vector<TimedCommand>> parseScript(const std::string& text, const std
 }
 
 Result<std::vector<TimedCommand>> loadScript(const std::string& path) {
+  STRATA_TRY_STATUS(requireRegularFile(path, "a script"));
   std::ifstream f(path);
   if (!f) return fail(path + ": cannot read the script");
   std::stringstream ss;
