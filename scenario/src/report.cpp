@@ -27,6 +27,28 @@ std::string fmt(const char* f, double v) {
   return buf;
 }
 
+// User text (a scenario's name and description, inflow and material names) as report.md shows
+// it: control characters written as visible \uXXXX escapes, so that none reaches a terminal or
+// a viewer raw; in a table cell ('cell'), '|' escaped and line breaks as spaces too.
+std::string userText(const std::string& text, bool cell = false) {
+  std::string out;
+  for (const char c : text) {
+    const auto u = static_cast<unsigned char>(c);
+    if (cell && (c == '\n' || c == '\t')) {
+      out += ' ';
+    } else if (cell && c == '|') {
+      out += "\\|";
+    } else if ((u < 0x20 && c != '\n' && c != '\t') || u == 0x7F) {
+      char code[8];
+      std::snprintf(code, sizeof code, "\\u%04X", unsigned(u));
+      out += code;
+    } else {
+      out += c;
+    }
+  }
+  return out;
+}
+
 std::string millions(double m3) { return fmt("%.1f", m3 / 1e6) + " million m³"; }
 
 std::string hours(double s) { return fmt("%.2f h", s / 3600.0); }
@@ -125,8 +147,8 @@ std::string erosionModelSection(const Scenario& s, const ScenarioDomain& d) {
       "weathering (1/s) | dissolution (1/s) |\n|---|---|---|---|---|---|---|---|---|---|\n";
   for (size_t l = 0; l < d.input.materials.size(); ++l) {
     const auto& m = d.input.materials[l];
-    md += "| " + std::to_string(l + 1) + " | " + m.name + " | " + fmt("%.3g", m.criticalShearPa) + " | " +
-          fmt("%.3g", m.shearErodibility) + " | " + fmt("%.3g", m.settlingVelocityMS) + " | " +
+    md += "| " + std::to_string(l + 1) + " | " + userText(m.name, true) + " | " + fmt("%.3g", m.criticalShearPa) +
+          " | " + fmt("%.3g", m.shearErodibility) + " | " + fmt("%.3g", m.settlingVelocityMS) + " | " +
           fmt("%.0f°", m.frictionAngleDeg) + " | " + fmt("%.3g", m.cohesionPa) + " | " + fmt("%.0f°", m.talusAngleDeg) +
           " | " + fmt("%.3g", m.weatheringRatePerS) + " | " + fmt("%.3g", m.dissolutionRate) + " |\n";
   }
@@ -140,8 +162,8 @@ Status writeReport(const fs::path& runDir, const ReportInput& in) {
   const auto& sum = in.summary;
   const auto& g = d.bed.georef;
   std::string md;
-  md += "# " + s.name + "\n\n";
-  if (!s.description.empty()) md += s.description + "\n\n";
+  md += "# " + userText(s.name, true) + "\n\n";
+  if (!s.description.empty()) md += userText(s.description) + "\n\n";
   {
     char date[64];
     const std::time_t now = std::time(nullptr);
@@ -222,8 +244,8 @@ Status writeReport(const fs::path& runDir, const ReportInput& in) {
     const auto& f = s.water.inflows[i];
     const double peak = f.hydrograph.maxOver(0, s.durationS);
     const auto& c = d.sources[i].cells.front();
-    md += "| inflow \"" + f.name + "\" | at " + where(g, c.first, c.second) + ", peak " + fmt("%.0f", peak) +
-          " m³/s, " + millions(f.hydrograph.integral(0, s.durationS)) + " in the run |\n";
+    md += "| inflow \"" + userText(f.name, true) + "\" | at " + where(g, c.first, c.second) + ", peak " +
+          fmt("%.0f", peak) + " m³/s, " + millions(f.hydrograph.integral(0, s.durationS)) + " in the run |\n";
   }
   if (const auto& u = in.summary.spinUp; u.seconds > 0) {
     const std::string tolerance = fmt("%g", 100 * u.toleranceRel) + "% of the base flow";

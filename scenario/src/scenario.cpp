@@ -13,6 +13,7 @@
 #include <set>
 #include <sstream>
 
+#include <strata/core/files.hpp>
 #include <strata/core/progress.hpp>
 #include <strata/core/toml_screen.hpp>
 
@@ -614,7 +615,10 @@ Status readWater(const Reader& r, const toml::table& root, Scenario& s) {
       STRATA_TRY_STATUS(r.onlyKeys(
           *it, key, {"name", "at_lonlat", "at_xy", "line_lonlat", "line_xy", "hydrograph", "hydrograph_units"}));
       Inflow f;
-      f.name = it->get("name") ? it->get("name")->value_or(std::string()) : "inflow " + std::to_string(i + 1);
+      f.name = "inflow " + std::to_string(i + 1);
+      if (const auto* n = it->get("name")) {
+        STRATA_TRY(f.name, r.string(*n, key + ".name"));
+      }
       STRATA_TRY(auto at, r.placeKey(*it, key, "at", true));
       STRATA_TRY(auto line, r.placeKey(*it, key, "line", false));
       if (at && line) return r.errorAt(line->line, line->key, "give a point (at_...) or a line (line_...), not both");
@@ -682,7 +686,10 @@ Status readWater(const Reader& r, const toml::table& root, Scenario& s) {
       STRATA_TRY_STATUS(r.onlyKeys(
           *lt, key, {"name", "line_lonlat", "line_xy", "polygon_lonlat", "polygon_xy", "stage", "stage_units"}));
       Level l;
-      l.name = lt->get("name") ? lt->get("name")->value_or(std::string()) : "level " + std::to_string(i + 1);
+      l.name = "level " + std::to_string(i + 1);
+      if (const auto* n = lt->get("name")) {
+        STRATA_TRY(l.name, r.string(*n, key + ".name"));
+      }
       STRATA_TRY(auto line, r.placeKey(*lt, key, "line", false));
       STRATA_TRY(auto poly, r.placeKey(*lt, key, "polygon", false));
       if (line && poly) return r.errorAt(poly->line, poly->key, "give a line (line_...) or a polygon, not both");
@@ -843,6 +850,7 @@ Result<Backend> parseBackend(std::string_view name) {
 }
 
 Result<Scenario> parseScenario(std::string_view text, const std::filesystem::path& fileName) {
+  text = withoutBom(text);
   Scenario s;
   Reader r{fileName.string(), fileName.parent_path(), &s.keyLines};
   TomlScreenOptions screen;
@@ -894,8 +902,10 @@ Result<Scenario> parseScenario(std::string_view text, const std::filesystem::pat
 }
 
 Result<Scenario> loadScenario(const std::filesystem::path& file) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(file, ec)) return fail(file.string() + ": no such scenario file");
+  if (auto ok = requireRegularFile(file, "a scenario file"); !ok) {
+    std::error_code ec;
+    return fail(std::filesystem::exists(file, ec) ? ok.message() : file.string() + ": no such scenario file");
+  }
   std::ifstream in(file);
   std::stringstream ss;
   ss << in.rdbuf();

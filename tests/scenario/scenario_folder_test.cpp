@@ -229,6 +229,11 @@ TEST(RunFolder, AHugeNameIsNotRepeatedInEveryLine) {
   EXPECT_LT(err.size() + out.size(), 20000u) << err.substr(0, 2000);
   EXPECT_EQ(err.find('\x1b'), std::string::npos) << "a control character of the name reached the terminal";
   EXPECT_NE(err.find(std::string(60, 'n') + "..."), std::string::npos) << err.substr(0, 2000);
+  // Issue 33: in report.md the name is whole, its control characters escaped and visible.
+  std::ifstream in(dir / "run" / "report.md");
+  const std::string report((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(report.find('\x1b'), std::string::npos) << "a control character of the name reached report.md";
+  EXPECT_NE(report.find("# " + name + "  \\u001B[31m\n"), std::string::npos) << report.substr(0, 200);
 }
 
 }  // namespace

@@ -139,7 +139,17 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"an unknown material constant", "[time]", "[materials.sand]\nhardness = 3\n[time]",
                 "/data/runs/gc.toml:22: key 'materials.sand.hardness': unknown key (expected one of: critical_shear, "
                 "shear_erodibility, settling_velocity, friction_angle, cohesion, talus_angle, weathering_rate, "
-                "dissolution_rate, erodibility)"}));
+                "dissolution_rate, erodibility)"},
+        // Issue 33: a name that is not a string is refused, not read as "".
+        BadCase{"a number for a name", "name = \"Colorado River\"", "name = 5",
+                "/data/runs/gc.toml:14: key 'water.inflow[0].name': expected a string"}));
+
+// Issue 33: a UTF-8 byte-order mark (some editors write one) is skipped, not refused.
+TEST(Scenario, AByteOrderMarkIsSkipped) {
+  auto s = parse("\xEF\xBB\xBF" + std::string(kGood));
+  ASSERT_TRUE(s) << s.message();
+  EXPECT_EQ(s->water.inflows.at(0).name, "Colorado River");
+}
 
 // Issue 30: the erosion law and the materials' constants in physical units, with units.
 TEST(Scenario, ReadsTheErosionLawAndMaterialConstants) {

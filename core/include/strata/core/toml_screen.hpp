@@ -30,6 +30,12 @@ struct TomlScreenOptions {
 /// Empty when toml++ may parse `text`; otherwise "file:line: what" (one line).
 Status screenToml(std::string_view text, const std::string& file, const TomlScreenOptions& options = {});
 
+/// `text` without a leading UTF-8 byte-order mark (EF BB BF), which some editors write and TOML
+/// does not allow; harmless, so a reader skips it rather than refuse the file.
+inline std::string_view withoutBom(std::string_view text) {
+  return text.substr(0, 3) == "\xEF\xBB\xBF" ? text.substr(3) : text;
+}
+
 /// "U+00E9" for the UTF-8 code point starting at text[i] ("byte 0xC3" when it is not one).
 std::string codePointName(std::string_view text, std::size_t i);
 
