@@ -77,13 +77,8 @@ void addInfoCommand(CLI::App& app) {
         std::printf("%s (tile store)\n%s", f.c_str(), terrain::describeStore(*store).c_str());
         continue;
       }
-      gis::ReadOptions ro;
-      if (!o->assignCrs.empty() || assignGt) {
-        auto has = gis::georefPresence(f);
-        if (has && !has->crs && !o->assignCrs.empty()) ro.crs = o->assignCrs;
-        if (has && !has->transform && assignGt) ro.transform = assignGt;
-      }
-      auto s = gis::summarizeDem(f, ro);
+      auto ro = gis::assignMissingGeoref(f, o->assignCrs, assignGt);
+      auto s = ro ? gis::summarizeDem(f, *ro) : Result<gis::DemSummary>(fail(ro.message()));
       if (!s) {
         std::fprintf(stderr, "strata info: %s\n", s.message().c_str());
         failed = true;

@@ -29,6 +29,7 @@ using namespace strata::render;
 
 struct RenderArgs {
   std::string dem;
+  std::string assignCrs, assignGeotransform;  ///< for a DEM file without its own
   std::string output = "render.png";
   std::string depthOut, elevationOut;
   std::optional<double> lon, lat, height, agl;
@@ -57,7 +58,8 @@ struct RenderArgs {
 
 // "synthetic:SIZE[:SEED]" (a rough fractal terrain of SIZE^2 cells of 30 m), else a DEM file
 // (any raster GDAL reads, through strata::gis::readDem).
-Result<gis::Raster> loadDem(const std::string& spec, bool planetary) {
+Result<gis::Raster> loadDem(const std::string& spec, bool planetary, const std::string& assignCrs,
+                            const std::string& assignGeotransform) {
   if (spec.rfind("synthetic:", 0) == 0) {
     int size = 0;
     unsigned seed = 1;
@@ -68,7 +70,12 @@ Result<gis::Raster> loadDem(const std::string& spec, bool planetary) {
   }
   // Planetary mode draws on the body's ellipsoid from lon/lat: an equirectangular DEM on a
   // sphere (LOLA's LDEM) is relabelled in degrees on the fly.
-  return planetary ? gis::readDemLonLat(spec) : gis::readDem(spec);
+  std::optional<gis::GeoTransform> gt;
+  if (!assignGeotransform.empty()) {
+    STRATA_TRY(gt, gis::parseGeoTransform(assignGeotransform, "--assign-geotransform"));
+  }
+  STRATA_TRY(const gis::ReadOptions ro, gis::assignMissingGeoref(spec, assignCrs, gt));
+  return planetary ? gis::readDemLonLat(spec, ro) : gis::readDem(spec, ro);
 }
 
 Result<std::unique_ptr<TerrainRenderer>> makeRenderer(const RenderArgs& a) {
@@ -193,7 +200,7 @@ void run(const RenderArgs& a) {
   // A folder with a manifest is a tile store: its elevation is streamed around the viewer.
   auto scene = [&]() -> Result<TerrainScene> {
     if (!std::filesystem::is_regular_file(std::filesystem::path(a.dem) / "manifest.toml")) {
-      STRATA_TRY(auto dem, loadDem(a.dem, a.planetary));
+      STRATA_TRY(auto dem, loadDem(a.dem, a.planetary, a.assignCrs, a.assignGeotransform));
       return TerrainScene::create(dem, {.planetary = a.planetary, .voids = voids});
     }
     STRATA_TRY(auto opened, strata::terrain::TileStore::open(a.dem));
@@ -204,7 +211,7 @@ void run(const RenderArgs& a) {
                                          .gpuBudgetBytes = size_t(a.gpuBudgetMiB * 1048576.0)},
                                         {.planetary = a.planetary});
   }();
-  if (!scene) die(a.dem + ": " + scene.message());
+  if (!scene) die(scene.message().starts_with(a.dem + ":") ? scene.message() : a.dem + ": " + scene.message());
   if (auto st = apps::applyView(a.view, *scene, shading); !st) die(st.message());
   auto renderer = makeRenderer(a);
   if (!renderer) die(renderer.message());
@@ -281,6 +288,9 @@ void addRenderCommand(CLI::App& app) {
   cmd->add_option("dem", a->dem,
                   "DEM file, synthetic:SIZE[:SEED] for a generated terrain, or a tile store folder (streamed)")
       ->required();
+  cmd->add_option("--assign-crs", a->assignCrs, "CRS for a DEM file that has none (EPSG:n, WKT or PROJ)");
+  cmd->add_option("--assign-geotransform", a->assignGeotransform,
+                  "Geotransform c0,c1,c2,c3,c4,c5 (GDAL's order) for a DEM file that has none");
   cmd->add_option("-o,--output", a->output, "Colour PNG (with --path: a pattern such as frame_%04d.png)");
   cmd->add_option("--depth", a->depthOut, "Also write the distance along the view axis (m) to this EXR");
   cmd->add_option("--elevation", a->elevationOut, "Also write the rendered elevation (m) to this EXR");

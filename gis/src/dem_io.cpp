@@ -305,6 +305,16 @@ Result<GeorefPresence> georefPresence(const std::string& path) {
   return p;
 }
 
+Result<ReadOptions> assignMissingGeoref(const std::string& path, const std::string& crs,
+                                        const std::optional<GeoTransform>& transform) {
+  ReadOptions ro;
+  if (crs.empty() && !transform) return ro;
+  STRATA_TRY(const GeorefPresence has, georefPresence(path));
+  if (!has.crs && !crs.empty()) ro.crs = crs;
+  if (!has.transform && transform) ro.transform = transform;
+  return ro;
+}
+
 Result<GeoTransform> parseGeoTransform(std::string_view text, const std::string& key) {
   GeoTransform t;
   std::string s(text);

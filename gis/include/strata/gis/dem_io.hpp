@@ -58,6 +58,11 @@ struct GeorefPresence {
 };
 /// Opens `path` and says whether it carries a CRS and a geotransform (before any assignment).
 Result<GeorefPresence> georefPresence(const std::string& path);
+/// The read options that give `path` the CRS `crs` (EPSG:n, WKT or PROJ; empty: none) and the
+/// geotransform `transform` where the file has none of its own; what the file has is kept (the
+/// commands' --assign-crs and --assign-geotransform).
+Result<ReadOptions> assignMissingGeoref(const std::string& path, const std::string& crs,
+                                        const std::optional<GeoTransform>& transform);
 
 /// Reads a DEM (or a window of it) as metres; nodata -> NaN. NaN values stored in the file (other
 /// than as the nodata value) are an error. The Georef describes the window read.
