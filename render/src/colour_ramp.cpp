@@ -21,6 +21,10 @@ glm::vec3 ColourRamp::at(float elevationM) const {
   return colours[i - 1] + t * (colours[i] - colours[i - 1]);
 }
 
+namespace {
+constexpr double kMaxStopM = 1e6;
+}  // namespace
+
 Result<ColourRamp> loadColourRamp(const std::string& path, float minM, float maxM) {
   STRATA_TRY_STATUS(requireRegularFile(path, "a colour ramp"));
   std::ifstream in(path);
@@ -59,7 +63,14 @@ Result<ColourRamp> loadColourRamp(const std::string& path, float minM, float max
     if (value.empty() || *end != '\0' || !std::isfinite(v)) {
       return fail(where + "elevation '" + w[0] + "': expected a number of metres, a percentage such as 50%, or nv");
     }
-    stops.emplace_back(float(percent ? minM + v / 100.0 * (maxM - minM) : v), colour);
+    // Beyond a thousand kilometres no relief of any body reaches (the deepest trench and the
+    // highest volcano are within 25 km of their datum); a larger stop (1e308 became inf as a
+    // float and drew every cell black) is a typing slip.
+    const double m = percent ? minM + v / 100.0 * (maxM - minM) : v;
+    if (!(std::abs(m) <= kMaxStopM)) {
+      return fail(where + "elevation '" + w[0] + "': outside +-1000 km of the datum (" + std::to_string(m) + " m)");
+    }
+    stops.emplace_back(float(m), colour);
   }
   if (stops.empty()) return fail(path + ": no colour stops (lines of ELEVATION R G B)");
   if (stops.size() > size_t(ColourRamp::kMaxStops)) {

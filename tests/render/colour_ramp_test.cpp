@@ -88,6 +88,10 @@ TEST(ColourRamp, BadFilesAreRefusedNamingFileAndLine) {
       {"100 white\n100 red green blue\n", ":1: expected ELEVATION R G B"},
       {"1e400 1 2 3\n", ":1: elevation '1e400': expected a number of metres, a percentage such as 50%, or nv"},
       {"low 1 2 3\n", ":1: elevation 'low': expected a number"},
+      // Issue 33: a stop beyond any relief (1e308 m became inf and drew every cell black).
+      {"0 1 2 3\n1e308 4 5 6\n", ":2: elevation '1e308': outside +-1000 km of the datum"},
+      {"-1e39 1 2 3\n", ":1: elevation '-1e39': outside +-1000 km of the datum"},
+      {"0 1 2 3\n1e12% 4 5 6\n", ":2: elevation '1e12%': outside +-1000 km of the datum"},
       {"# nothing\n\n", ": no colour stops (lines of ELEVATION R G B)"},
   };
   const auto dir = test::tempDir("colour_ramp");
