@@ -265,12 +265,11 @@ Result<RowsBuilt> buildByRows(const RowBuilder& b, const Scenario& s, const Rank
   return RowsBuilt{std::move(shape), std::move(d)};
 }
 
-Status writeRows(const Ranks& ranks, const fs::path& runDir, const RowsBuilt& built, bool elevation) {
+Status writeRows(const Ranks& ranks, const fs::path& runDir, const RowsBuilt& built) {
   const auto& shape = built.shape;
   const auto& d = built.rows;
   STRATA_TRY_STATUS(writeModelInput(ranks, runDir, shape.bed.georef, d, int(shape.input.materials.size()),
                                     shape.input.waterDepthM.size() > 0, shape.input.rainMmPerHour.size() > 0));
-  if (!elevation) return {};
   return writeRaster(ranks, runDir / "maps" / "elevation.tif", shape.bed.georef, {}, {{0, d.firstRow, d.bed.values}});
 }
 sim::RegionSource modelInputSource(const fs::path& runDir, const ScenarioDomain& shape) {

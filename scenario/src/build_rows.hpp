@@ -47,9 +47,8 @@ struct RowsBuilt {
 /// sent back). Writes nothing (a check that fails leaves no file). Needs at least one row per
 /// rank (RowBuilder::plan refuses a region with fewer).
 Result<RowsBuilt> buildByRows(const RowBuilder& builder, const Scenario& s, const Ranks& ranks);
-/// Collective: every rank writes its rows into the model input and, with `elevation`, into
-/// maps/elevation.tif.
-Status writeRows(const Ranks& ranks, const std::filesystem::path& runDir, const RowsBuilt& built, bool elevation);
+/// Collective: every rank writes its rows into the model input and into maps/elevation.tif.
+Status writeRows(const Ranks& ranks, const std::filesystem::path& runDir, const RowsBuilt& built);
 
 /// The region read window by window from those files (`shape`: RowsBuilt::shape): what each
 /// rank builds its blocks from.

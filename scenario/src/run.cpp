@@ -801,12 +801,12 @@ class Session {
     }
     STRATA_TRY_STATUS(takeFolder());
     scenarioText_ = ranks_.fromLead(ranks_.lead() ? slurp(s_.file) : std::string());
-    // Pictures and plots draw the bed: the elevation map, written once the domain is built.
-    const bool elevation = opt_.pictures || opt_.plots;
+    // The bed the model uses (conditioned), written once the domain is built: a map for the GIS
+    // user, and what pictures and plots draw.
     if (rows) {
-      STRATA_TRY_STATUS(detail::writeRows(ranks_, opt_.outDir, *rows, elevation));
+      STRATA_TRY_STATUS(detail::writeRows(ranks_, opt_.outDir, *rows));
       domain_ = std::move(rows->shape);  // this rank's rows: read back from input/ by its blocks
-    } else if (elevation) {
+    } else {
       STRATA_TRY_STATUS(detail::writeRaster(ranks_, opt_.outDir / "maps" / "elevation.tif", domain_.bed.georef, {},
                                             {{0, 0, domain_.bed.values}}));
     }
@@ -945,6 +945,7 @@ class Session {
     } else {
       summary_.files.push_back("checkpoint.bin");
     }
+    if (fs::exists(opt_.outDir / "maps" / "elevation.tif")) summary_.files.push_back("maps/elevation.tif");
     const auto maps = run_->mapFiles();
     summary_.files.insert(summary_.files.end(), maps.begin(), maps.end());
     std::vector<std::string> pictureFiles;

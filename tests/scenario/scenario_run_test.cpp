@@ -80,6 +80,13 @@ TEST(ScenarioRun, PipeRunsSayTheirDepthsAreNotPhysical) {
   const std::string report = slurp(opt.outDir / "report.md");
   EXPECT_NE(report.find("virtual pipes: an interactive authoring model"), std::string::npos) << report;
   EXPECT_NE(report.find("not physical"), std::string::npos);
+  // Issue 33: the bed the model used is written without pictures and plots too (the docs list
+  // it among the maps), on the run's grid, and named among the run's files.
+  auto bed = gis::readDem((opt.outDir / "maps" / "elevation.tif").string());
+  ASSERT_TRUE(bed) << bed.message();
+  EXPECT_GT(bed->georef.width, 10);
+  EXPECT_GT(bed->georef.height, 10);
+  EXPECT_NE(std::find(summary->files.begin(), summary->files.end(), "maps/elevation.tif"), summary->files.end());
 }
 
 // An erosion run writes what an erosion user needs (issue 16): net cut and fill, each layer's
