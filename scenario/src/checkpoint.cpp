@@ -88,8 +88,8 @@ Result<Checkpoint> decodeCheckpoint(const std::filesystem::path& path, const Che
   return c;
 }
 
-std::string rankCheckpointFile(int rank, int ranks) {
-  return "checkpoint." + std::to_string(rank) + "-of-" + std::to_string(ranks) + ".bin";
+std::string rankCheckpointFile(int rank, int ranks, bool previous) {
+  return "checkpoint." + std::to_string(rank) + "-of-" + std::to_string(ranks) + (previous ? ".previous" : "") + ".bin";
 }
 
 bool isRankCheckpointFile(std::string_view name, int* ranks) {
@@ -97,6 +97,7 @@ bool isRankCheckpointFile(std::string_view name, int* ranks) {
   if (name.size() < 21 || !name.starts_with("checkpoint.") || !name.ends_with(".bin")) return false;
   name.remove_prefix(11);
   name.remove_suffix(4);
+  if (name.ends_with(".previous")) name.remove_suffix(9);
   const auto of = name.find("-of-");
   if (of == std::string_view::npos) return false;
   int r = -1, n = 0;

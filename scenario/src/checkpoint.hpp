@@ -30,9 +30,11 @@ struct Checkpoint {
   sim::SolverState state;
 };
 
-/// checkpoint.R-of-N.bin: rank R's part of a run checkpointed on N ranks.
-std::string rankCheckpointFile(int rank, int ranks);
-/// Whether `name` is such a file (any R and N); sets `ranks` to its N.
+/// checkpoint.R-of-N.bin: rank R's part of a run checkpointed on N ranks; with `previous`,
+/// checkpoint.R-of-N.previous.bin, its part of the checkpoint before (kept until every rank has
+/// written the next, so that a rank killed while the parts are written loses nothing).
+std::string rankCheckpointFile(int rank, int ranks, bool previous = false);
+/// Whether `name` is such a file, current or previous (any R and N); sets `ranks` to its N.
 bool isRankCheckpointFile(std::string_view name, int* ranks = nullptr);
 
 /// FNV-1a (64 bit) of `text`.

@@ -866,28 +866,49 @@ class Session {
   }
 
   // A resumed run continues from its checkpoint (each rank its own part, all of the same
-  // interval); a fresh one records its scenario.
+  // interval); a fresh one records its scenario. Over MPI ranks each rank holds its parts of the
+  // last two checkpoints, and the run resumes from the newest interval every rank has: a rank
+  // killed while the parts were written leaves the others one interval ahead, not a lost run.
   Status resumeOrBegin() {
     summary_.backend = run_->backendName();
     summary_.ranks = ranks_.size();
     if (!opt_.resume) {
       return ranks_.agree(ranks_.lead() ? writeFileAtomic(opt_.outDir / "scenario.toml", scenarioText_) : Status{});
     }
-    Checkpoint c;
+    std::optional<Checkpoint> current, previous;
     Status status;
-    if (!fs::exists(checkpointPath())) {
-      status = fail(checkpointPath().string() + ": no checkpoint to resume from" + checkpointHint(opt_.outDir, ranks_));
-    } else {
+    if (fs::exists(checkpointPath())) {
       auto decoded = decodeCheckpoint(checkpointPath(), owner());
-      if (decoded) c = std::move(decoded).value();
+      if (decoded) current = std::move(decoded).value();
       status = statusOf(decoded);
     }
-    STRATA_TRY_STATUS(ranks_.agree(status));
-    const auto [first, last] = ranks_.minMax(c.interval);
-    if (first != last) {
-      return fail(opt_.outDir.string() + ": the ranks' checkpoint parts are of different intervals (" +
-                  std::to_string(first) + " to " + std::to_string(last) + "): the run was stopped while writing them");
+    if (status.ok() && ranks_.distributed() && fs::exists(checkpointPath(true))) {
+      auto decoded = decodeCheckpoint(checkpointPath(true), owner());
+      if (decoded) previous = std::move(decoded).value();
+      status = statusOf(decoded);
     }
+    if (status.ok() && !current && !previous) {
+      status = fail(checkpointPath().string() + ": no checkpoint to resume from" + checkpointHint(opt_.outDir, ranks_));
+    }
+    STRATA_TRY_STATUS(ranks_.agree(status));
+    const int newest = std::max(current ? current->interval : -1, previous ? previous->interval : -1);
+    const int target = ranks_.minMax(newest).first;
+    const bool fromPrevious = !(current && current->interval == target);
+    if (fromPrevious && !(previous && previous->interval == target)) {
+      status = fail(opt_.outDir.string() + ": rank " + std::to_string(ranks_.rank()) +
+                    " has no checkpoint part of interval " + std::to_string(target) + " (its newest is " +
+                    std::to_string(newest) + "): the parts are not of one run");
+    } else if (fromPrevious) {
+      // The newer part of this rank is dropped: its files again say where the run stands.
+      std::error_code ec;
+      fs::rename(checkpointPath(true), checkpointPath(), ec);
+      if (ec) status = fail(checkpointPath(true).string() + ": cannot restore it: " + ec.message());
+    }
+    STRATA_TRY_STATUS(ranks_.agree(status));
+    if (fromPrevious)
+      log::warn(opt_.command)
+          << "resuming from the checkpoint before the last: the ranks were stopped while writing it";
+    Checkpoint c = std::move(fromPrevious ? *previous : *current);
     if (c.interval > intervals_) return fail(checkpointPath().string() + ": more intervals than the scenario has");
     STRATA_TRY_STATUS(run_->solver().restoreState(c.state));
     STRATA_TRY_STATUS(run_->setRain(c.state.counters.timeS));
@@ -938,7 +959,12 @@ class Session {
     summary_.spinUp = spinUp_;
     summary_.files = {"scenario.toml", "series.csv"};
     if (ranks_.distributed()) {
-      for (int r = 0; r < ranks_.size(); ++r) summary_.files.push_back(rankCheckpointFile(r, ranks_.size()));
+      for (int r = 0; r < ranks_.size(); ++r) {
+        summary_.files.push_back(rankCheckpointFile(r, ranks_.size()));
+        if (fs::exists(opt_.outDir / rankCheckpointFile(r, ranks_.size(), true))) {
+          summary_.files.push_back(rankCheckpointFile(r, ranks_.size(), true));
+        }
+      }
       for (const auto& f : detail::modelInputFiles(int(run_->domain().input.materials.size()))) {
         if (fs::exists(opt_.outDir / f)) summary_.files.push_back(f);
       }
@@ -1025,7 +1051,7 @@ class Session {
       }
     }
     const Checkpoint c{interval_, wallSoFar(), summary_.series, spinUp_, run_->solver().saveState()};
-    return ranks_.agree(writeFileAtomic(checkpointPath(), encodeCheckpoint(owner(), c)));
+    return writeCheckpoint(c);
   }
 
   Status drawPicture(const std::vector<detail::Piece>& pieces, const char* file) {
@@ -1044,10 +1070,24 @@ class Session {
     return text;
   }
 
+  // Over MPI ranks this rank's last part becomes its previous one before the new part is written,
+  // and the write is complete on every rank before any goes on (agree): the ranks' parts are then
+  // never more than one interval apart, and each holds the older of any two (resumeOrBegin).
+  Status writeCheckpoint(const Checkpoint& c) {
+    Status status;
+    if (ranks_.distributed() && fs::exists(checkpointPath())) {
+      std::error_code ec;
+      fs::rename(checkpointPath(), checkpointPath(true), ec);
+      if (ec) status = fail(checkpointPath().string() + ": cannot keep it as the previous part: " + ec.message());
+    }
+    if (status.ok()) status = writeFileAtomic(checkpointPath(), encodeCheckpoint(owner(), c));
+    return ranks_.agree(status);
+  }
+
   CheckpointOwner owner() const { return {opt_.command, fnv1a(scenarioText_)}; }
-  fs::path checkpointPath() const {
-    return opt_.outDir /
-           (ranks_.distributed() ? rankCheckpointFile(ranks_.rank(), ranks_.size()) : std::string("checkpoint.bin"));
+  fs::path checkpointPath(bool previous = false) const {
+    return opt_.outDir / (ranks_.distributed() ? rankCheckpointFile(ranks_.rank(), ranks_.size(), previous)
+                                               : std::string("checkpoint.bin"));
   }
   double wallSoFar() const {
     return earlierWallS_ + std::chrono::duration<double>(std::chrono::steady_clock::now() - wallStart_).count();

@@ -518,14 +518,44 @@ TEST(ScenarioMpi, AStoppedRunResumesOnItsRanks) {
                   {"max_depth", "max_speed", "arrival_time", "inundation_duration", "final_depth"},
                   "resumed on " + std::to_string(worldSize()) + " ranks");
   }
+  // Issue 33: ranks stopped while the second checkpoint's parts were written. Rank 0 was killed
+  // between keeping its last part as the previous one and writing the new (only its interval-1
+  // part is left), rank 1 before it began (its current part is of interval 1, it has no
+  // previous), the others finished (interval 2, previous 1). The resume takes interval 1 on
+  // every rank and ends as the run that was never stopped.
+  o.outDir = dir / "torn";
+  o.resume = false;
+  o.stopAfterIntervals = 2;
+  auto torn = runScenario(s, o);
+  ASSERT_TRUE(torn) << torn.message();
+  const std::string of = "-of-" + std::to_string(worldSize());
+  const fs::path part = dir / "torn" / ("checkpoint." + std::to_string(worldRank()) + of + ".bin");
+  const fs::path previous = dir / "torn" / ("checkpoint." + std::to_string(worldRank()) + of + ".previous.bin");
+  EXPECT_TRUE(fs::exists(part) && fs::exists(previous));
+  if (worldRank() == 0) fs::remove(part);
+  if (worldRank() == 1) fs::rename(previous, part);
+  MPI_Barrier(MPI_COMM_WORLD);
+  o.stopAfterIntervals = -1;
+  o.resume = true;
+  auto healed = runScenario(s, o);
+  ASSERT_TRUE(healed) << healed.message();
+  EXPECT_TRUE(healed->completed);
+  MPI_Barrier(MPI_COMM_WORLD);
+  if (worldRank() == 0) {
+    expectSameRun(dir / "whole", dir / "torn",
+                  {"max_depth", "max_speed", "arrival_time", "inundation_duration", "final_depth"},
+                  "resumed after a torn checkpoint on " + std::to_string(worldSize()) + " ranks");
+  }
   // A folder checkpointed on another number of ranks is refused on every rank, saying how many.
   if (worldRank() == 0) {
     fs::create_directories(dir / "other");
     fs::copy(dir / "stopped", dir / "other", fs::copy_options::recursive | fs::copy_options::overwrite_existing);
     for (int r = 0; r < worldSize(); ++r) {
-      fs::rename(
-          dir / "other" / ("checkpoint." + std::to_string(r) + "-of-" + std::to_string(worldSize()) + ".bin"),
-          dir / "other" / ("checkpoint." + std::to_string(r) + "-of-" + std::to_string(worldSize() + 1) + ".bin"));
+      for (const std::string kind : {".bin", ".previous.bin"}) {  // both parts a rank keeps
+        fs::rename(
+            dir / "other" / ("checkpoint." + std::to_string(r) + "-of-" + std::to_string(worldSize()) + kind),
+            dir / "other" / ("checkpoint." + std::to_string(r) + "-of-" + std::to_string(worldSize() + 1) + kind));
+      }
     }
   }
   MPI_Barrier(MPI_COMM_WORLD);
