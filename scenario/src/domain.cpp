@@ -393,10 +393,10 @@ gis::Georef windowGeoref(const gis::Georef& full, const gis::CellRect& w) {
 
 // Step 2: the grid, planned before anything is read: the window at region.cell_size (sizes in
 // double, so no count overflows), at least 4 x 4 cells, and a run on it must fit in the memory
-// this process can have (`budget` bytes; 0: what the machine has available), its share of a run
-// over `ranks` MPI ranks.
+// this process can have, its share of a run over `ranks` MPI ranks: `budget` bytes (0: what the
+// machine has available) shared by the `ranksOnNode` ranks that run on this machine.
 Status planGrid(const Scenario& s, const TerrainSource& source, RegionFrame& frame, uint64_t budget, int ranks,
-                bool pictures) {
+                bool pictures, int ranksOnNode) {
   const gis::Georef g0 = windowGeoref(source.georef(), frame.window);
   double width = g0.width, height = g0.height;
   if (s.region.cellSizeM > 0) {
@@ -428,7 +428,8 @@ Status planGrid(const Scenario& s, const TerrainSource& source, RegionFrame& fra
   // The window as read (and GDAL's copy while it resamples) comes on top.
   const double native = s.region.cellSizeM > 0 ? 8 * nativeCells / ranks : 0;
   const double bytes = cells * bytesPerCell(layers, ranks) + native + (pictures ? pictureBytes(width, height) : 0);
-  const double available = budget > 0 ? double(budget) : double(availableMemoryBytes());
+  const double node = budget > 0 ? double(budget) : double(availableMemoryBytes());
+  const double available = node / std::max(1, ranksOnNode);  // this rank's share of the machine
   const bool tooWide = width > std::numeric_limits<int>::max() / 2 || height > std::numeric_limits<int>::max() / 2;
   if (tooWide || (available > 0 && bytes > available)) {
     char msg[320];
@@ -436,7 +437,11 @@ Status planGrid(const Scenario& s, const TerrainSource& source, RegionFrame& fra
                   cells / 1e6, formatBytes(bytes).c_str());
     char cellSize[64] = "";
     if (s.region.cellSizeM > 0) std::snprintf(cellSize, sizeof cellSize, "%.6g m cells: ", s.region.cellSizeM);
-    const std::string have = tooWide         ? "more than one grid can index"
+    const std::string have = tooWide ? "more than one grid can index"
+                             : available > 0 && ranksOnNode > 1
+                                 ? "and " + formatBytes(available) + " are available to each of the " +
+                                       std::to_string(ranksOnNode) + " MPI ranks on this machine (" +
+                                       formatBytes(node) + " in all)"
                              : available > 0 ? "and " + formatBytes(available) + " are available"
                                              : "more than there is";
     return fail(s.at(sizeKey(s)) + cellSize + msg + have + " (use larger cells or a smaller region)");
@@ -512,11 +517,11 @@ Result<std::vector<Material>> layerMaterials(const Scenario& s, const TerrainSou
 
 // Steps 1 and 2, and the grid: the region's window of the source, the grid planned against
 // memory, its georeference (the window's, resampled to region.cell_size) and cell sizes.
-Result<Plan> planRegion(const Scenario& s, uint64_t budget, int ranks, bool pictures) {
+Result<Plan> planRegion(const Scenario& s, uint64_t budget, int ranks, bool pictures, int ranksOnNode) {
   STRATA_TRY(auto source, TerrainSource::open(s));
   STRATA_TRY(auto mapper, PixelMapper::create(source.georef()));
   STRATA_TRY(auto frame, regionWindow(s, source, mapper));
-  STRATA_TRY_STATUS(planGrid(s, source, frame, budget, ranks, pictures));
+  STRATA_TRY_STATUS(planGrid(s, source, frame, budget, ranks, pictures, ranksOnNode));
   const gis::Georef g0 = windowGeoref(source.georef(), frame.window);
   gis::Georef grid = g0;
   if (s.region.cellSizeM > 0) {
@@ -1125,8 +1130,9 @@ RowBuilder::RowBuilder(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 RowBuilder::RowBuilder(RowBuilder&&) noexcept = default;
 RowBuilder::~RowBuilder() = default;
 
-Result<RowBuilder> RowBuilder::plan(const Scenario& s, uint64_t memoryBudgetBytes, int ranks, bool pictures) {
-  STRATA_TRY(auto plan, planRegion(s, memoryBudgetBytes, ranks, pictures));
+Result<RowBuilder> RowBuilder::plan(const Scenario& s, uint64_t memoryBudgetBytes, int ranks, bool pictures,
+                                    int ranksOnNode) {
+  STRATA_TRY(auto plan, planRegion(s, memoryBudgetBytes, ranks, pictures, ranksOnNode));
   ScenarioDomain shape;
   shape.bed.georef = plan.grid;
   shape.input.rowDxM = plan.rowDxM;

@@ -20,9 +20,11 @@ class RowBuilder {
  public:
   /// Plans the build (reads no cell; every rank makes the same): the region's grid, per-row cell
   /// sizes, materials, the model, inflows and levels on cells, the rain. The memory check is a
-  /// rank's share of a run over `ranks` (with the pictures' gather on the lead when `pictures`).
-  /// `s` must outlive the builder.
-  static Result<RowBuilder> plan(const Scenario& s, uint64_t memoryBudgetBytes, int ranks, bool pictures);
+  /// rank's share of a run over `ranks` (with the pictures' gather on the lead when `pictures`)
+  /// against its share of the machine's memory (or of `memoryBudgetBytes`), which `ranksOnNode`
+  /// ranks share. `s` must outlive the builder.
+  static Result<RowBuilder> plan(const Scenario& s, uint64_t memoryBudgetBytes, int ranks, bool pictures,
+                                 int ranksOnNode = 1);
   RowBuilder(RowBuilder&&) noexcept;
   ~RowBuilder();
 

@@ -793,7 +793,8 @@ class Session {
     STRATA_TRY(engine_, startContext(opt_.backend.value_or(s_.model.backend), opt_.pictures, ranks_));
     std::optional<detail::RowsBuilt> rows;
     if (ranks_.distributed()) {
-      auto planned = detail::RowBuilder::plan(s_, opt_.memoryBudgetBytes, ranks_.size(), opt_.pictures);
+      auto planned =
+          detail::RowBuilder::plan(s_, opt_.memoryBudgetBytes, ranks_.size(), opt_.pictures, ranks_.onThisMachine());
       STRATA_TRY_STATUS(ranks_.agree(statusOf(planned)));
       STRATA_TRY(rows, detail::buildByRows(*planned, s_, ranks_));
     } else {

@@ -309,6 +309,34 @@ TEST(ScenarioMpi, TheRanksBreachAsOneProcessWhereManyPathsTie) {
 // at_rest layers settled by the ranks (settle.hpp) on a finer grid of the canyon, where cells on
 // the ranks' border rows lose a layer because of a cell across the border: each rank's rows of
 // every layer are the one process's, and so are the counts.
+// Issue 33: the memory check is per machine. The ranks on one machine share its memory (or the
+// budget given), so a region whose one-rank share just fits the budget is refused when K ranks
+// run on the machine, the message saying so, and accepted with K times the budget.
+TEST(ScenarioMpi, TheMemoryCheckSharesTheMachineAmongItsRanks) {
+  const auto dir = sharedDir("memory");
+  const Scenario s = load(dir, "flood.toml", floodText());
+  const int k = detail::Ranks::world().onThisMachine();
+  EXPECT_EQ(k, worldSize());  // the tests run every rank on this machine
+  // The smallest budget (to 1 %) that one rank's share fits in, alone on its machine.
+  uint64_t lo = 1, hi = uint64_t(1) << 40;
+  while (hi > lo + lo / 100) {
+    const uint64_t mid = lo + (hi - lo) / 2;
+    (detail::RowBuilder::plan(s, mid, worldSize(), false, 1) ? hi : lo) = mid;
+  }
+  ASSERT_TRUE(detail::RowBuilder::plan(s, hi, worldSize(), false, 1));
+  if (k > 1) {
+    auto refused = detail::RowBuilder::plan(s, hi, worldSize(), false, k);
+    ASSERT_FALSE(refused);
+    EXPECT_NE(
+        refused.message().find("are available to each of the " + std::to_string(k) + " MPI ranks on this machine"),
+        std::string::npos)
+        << refused.message();
+  }
+  EXPECT_TRUE(detail::RowBuilder::plan(s, hi * uint64_t(k), worldSize(), false, k));
+  MPI_Barrier(MPI_COMM_WORLD);
+  if (worldRank() == 0) fs::remove_all(dir);
+}
+
 TEST(ScenarioMpi, TheRanksSettleLayersAtRestAsOneProcess) {
   const auto dir = sharedDir("at-rest");
   std::string text = erosionText();

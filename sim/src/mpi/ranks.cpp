@@ -34,6 +34,16 @@ Ranks Ranks::of(MPI_Comm comm) {
   return r;
 }
 
+int Ranks::onThisMachine() const {
+  if (!distributed_) return 1;
+  MPI_Comm machine = MPI_COMM_NULL;
+  MPI_Comm_split_type(comm_, MPI_COMM_TYPE_SHARED, rank_, MPI_INFO_NULL, &machine);
+  int n = 1;
+  MPI_Comm_size(machine, &n);
+  MPI_Comm_free(&machine);
+  return n;
+}
+
 Status Ranks::agree(const Status& local) const {
   if (!distributed_) return local;
   int failing = local.ok() ? INT_MAX : rank_, first = INT_MAX;

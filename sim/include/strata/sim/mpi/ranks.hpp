@@ -28,6 +28,9 @@ class Ranks {
   bool lead() const { return rank_ == 0; }
   int rank() const { return rank_; }
   int size() const { return size_; }
+  /// How many of the ranks run on this rank's machine and so share its memory
+  /// (MPI_COMM_TYPE_SHARED). Collective: every rank calls it.
+  int onThisMachine() const;
   MPI_Comm comm() const { return comm_; }  ///< MPI_COMM_NULL for single()
 
   /// Collective: success on every rank, or the failure of the lowest failing rank on every rank
