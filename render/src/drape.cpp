@@ -78,12 +78,37 @@ Result<DrapeImage> loadDrape(const std::string& path, const gis::Georef& scene, 
     target.width = std::max(1, int(std::lround(scene.width * shrink)));
     target.height = std::max(1, int(std::lround(scene.height * shrink)));
   }
+  // The warp reads every source pixel (GDAL's warper takes no overviews): a source far finer than
+  // the texture would be decoded whole, minutes and gigabytes for a picture 8192 texels a side at
+  // most. Above 256 M pixels and 64 times the texels it is refused, saying how to resample it.
+  const double sourcePixels = double(info.georef.width) * double(info.georef.height);
+  const double texels = double(target.width) * double(target.height);
+  const double limit = std::max(double(1 << 28), 64 * texels);
+  if (sourcePixels > limit) {
+    const int fits = int(std::floor(info.georef.width * std::sqrt(limit / sourcePixels)));
+    char msg[320];
+    std::snprintf(msg, sizeof msg,
+                  ": %d x %d pixels, %.0f times the %d x %d texels drawn: resample it first "
+                  "(gdal_translate -r average -outsize %d 0 %s small.tif)",
+                  info.georef.width, info.georef.height, sourcePixels / texels, target.width, target.height, fits,
+                  path.c_str());
+    return fail(path + msg);
+  }
   const double fx = double(target.width) / scene.width, fy = double(target.height) / scene.height;
   for (int k : {1, 4}) target.transform.c[k] /= fx;
   for (int k : {2, 5}) target.transform.c[k] /= fy;
 
+  // What the bands are is read from their number: 1 to 4 Byte bands are grey, grey and alpha,
+  // RGB, RGBA; one band of another type is coloured by a ramp. Anything else would be drawn from
+  // bands chosen silently: refused, saying how to pick them.
   const bool bytes = info.bandType == "Byte";
-  const int bands = bytes ? std::min(info.bandCount, 4) : 1;
+  if ((bytes && info.bandCount > 4) || (!bytes && info.bandCount > 1)) {
+    return fail(path + ": " + std::to_string(info.bandCount) + " " + info.bandType +
+                " bands; a drape is 1 to 4 Byte bands (grey, grey and alpha, RGB, RGBA) or one band of values to "
+                "colour: pick them first (gdal_translate -b 1 -b 2 -b 3 " +
+                path + " rgb.tif)");
+  }
+  const int bands = bytes ? info.bandCount : 1;
   std::vector<gis::Grid<float>> values;
   for (int b = 1; b <= bands; ++b) {
     gis::MosaicInput in;

@@ -1,8 +1,11 @@
 // Rasters draped over a terrain (render/drape.hpp): warped by GDAL onto the scene's grid, a
 // pixel lands on its georeferenced ground point; bands become colours as documented. CPU only:
 // the picture test is in terrain_render_test.cpp.
+#include <gdal.h>
 #include <gtest/gtest.h>
+#include <ogr_srs_api.h>
 
+#include <chrono>
 #include <cmath>
 #include <numbers>
 
@@ -164,6 +167,53 @@ TEST(Drape, BadInputNamesTheFile) {
   auto bad = loadDrape(path, scene, o);
   ASSERT_FALSE(bad);
   EXPECT_EQ(bad.message(), path + ": drape range 5.000000 .. 5.000000 is not an interval");
+}
+
+// Issue 33: a raster whose bands are not a picture or one band of values (a 64-band image, two
+// bands of floats) is refused naming the bands, not drawn from bands picked silently.
+TEST(Drape, BandsThatAreNotAPictureAreRefused) {
+  const gis::Georef scene = canyonGeoref();
+  const auto dir = strata::test::tempDir("drape-bands");
+  const std::string many = (dir / "many.tif").string(), two = (dir / "two.tif").string();
+  ASSERT_TRUE(test::writeDrapeRaster(many, 8, 8, 64, GDT_Byte, "EPSG:4326", {-113, 0.125, 0, 37, 0, -0.125},
+                                     [](int, int, int b) { return double(b); }));
+  ASSERT_TRUE(test::writeDrapeRaster(two, 8, 8, 2, GDT_Float32, "EPSG:4326", {-113, 0.125, 0, 37, 0, -0.125},
+                                     [](int, int, int b) { return double(b); }));
+  auto refused = loadDrape(many, scene);
+  ASSERT_FALSE(refused);
+  EXPECT_EQ(refused.message().rfind(many + ": 64 Byte bands; a drape is 1 to 4 Byte bands", 0), 0u)
+      << refused.message();
+  auto floats = loadDrape(two, scene);
+  ASSERT_FALSE(floats);
+  EXPECT_EQ(floats.message().rfind(two + ": 2 Float32 bands;", 0), 0u) << floats.message();
+}
+
+// Issue 33: a drape far finer than any texture (60000 x 60000 pixels, here sparse and so small on
+// disk) is refused at once, saying how to resample it, instead of being decoded whole for
+// minutes while memory grows.
+TEST(Drape, ASourceFarFinerThanTheTextureIsRefusedAtOnce) {
+  const auto dir = strata::test::tempDir("drape-huge");
+  const std::string path = (dir / "huge.tif").string();
+  {
+    GDALDriverH gtiff = GDALGetDriverByName("GTiff");
+    const char* opts[] = {"TILED=YES", "COMPRESS=DEFLATE", "SPARSE_OK=TRUE", nullptr};
+    GDALDatasetH ds = GDALCreate(gtiff, path.c_str(), 60000, 60000, 3, GDT_Byte, const_cast<char**>(opts));
+    ASSERT_NE(ds, nullptr);
+    double gt[6] = {-112.3, 0.3 / 60000, 0, 36.25, 0, -0.3 / 60000};
+    GDALSetGeoTransform(ds, gt);
+    OGRSpatialReferenceH srs = OSRNewSpatialReference(nullptr);
+    OSRImportFromEPSG(srs, 4326);
+    GDALSetSpatialRef(ds, srs);
+    OSRDestroySpatialReference(srs);
+    GDALClose(ds);
+  }
+  const auto start = std::chrono::steady_clock::now();
+  auto refused = loadDrape(path, canyonGeoref());
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  ASSERT_FALSE(refused);
+  EXPECT_LT(seconds, 5.0);
+  EXPECT_EQ(refused.message().rfind(path + ": 60000 x 60000 pixels, ", 0), 0u) << refused.message();
+  EXPECT_NE(refused.message().find("resample it first (gdal_translate -r average -outsize "), std::string::npos);
 }
 
 }  // namespace
