@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs Strata to a fresh prefix and runs a short flood scenario with the installed `strata`
 # from a folder outside the source and build trees: the plots must be written (their scripts are
-# compiled in), and the installed main-job scenario must name a DEM that exists.
+# compiled in), and every installed scenario (the main job's and the second job's) must name a DEM
+# that is installed.
 #   installed_run.sh BUILD_DIR DEM
 set -euo pipefail
 build=$1
@@ -29,9 +30,12 @@ TOML
 for f in run/report.md run/plots/water.png run/plots/max_depth.png run/maps/max_depth.tif; do
   [ -s "$f" ] || { echo "installed run: $f missing" >&2; exit 1; }
 done
-installed="$work/prefix/share/strata/scenarios/grand_canyon_flood.toml"
-dem_line=$(grep '^dem' "$installed")
-rel=${dem_line#*\"}
-rel=${rel%\"*}
-[ -s "$(dirname "$installed")/$rel" ] || { echo "installed scenario names a missing DEM: $rel" >&2; exit 1; }
+# Every installed scenario (the main job and the second, erosion, job) names a DEM installed beside it.
+for installed in "$work"/prefix/share/strata/scenarios/*.toml; do
+  dem_line=$(grep '^dem' "$installed")
+  rel=${dem_line#*\"}
+  rel=${rel%\"*}
+  [ -s "$(dirname "$installed")/$rel" ] || { echo "installed $(basename "$installed") names a missing DEM: $rel" >&2; exit 1; }
+done
+[ -s "$work/prefix/share/strata/scenarios/rainier_erosion.toml" ] || { echo "the second job's scenario is not installed" >&2; exit 1; }
 echo "installed run: report, plots and maps written from $work"
