@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -123,6 +124,58 @@ void expectNoCrack(TerrainRenderer& renderer, double reachM) {
   }
   // The check is not vacuous: a third of all pixels over the six views.
   EXPECT_GT(mustBeTerrain, 6L * w * h / 3);
+}
+
+// Issue 33: a straight-down render was said to match `gdaldem hillshade` best shifted 75-100 m
+// north, under half a cell. The geometry is where the georeference puts it: a 4 x 4-cell block
+// 100 m high, centred under a camera looking straight down, appears centred in the rendered
+// elevation to a tenth of a pixel, on a UTM grid (30 m cells) and on a lon/lat grid (the Grand
+// Canyon's 0.001953125 degree cells). A half-cell offset would move it 2 to 4 pixels here; the
+// hillshade's shift comes from the lighting (a shaded slope's bright and dark sides), not from
+// where the relief is drawn.
+TEST_F(GlTest, AStraightDownRenderDrawsReliefWhereItsGeoreferencePutsIt) {
+  const auto dir = test::outputDir("render");
+  const struct {
+    const char* name;
+    const char* crs;
+    std::array<double, 6> gt;
+    double heightM;
+  } grids[] = {{"utm", "EPSG:32612", {500000, 30, 0, 4000000, 0, -30}, 2000},
+               {"lonlat", "EPSG:4326", {-112.5, 0.001953125, 0, 36.5, 0, -0.001953125}, 20000}};
+  auto ring = RingRenderer::create({});
+  ASSERT_TRUE(ring) << ring.message();
+  const int size = 256;
+  auto target = OffscreenTarget::create(size, size);
+  ASSERT_TRUE(target) << target.message();
+  for (const auto& g : grids) {
+    const std::string path = (dir / (std::string("block_") + g.name + ".tif")).string();
+    ASSERT_TRUE(test::writeDrapeRaster(path, 64, 64, 1, GDT_Float32, g.crs, g.gt, [](int x, int y, int) {
+      return x >= 30 && x < 34 && y >= 30 && y < 34 ? 100.0 : 0.0;
+    }));
+    auto dem = gis::readDem(path);
+    ASSERT_TRUE(dem) << dem.message();
+    auto scene = TerrainScene::create(*dem);
+    ASSERT_TRUE(scene) << scene.message();
+    // The block's centre: the corner shared by cells 31 and 32 in x and in y.
+    const CameraPose cam{.lon = g.gt[0] + 32 * g.gt[1],
+                         .lat = g.gt[3] + 32 * g.gt[5],
+                         .heightM = g.heightM,
+                         .headingDeg = 0,
+                         .pitchDeg = -90,
+                         .fovYDeg = 30};
+    ASSERT_TRUE((*ring)->draw(*scene, cam, Shading{}, *target));
+    const auto elev = target->elevation();
+    double sx = 0, sy = 0;
+    int n = 0;
+    for (int y = 0; y < size; ++y) {
+      for (int x = 0; x < size; ++x) {
+        if (elev[size_t(y) * size + size_t(x)] > 50) sx += x, sy += y, ++n;
+      }
+    }
+    ASSERT_GT(n, 100) << g.name;
+    EXPECT_NEAR(sx / n, 0.5 * (size - 1), 0.1) << g.name << ": the block is drawn off its place east-west";
+    EXPECT_NEAR(sy / n, 0.5 * (size - 1), 0.1) << g.name << ": the block is drawn off its place north-south";
+  }
 }
 
 TEST_F(GlTest, RingRenderHasNoCrackOverMagenta) {
