@@ -195,6 +195,7 @@ TEST(Drape, ASourceFarFinerThanTheTextureIsRefusedAtOnce) {
   const auto dir = strata::test::tempDir("drape-huge");
   const std::string path = (dir / "huge.tif").string();
   {
+    GDALAllRegister();  // run alone, no earlier read has registered the drivers
     GDALDriverH gtiff = GDALGetDriverByName("GTiff");
     const char* opts[] = {"TILED=YES", "COMPRESS=DEFLATE", "SPARSE_OK=TRUE", nullptr};
     GDALDatasetH ds = GDALCreate(gtiff, path.c_str(), 60000, 60000, 3, GDT_Byte, const_cast<char**>(opts));
