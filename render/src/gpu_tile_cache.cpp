@@ -51,8 +51,10 @@ Result<int> GpuTileCache::acquire(const PageKey& key, bool wait) {
   ++stats_.misses;
   STRATA_CHECK(grid.width == p && grid.height == p) << "readWindow returned " << grid.width << "x" << grid.height;
   if (options_.noDataFill) {
-    for (float& v : grid.data) {
-      if (std::isnan(v)) v = *options_.noDataFill;
+    for (int y = 0; y < p; ++y) {
+      for (int x = 0; x < p; ++x) {
+        if (float& v = grid.at(x, y); std::isnan(v)) v = options_.noDataFill(key, x, y);
+      }
     }
   }
   int layer = 0;

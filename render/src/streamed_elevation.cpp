@@ -62,9 +62,10 @@ Result<std::unique_ptr<StreamedElevation>> StreamedElevation::create(strata::ter
   s->coarse_ = c;
   const int cw = st.levelWidth(c), ch = st.levelHeight(c);
   STRATA_TRY(auto coarse, st.readWindow(field, {0, 0, cw, ch}, c));
-  // Voids of the coarse level filled from the cells around them, not pits. The streamed pages
-  // are still filled with the lowest elevation (GpuCacheOptions::noDataFill): a page has no
-  // neighbours to fill from (docs/render-rings.md, "Voids").
+  // Voids of the coarse level filled from the cells around them, not pits. A streamed page has
+  // no neighbours to fill from: its voids take the filled coarse level's surface there
+  // (voidFill; docs/render-rings.md, "Voids"), as the whole-DEM render's filled surface would
+  // be seen from afar, never the lowest elevation (shafts down to it).
   STRATA_TRY(const size_t filled, gis::fillVoids(coarse));
   (void)filled;
   s->coarseCpu_ = std::move(coarse);
@@ -94,8 +95,12 @@ Result<std::unique_ptr<StreamedElevation>> StreamedElevation::create(strata::ter
     return fail(where + "GPU budget of " + std::to_string(params.gpuBudgetBytes) + " bytes is below the stack's " +
                 std::to_string(fixed) + " bytes plus one " + std::to_string(page) + "-byte page");
   }
-  STRATA_TRY(auto cache,
-             GpuTileCache::create(st, {.pageSize = p, .budgetBytes = params.gpuBudgetBytes - fixed, .noDataFill = lo}));
+  STRATA_TRY(auto cache, GpuTileCache::create(st, {.pageSize = p,
+                                                   .budgetBytes = params.gpuBudgetBytes - fixed,
+                                                   .noDataFill = [raw = s.get(), p](const PageKey& key, int x, int y) {
+                                                     return raw->voidFill((key.x * p + x + 0.5) * double(1 << key.lod),
+                                                                          (key.y * p + y + 0.5) * double(1 << key.lod));
+                                                   }}));
   s->cache_ = std::make_unique<GpuTileCache>(std::move(cache));
   s->stats_.gpuBudgetBytes = params.gpuBudgetBytes;
   return s;
@@ -203,6 +208,20 @@ Status StreamedElevation::update(glm::dvec2 cell) {
   return {};
 }
 
+float StreamedElevation::voidFill(double x, double y) const {
+  // Bilinear on the filled coarse grid, whose cell (i, j) is centred at ((i + 0.5) s, (j + 0.5) s).
+  const double s = double(1 << coarse_);
+  const double u = std::clamp(x / s - 0.5, 0.0, double(coarseCpu_.width - 1));
+  const double v = std::clamp(y / s - 0.5, 0.0, double(coarseCpu_.height - 1));
+  const int i0 = int(u), j0 = int(v);
+  const int i1 = std::min(i0 + 1, coarseCpu_.width - 1), j1 = std::min(j0 + 1, coarseCpu_.height - 1);
+  const double fu = u - i0, fv = v - j0;
+  const double top = (1 - fu) * coarseCpu_.at(i0, j0) + fu * coarseCpu_.at(i1, j0);
+  const double bottom = (1 - fu) * coarseCpu_.at(i0, j1) + fu * coarseCpu_.at(i1, j1);
+  const double h = (1 - fv) * top + fv * bottom;
+  return std::isfinite(h) ? float(h) : minM_;  // a grid with no data at all
+}
+
 std::array<float, 4> StreamedElevation::cellQuad(int i, int j) {
   // Without waitForDisk a tile not in RAM yet is requested, and the coarse level answers
   // meanwhile (draw() asks for the ground under the viewer every frame).
@@ -214,7 +233,10 @@ std::array<float, 4> StreamedElevation::cellQuad(int i, int j) {
   }
   std::array<float, 4> q{};
   if (read) {
-    for (size_t k = 0; k < 4; ++k) q[k] = std::isnan(read->data[k]) ? minM_ : read->data[k];
+    for (size_t k = 0; k < 4; ++k) {
+      const int x = i + int(k & 1), y = j + int(k >> 1);
+      q[k] = std::isnan(read->data[k]) ? voidFill(x + 0.5, y + 0.5) : read->data[k];
+    }
     return q;
   }
   const int s = 1 << coarse_;

@@ -258,6 +258,73 @@ TEST_F(GlTest, StreamedRenderMatchesTheWholeDemRender) {
   EXPECT_LT(d.terrainMismatch, size_t(w * h / 100));
 }
 
+// Issue 33: voids in a streamed store were drawn as shafts down to its lowest elevation (a page
+// has no neighbours to fill from), where the whole-DEM render fills them from the cells around.
+// Three voids of 6 x 6 cells in the view (5, 10 and 20 km ahead of the camera, on the canyon's
+// rims and slopes) now take the filled coarse level's surface: the streamed render matches the
+// whole-DEM render of the same voided DEM up to the two fills' difference over the voids.
+TEST_F(GlTest, StreamedVoidsAreDrawnAsTheWholeDemDrawsThem) {
+  const std::string path = test::dataPath("grand_canyon/grand_canyon_512.tif");
+  auto dem = gis::readDem(path);
+  ASSERT_TRUE(dem) << dem.message();
+  for (const auto& [cx, cy] : {std::pair{445, 471}, std::pair{419, 461}, std::pair{367, 442}}) {
+    for (int y = cy - 3; y < cy + 3; ++y) {
+      for (int x = cx - 3; x < cx + 3; ++x) dem->values.at(x, y) = gis::kNoData;
+    }
+  }
+  const auto dir = test::tempDir("void_store") / "store";
+  strata::terrain::IngestOptions o;
+  o.metric = {.minExp = 4, .maxExp = 7};
+  o.cache.prefetch = false;
+  const gis::Grid<float> voided = dem->values;
+  auto reader = [&voided](int x, int y, int w, int h) -> Result<gis::Grid<float>> {
+    gis::Grid<float> g(w, h, gis::kNoData);
+    for (int j = 0; j < h; ++j) {
+      for (int i = 0; i < w; ++i) {
+        if (x + i < voided.width && y + j < voided.height) g.at(i, j) = voided.at(x + i, y + j);
+      }
+    }
+    return g;
+  };
+  auto rep =
+      strata::terrain::ingest(dir, dem->georef, {{{"bedrock", strata::terrain::LayerKind::Bedrock, ""}, reader}}, o);
+  ASSERT_TRUE(rep) << rep.message();
+  auto store = TileStore::open(dir, {.budgetBytes = size_t(16) << 20, .prefetch = false});
+  ASSERT_TRUE(store) << store.message();
+  // The whole-DEM render of the store's level 0 (voids and all), voids filled (the default).
+  auto grid = store->readWindow(0, {0, 0, store->width(), store->height()}, 0);
+  ASSERT_TRUE(grid) << grid.message();
+  auto whole = TerrainScene::create(gis::Raster{store->desc().georef, std::move(*grid)});
+  ASSERT_TRUE(whole) << whole.message();
+  EXPECT_EQ(whole->voidCount(), 108u);
+  auto streamed =
+      TerrainScene::createStreamed(std::move(*store), {.clipSize = 128, .pageSize = 32, .uploadPagesPerFrame = 1000});
+  ASSERT_TRUE(streamed) << streamed.message();
+  auto ring = RingRenderer::create({.circles = 64});
+  ASSERT_TRUE(ring) << ring.message();
+  const int w = 256, h = 160;
+  auto t1 = OffscreenTarget::create(w, h), t2 = OffscreenTarget::create(w, h);
+  ASSERT_TRUE(t1 && t2);
+  Shading shading;
+  shading.fogM = 150000;
+  shading.tintRangeM = glm::vec2(whole->minElevationM(), whole->maxElevationM());
+  ASSERT_TRUE((*ring)->draw(*whole, kCanyonCamera, shading, *t1));
+  ASSERT_TRUE((*ring)->draw(*streamed, kCanyonCamera, shading, *t2));
+  const Diff d = compare(*t1, *t2, 8);
+  std::ofstream(test::outputDir("render") / "streaming_voids.txt")
+      << "# streamed vs whole-DEM ring render of the canyon with three 6 x 6-cell voids, " << w << "x" << h
+      << "\ncolour_fraction_over_8 " << d.colourFraction << "\nelev_mean_m " << d.elevMeanM << "\nelev_p99_m "
+      << d.elevP99M << "\nelev_max_m " << d.elevMaxM << "\n";
+  ASSERT_TRUE(render::writeImage8((test::outputDir("render") / "streaming_voids.png").string(), w, h, 4, t2->colour()));
+  // Measured on llvmpipe: 1.1 % of pixels off by more than 8, elevation mean 1.3 m, 99th
+  // percentile 36 m (the coarse level's fill against GDAL's fill of the full-resolution grid,
+  // over the voids); drawn with the lowest elevation before: 5.0 %, 13.5 m and 362 m, a pit
+  // in the picture.
+  EXPECT_LT(d.colourFraction, 0.02);
+  EXPECT_LT(d.elevMeanM, 3.0);
+  EXPECT_LT(d.elevP99M, 60.0);
+}
+
 // A drape, cast shadows and a graticule on a streamed scene (the drape over the whole terrain,
 // shadows and lon/lat on the overview level: here level 0, the store's 512^2) look as on the
 // whole-DEM scene, up to the streamed elevation's own difference (the test above); and they

@@ -12,6 +12,7 @@
 // tiles into one page.
 
 #include <cstdint>
+#include <functional>
 #include <list>
 #include <optional>
 #include <unordered_map>
@@ -36,7 +37,9 @@ struct PageKey {
 struct GpuCacheOptions {
   int pageSize = 64;                      ///< P: texels a page side (a power of two, 8..1024)
   size_t budgetBytes = size_t(32) << 20;  ///< GPU bytes of the page array; capacity = budget / (P^2 * 4)
-  std::optional<float> noDataFill;        ///< NaN samples replaced by this on upload (unset: NaN kept)
+  /// NaN samples of a page replaced on upload by noDataFill(key, x, y), (x, y) the texel in the
+  /// page (unset: NaN kept).
+  std::function<float(const PageKey&, int, int)> noDataFill;
 };
 
 /// Lookups and traffic since creation (or resetStats()).

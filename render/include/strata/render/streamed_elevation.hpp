@@ -89,6 +89,9 @@ class StreamedElevation {
   const gl::Texture& pageFlags() const { return flags_; }
   /// Elevation range of the field over the store (m).
   float minElevationM() const { return minM_; }
+  /// The elevation a void takes at base-cell coordinates (x, y) (cell (i, j) spans [i, i+1)):
+  /// the filled coarse level, bilinear (its voids filled from the cells around them).
+  float voidFill(double x, double y) const;
   float maxElevationM() const { return maxM_; }
   /// The four base-grid samples (i, j), (i+1, j), (i, j+1), (i+1, j+1), NaN filled with the
   /// minimum, through the store's RAM cache (the coarse level's samples if a tile cannot be read,
