@@ -11,6 +11,7 @@ uniform vec3 uAirHazeColour;
 uniform float uAirBrightness;
 uniform float uAirRadius;       // the body's radius (m), for grazing rays
 uniform float uAirSun;          // sunlight on the air at the viewer (airSunAt), 0 (night) to 1
+uniform vec3 uAirSunDir;        // towards the sun, in the viewer's east-north-up frame
 
 // Optical depth per unit datum extinction along a straight segment of length `len` from
 // altitude z0 to z1 (density exp(-z / H)).
@@ -33,6 +34,13 @@ float airRay(float h, float s, float H) {
   return grazing * (2.0 * exp(-a / H) - eh);
 }
 
+// Optical depth per unit datum extinction from altitude h along the ray tangent to the datum
+// (the limb), less the half behind its tangent point that a viewer above it does not see.
+float airLimb(float h, float H) {
+  float grazing = sqrt(3.14159265 * uAirRadius * H / 2.0);
+  return grazing * (2.0 - exp(-max(h, -2.0 * H) / H));
+}
+
 // Sunlight on the air where the local up is `up` (viewer's frame): full with the sun 8 degrees
 // up, none 6 below (twilight).
 float airSunAt(vec3 up, vec3 sunDir) { return smoothstep(-0.1, 0.14, dot(up, sunDir)); }
@@ -46,14 +54,27 @@ vec3 airLight(float tR, float tM, float sun, out vec3 transmittance) {
   return uAirBrightness * sun * scatter * (1.0 - transmittance);
 }
 
-// The sky seen from altitude h along a ray of elevation sine s (rays into the body get the
-// horizon's colour: terrain drawn over them, or the haze at the limb).
-vec3 skyLight(float h, float s) {
+// The sky seen from altitude h along the ray `dir` (unit, viewer's east-north-up; rays into the
+// body get the horizon's colour: terrain drawn over them, or the haze at the limb). The air along
+// a downward ray is densest at its lowest point, and lit by the sun there: above a limb on the
+// night side the glow is dark, as the ground under it (lit as at the viewer, a bright rim stood
+// over a black band of night ground).
+vec3 skyLight(float h, vec3 dir) {
+  float s = dir.z;
   float tR = airRay(h, s, uAirRayleighScaleM), tM = airRay(h, s, uAirHazeScaleM);
+  float sun = uAirSun;
   if (tR < 0.0 || tM < 0.0) {
-    tR = airRay(h, 0.0, uAirRayleighScaleM);
-    tM = airRay(h, 0.0, uAirHazeScaleM);
+    // Into the datum's sphere with no terrain drawn over it (relief below the datum, exaggerated
+    // or not, has its horizon lower): the limb's haze, a ray tangent to the datum (from orbit a
+    // horizontal ray at the viewer's altitude meets no air: a black band stood between the limb's
+    // glow and the ground).
+    tR = airLimb(h, uAirRayleighScaleM);
+    tM = airLimb(h, uAirHazeScaleM);
+  }
+  if (s < 0.0) {
+    vec3 lowest = vec3(0.0, 0.0, uAirRadius + h) - (uAirRadius + h) * s * dir;  // from the centre
+    sun = airSunAt(normalize(lowest), uAirSunDir);
   }
   vec3 t;
-  return airLight(tR, tM, uAirSun, t);
+  return airLight(tR, tM, sun, t);
 }

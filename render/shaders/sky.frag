@@ -12,6 +12,6 @@ layout(location = 1) out float oElevation;
 void main() {
   vec4 p = uInvViewProj * vec4(vNdc, 0.5, 1.0);
   vec3 dir = normalize(p.xyz / p.w);
-  oColour = vec4(skyLight(uSkyAltM, dir.z), 1.0);
+  oColour = vec4(skyLight(uSkyAltM, dir), 1.0);
   oElevation = uintBitsToFloat(0x7fc00000u);  // no terrain: NaN, as the target's clear value
 }

@@ -189,9 +189,12 @@ void main() {
   }
   if (uHasAir != 0) {
     // Aerial perspective: the air between the viewer and the point dims it and adds the light it
-    // scatters (atmosphere.glsl), from the viewer's altitude to the point's.
+    // scatters (atmosphere.glsl), from the viewer's altitude to the point's. The air's density
+    // follows the point's true altitude: exaggerated relief is a drawing of the ground, not of
+    // the air (x10 put Mars's polar troughs 50 km below the datum, in air 7 times denser than
+    // at the datum: the cap washed out and the limb went black).
     float len = length(fs.rel);
-    float z1 = uPlanetary == 0 ? uCamZ + fs.rel.z : elev * uExaggeration;
+    float z1 = elev;
     vec3 transmittance;
     vec3 air = airLight(airColumn(uCamZ, z1, len, uAirRayleighScaleM), airColumn(uCamZ, z1, len, uAirHazeScaleM),
                         airSunAt(up, uSunDir), transmittance);

@@ -88,6 +88,7 @@ void setAirUniforms(const gl::Program& p, const TerrainScene& scene, const Shadi
   p.set("uAirHazeColour", a.hazeColour);
   p.set("uAirBrightness", a.brightness);
   p.set("uAirRadius", float(scene.radiusM()));
+  p.set("uAirSunDir", sun);
   // Sunlight on the air at the viewer, as atmosphere.glsl's airSunAt.
   const float s = std::clamp((sun.z + 0.1f) / 0.24f, 0.0f, 1.0f);
   p.set("uAirSun", s * s * (3 - 2 * s));

@@ -403,6 +403,71 @@ INSTANTIATE_TEST_SUITE_P(
 // the 1737.4 km sphere; relabelled in lon/lat on the fly by gis::readDemLonLat): the near side
 // from 4,000 km as in the golden view above. The CLI has its own sun and shading, so the check is
 // the globe's shape: a disc centred in the image covering 0.3 .. pi/4 of it, black corners.
+// Issue 33: Mars's air over its north polar cap, relief x10, from 1,500 km (`strata render` as a
+// user runs it). It drew a black band along the limb (rays into the datum's sphere with no
+// terrain over them, relief being below the datum, took the sky of a horizontal ray at the
+// viewer's 1,500 km: no air) and washed the troughs out (the air's density followed the
+// exaggerated altitude, 50 km below the datum). Now no column has a dark run between the limb's
+// glow and the ground, and the cap keeps at least half the local contrast of `--sky flat`
+// (measured 0.60: 0.753 against 1.254; 0.13 before).
+TEST_F(GlTest, MarsAirKeepsTheLimbLitAndExaggeratedReliefVisible) {
+  const auto dir = test::outputDir("render");
+  Image8 images[2];
+  for (int k = 0; k < 2; ++k) {
+    const auto out = dir / (k == 0 ? "mars_cap_air.png" : "mars_cap_flat.png");
+    std::filesystem::remove(out);
+    std::vector<std::string> args{STRATA_CLI,    "render",    test::dataPath("mars/mola_megdr_4ppd.vrt"),
+                                  "--planetary", "--lon",     "0",
+                                  "--lat",       "70",        "--height",
+                                  "1500000",     "--pitch",   "-50",
+                                  "--heading",   "0",         "--exaggeration",
+                                  "10",          "--size",    "320x200",
+                                  "-o",          out.string()};
+    if (k == 1) args.insert(args.end(), {"--sky", "flat"});
+    const auto run = runProcess(args);
+    ASSERT_TRUE(run) << run.message();
+    auto img = render::readImage8(out.string());
+    ASSERT_TRUE(img) << img.message();
+    images[k] = std::move(*img);
+  }
+  auto lum = [](const Image8& img, int x, int y) {
+    const auto* p = &img.pixels[(size_t(y) * size_t(img.width) + size_t(x)) * size_t(img.channels)];
+    return 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+  };
+  // The limb: down each column, once the glow is reached (over 40), nothing darker than 20.
+  const Image8& air = images[0];
+  int dark = 0, columns = 0;
+  for (int x = 0; x < air.width; ++x) {
+    int y = 0;
+    while (y < air.height && lum(air, x, y) <= 40) ++y;
+    if (y == air.height) continue;
+    ++columns;
+    for (; y < air.height; ++y) dark += lum(air, x, y) < 20 ? 1 : 0;
+  }
+  EXPECT_GT(columns, air.width / 2);
+  EXPECT_EQ(dark, 0) << "dark pixels below the limb's glow";
+  // Local contrast over the cap: the standard deviation of the luminance less its 5 x 5 mean.
+  auto localContrast = [&](const Image8& img) {
+    double sum = 0, sum2 = 0;
+    int n = 0;
+    for (int y = 130; y < 195; ++y) {
+      for (int x = 80; x < 240; ++x) {
+        double box = 0;
+        for (int dy = -2; dy <= 2; ++dy) {
+          for (int dx = -2; dx <= 2; ++dx) box += lum(img, x + dx, std::min(y + dy, img.height - 1));
+        }
+        const double d = lum(img, x, y) - box / 25;
+        sum += d, sum2 += d * d, ++n;
+      }
+    }
+    return std::sqrt(std::max(0.0, sum2 / n - (sum / n) * (sum / n)));
+  };
+  const double withAir = localContrast(images[0]), flat = localContrast(images[1]);
+  std::ofstream(dir / "mars_cap_contrast.txt") << "air " << withAir << "\nflat " << flat << "\n";
+  EXPECT_GT(flat, 0.5);
+  EXPECT_GE(withAir, 0.5 * flat);
+}
+
 TEST_F(GlTest, CliRendersTheMoonsProjectedDemInPlanetaryMode) {
   const auto out = test::outputDir("render") / "cli_moon_planetary.png";
   std::filesystem::remove(out);
