@@ -197,6 +197,27 @@ Diff compare(const OffscreenTarget& a, const OffscreenTarget& b, int threshold) 
   return d;
 }
 
+// The whole-DEM and the streamed scene drawn from the canyon camera (64 circles, 256 x 160, fog,
+// the whole scene's tint range) and compared with a colour threshold of 8; the streamed picture
+// into `picture` when given. 64 circles: the ring wants, at distance r, texels about as large as
+// its tangential spacing 2 pi r / 6i, which a window of N texels holds out to where that is its
+// level: N >= 2n (docs/render-rings.md, "Streaming"). With 128 circles: 3.1 m mean, 33 m 99th
+// percentile.
+constexpr int kMatchW = 256, kMatchH = 160;
+Result<Diff> drawBothAndCompare(const TerrainScene& whole, const TerrainScene& streamed,
+                                std::vector<uint8_t>* picture = nullptr) {
+  STRATA_TRY(auto ring, RingRenderer::create({.circles = 64}));
+  STRATA_TRY(auto t1, OffscreenTarget::create(kMatchW, kMatchH));
+  STRATA_TRY(auto t2, OffscreenTarget::create(kMatchW, kMatchH));
+  Shading shading;
+  shading.fogM = 150000;
+  shading.tintRangeM = glm::vec2(whole.minElevationM(), whole.maxElevationM());
+  STRATA_TRY_STATUS(ring->draw(whole, kCanyonCamera, shading, t1));
+  STRATA_TRY_STATUS(ring->draw(streamed, kCanyonCamera, shading, t2));
+  if (picture) *picture = t2.colour();
+  return compare(t1, t2, 8);
+}
+
 TEST_F(GlTest, StreamedWithTheWholeTerrainResidentIsTheWholeDemRender) {
   // clipSize 512 >= the grid: level 0 is the coarse level, the stack is empty, and the streamed
   // path samples the same texture as the whole-DEM path: the images must be identical.
@@ -229,21 +250,11 @@ TEST_F(GlTest, StreamedRenderMatchesTheWholeDemRender) {
   auto streamed = TerrainScene::createStreamed(openStore(), params);
   ASSERT_TRUE(streamed) << streamed.message();
   ASSERT_EQ(streamed->streamed()->coarseLevel(), 2);
-  // 64 circles: the ring wants, at distance r, texels about as large as its tangential spacing
-  // 2 pi r / 6i, which a window of N texels holds out to where that is its level: N >= 2n
-  // (docs/render-rings.md, "Streaming"). With 128 circles: 3.1 m mean, 33 m 99th percentile.
-  auto ring = RingRenderer::create({.circles = 64});
-  ASSERT_TRUE(ring) << ring.message();
-  const int w = 256, h = 160;
-  auto t1 = OffscreenTarget::create(w, h), t2 = OffscreenTarget::create(w, h);
-  ASSERT_TRUE(t1 && t2);
-  Shading shading;
-  shading.fogM = 150000;
-  shading.tintRangeM = glm::vec2(whole->minElevationM(), whole->maxElevationM());
-  ASSERT_TRUE((*ring)->draw(*whole, kCanyonCamera, shading, *t1));
-  ASSERT_TRUE((*ring)->draw(*streamed, kCanyonCamera, shading, *t2));
+  auto diff = drawBothAndCompare(*whole, *streamed);
+  ASSERT_TRUE(diff) << diff.message();
   EXPECT_EQ(streamed->streamed()->stats().pending, 0);
-  const Diff d = compare(*t1, *t2, 8);
+  const Diff d = *diff;
+  const int w = kMatchW, h = kMatchH;
   std::ofstream(test::outputDir("render") / "streaming_match.txt")
       << "# streamed (N=128, P=32, levels 0-1 streamed, 2 coarse) vs whole-DEM ring render, Grand Canyon store, " << w
       << "x" << h << "\ncolour_fraction_over_8 " << d.colourFraction << "\nmax_channel " << d.maxChannel
@@ -300,22 +311,16 @@ TEST_F(GlTest, StreamedVoidsAreDrawnAsTheWholeDemDrawsThem) {
   auto streamed =
       TerrainScene::createStreamed(std::move(*store), {.clipSize = 128, .pageSize = 32, .uploadPagesPerFrame = 1000});
   ASSERT_TRUE(streamed) << streamed.message();
-  auto ring = RingRenderer::create({.circles = 64});
-  ASSERT_TRUE(ring) << ring.message();
-  const int w = 256, h = 160;
-  auto t1 = OffscreenTarget::create(w, h), t2 = OffscreenTarget::create(w, h);
-  ASSERT_TRUE(t1 && t2);
-  Shading shading;
-  shading.fogM = 150000;
-  shading.tintRangeM = glm::vec2(whole->minElevationM(), whole->maxElevationM());
-  ASSERT_TRUE((*ring)->draw(*whole, kCanyonCamera, shading, *t1));
-  ASSERT_TRUE((*ring)->draw(*streamed, kCanyonCamera, shading, *t2));
-  const Diff d = compare(*t1, *t2, 8);
+  std::vector<uint8_t> picture;
+  auto diff = drawBothAndCompare(*whole, *streamed, &picture);
+  ASSERT_TRUE(diff) << diff.message();
+  const Diff d = *diff;
+  const int w = kMatchW, h = kMatchH;
   std::ofstream(test::outputDir("render") / "streaming_voids.txt")
       << "# streamed vs whole-DEM ring render of the canyon with three 6 x 6-cell voids, " << w << "x" << h
       << "\ncolour_fraction_over_8 " << d.colourFraction << "\nelev_mean_m " << d.elevMeanM << "\nelev_p99_m "
       << d.elevP99M << "\nelev_max_m " << d.elevMaxM << "\n";
-  ASSERT_TRUE(render::writeImage8((test::outputDir("render") / "streaming_voids.png").string(), w, h, 4, t2->colour()));
+  ASSERT_TRUE(render::writeImage8((test::outputDir("render") / "streaming_voids.png").string(), w, h, 4, picture));
   // Measured on llvmpipe: 1.1 % of pixels off by more than 8, elevation mean 1.3 m, 99th
   // percentile 36 m (the coarse level's fill against GDAL's fill of the full-resolution grid,
   // over the voids); drawn with the lowest elevation before: 5.0 %, 13.5 m and 362 m, a pit
