@@ -49,8 +49,6 @@ std::string userText(const std::string& text, bool cell = false) {
   return out;
 }
 
-std::string millions(double m3) { return fmt("%.1f", m3 / 1e6) + " million m³"; }
-
 std::string hours(double s) { return fmt("%.2f h", s / 3600.0); }
 
 // "36.0586 N, 112.0030 W" for a cell centre.
@@ -217,13 +215,13 @@ Status writeReport(const fs::path& runDir, const ReportInput& in) {
     md += "| breached | " + std::to_string(d.breach.paths) +
           " inflow path(s) to an open edge given the closest profile that never climbs ([terrain] breach_inflows): " +
           std::to_string(d.breach.cells) + " cells changed, cut by up to " + fmt("%.0f", d.breach.maxCutM) +
-          " m and filled by up to " + fmt("%.0f", d.breach.maxFillM) + " m (" + millions(d.breach.cutM3) + " cut, " +
-          millions(d.breach.fillM3) + " filled) |\n";
+          " m and filled by up to " + fmt("%.0f", d.breach.maxFillM) + " m (" + volumeText(d.breach.cutM3) + " cut, " +
+          volumeText(d.breach.fillM3) + " filled) |\n";
   }
   if (s.terrain.fillDepressions) {
     md += "| depressions filled | " + std::to_string(d.filled.cells) +
           " cells that drained to no open edge raised to their spill level ([terrain] fill_depressions), by up to " +
-          fmt("%.0f", d.filled.maxM) + " m, " + millions(d.filled.volumeM3) + " in all |\n";
+          fmt("%.0f", d.filled.maxM) + " m, " + volumeText(d.filled.volumeM3) + " in all |\n";
   }
   for (size_t l = 0; l < s.terrain.layers.size() && l < d.layerCellsTooSteep.size(); ++l) {
     if (!s.terrain.layers[l].atRest) continue;
@@ -245,7 +243,7 @@ Status writeReport(const fs::path& runDir, const ReportInput& in) {
     const double peak = f.hydrograph.maxOver(0, s.durationS);
     const auto& c = d.sources[i].cells.front();
     md += "| inflow \"" + userText(f.name, true) + "\" | at " + where(g, c.first, c.second) + ", peak " +
-          fmt("%.0f", peak) + " m³/s, " + millions(f.hydrograph.integral(0, s.durationS)) + " in the run |\n";
+          fmt("%.0f", peak) + " m³/s, " + volumeText(f.hydrograph.integral(0, s.durationS)) + " in the run |\n";
   }
   if (const auto& u = in.summary.spinUp; u.seconds > 0) {
     const std::string tolerance = fmt("%g", 100 * u.toleranceRel) + "% of the base flow";
@@ -260,14 +258,14 @@ Status writeReport(const fs::path& runDir, const ReportInput& in) {
                 ": lengthen time.spin_up)";
     }
     md += "| base flow | " + fmt("%.0f", u.baseFlowM3S) + " m³/s (the inflows at t = 0), " + length + ", " +
-          std::to_string(u.steps) + " steps: at t = 0 the region held " + millions(u.storedM3) + "; over the last " +
+          std::to_string(u.steps) + " steps: at t = 0 the region held " + volumeText(u.storedM3) + "; over the last " +
           formatDuration(u.windowS) + " of it " + fmt("%.0f", u.outflowM3S) +
           " m³/s left it and the stored water changed by " + fmt("%+.0f", u.storageRateM3S) +
           " m³/s. Every result below is of the run from t = 0: the river's water at t = 0 is the initial water, and "
           "cells wet at t = 0 count as flooded from the start |\n";
   }
   if (s.water.rain) md += "| rain | " + fmt("%.1f", s.water.rain->rateMPerS * 3.6e6) + " mm/h |\n";
-  if (d.damBreakVolumeM3 > 0) md += "| dam break | " + millions(d.damBreakVolumeM3) + " released at t = 0 |\n";
+  if (d.damBreakVolumeM3 > 0) md += "| dam break | " + volumeText(d.damBreakVolumeM3) + " released at t = 0 |\n";
   md += "| duration | " + formatDuration(s.durationS) + ", outputs every " + formatDuration(s.outputIntervalS) + " |\n";
   md += "| wet threshold | " + fmt("%.2f", s.outputs.wetThresholdM) + " m |\n\n";
 
@@ -285,13 +283,13 @@ Status writeReport(const fs::path& runDir, const ReportInput& in) {
     const auto& f = in.flood;
     const double supplied = last.inflowM3 + last.rainM3 + d.damBreakVolumeM3 + sum.spinUp.storedM3;
     md += "| quantity | value |\n|---|---|\n";
-    md +=
-        "| water that entered | " + millions(last.inflowM3 + last.rainM3) + " (inflow " + millions(last.inflowM3) +
-        ", rain " + millions(last.rainM3) + ")" +
-        (d.damBreakVolumeM3 > 0 ? " + dam " + millions(d.damBreakVolumeM3) : "") +
-        (sum.spinUp.seconds > 0 ? ", after the " + millions(sum.spinUp.storedM3) + " of the base flow at t = 0" : "") +
-        " |\n";
-    md += "| most water in the region | " + millions(peakW.waterM3) + " at " + hours(peakW.timeS) + " |\n";
+    md += "| water that entered | " + volumeText(last.inflowM3 + last.rainM3) + " (inflow " +
+          volumeText(last.inflowM3) + ", rain " + volumeText(last.rainM3) + ")" +
+          (d.damBreakVolumeM3 > 0 ? " + dam " + volumeText(d.damBreakVolumeM3) : "") +
+          (sum.spinUp.seconds > 0 ? ", after the " + volumeText(sum.spinUp.storedM3) + " of the base flow at t = 0"
+                                  : "") +
+          " |\n";
+    md += "| most water in the region | " + volumeText(peakW.waterM3) + " at " + hours(peakW.timeS) + " |\n";
     md += "| largest flooded area | " + fmt("%.1f", peakA.floodedAreaKm2) + " km² at " + hours(peakA.timeS) + " (" +
           fmt("%.1f", 100 * peakA.floodedAreaKm2 * 1e6 / d.totalAreaM2) + "% of the region) |\n";
     md += "| area flooded at some time | " + fmt("%.1f", f.everWetM2 / 1e6) + " km² |\n";
@@ -303,12 +301,12 @@ Status writeReport(const fs::path& runDir, const ReportInput& in) {
             d.sourceNames.front() + "\", at " + where(g, f.farthest.x, f.farthest.y) +
             (f.farthestArrivalS >= 0 ? ", reached at " + hours(f.farthestArrivalS) : "") + " |\n";
     }
-    md += "| water that left through the edges | " + millions(last.outflowM3) +
+    md += "| water that left through the edges | " + volumeText(last.outflowM3) +
           (supplied > 0 ? " (" + fmt("%.0f", 100 * last.outflowM3 / supplied) + "% of what entered" +
                               (sum.spinUp.seconds > 0 ? " or was there at t = 0)" : ")")
                         : "") +
           " |\n";
-    md += "| water in the region at the end | " + millions(last.waterM3) + ", " + fmt("%.1f", last.floodedAreaKm2) +
+    md += "| water in the region at the end | " + volumeText(last.waterM3) + ", " + fmt("%.1f", last.floodedAreaKm2) +
           " km² flooded |\n";
     md += "| volume balance error at the end | " + fmt("%.2e", last.balanceErrorRel) +
           " (in − out − stored, relative to what entered) |\n";
@@ -343,6 +341,13 @@ Status writeReport(const fs::path& runDir, const ReportInput& in) {
   md += "\n## Files\n\n";
   for (const auto& f : sum.files) md += "- `" + f + "`\n";
   return writeFileAtomic(runDir / "report.md", md);
+}
+
+std::string volumeText(double m3) {
+  const double a = std::abs(m3);
+  if (a < 1e4) return fmt("%.0f", m3) + " m³";
+  if (a < 1e6) return fmt("%.1f", m3 / 1e3) + " thousand m³";
+  return fmt("%.1f", m3 / 1e6) + " million m³";
 }
 
 }  // namespace strata::scenario

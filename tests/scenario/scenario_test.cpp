@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <strata/scenario/report.hpp>
 #include <strata/scenario/scenario.hpp>
 
 namespace strata::scenario {
@@ -143,6 +144,15 @@ INSTANTIATE_TEST_SUITE_P(
         // Issue 33: a name that is not a string is refused, not read as "".
         BadCase{"a number for a name", "name = \"Colorado River\"", "name = 5",
                 "/data/runs/gc.toml:14: key 'water.inflow[0].name': expected a string"}));
+
+// Issue 31: report volumes in the unit that fits.
+TEST(Report, VolumesAreWrittenInTheUnitThatFits) {
+  EXPECT_EQ(volumeText(740.4), "740 m³");
+  EXPECT_EQ(volumeText(9999), "9999 m³");
+  EXPECT_EQ(volumeText(69300), "69.3 thousand m³");
+  EXPECT_EQ(volumeText(4.24e6), "4.2 million m³");
+  EXPECT_EQ(volumeText(-2.5e4), "-25.0 thousand m³");
+}
 
 // Issue 33: a UTF-8 byte-order mark (some editors write one) is skipped, not refused.
 TEST(Scenario, AByteOrderMarkIsSkipped) {

@@ -46,4 +46,9 @@ Result<std::vector<std::string>> writePlots(const std::filesystem::path& runDir,
 /// report.md.
 Status writeReport(const std::filesystem::path& runDir, const ReportInput& input);
 
+/// A volume as the report writes it, in the unit that fits: "740 m³" under ten thousand, "69.3
+/// thousand m³" under a million, "4.2 million m³" above (a 2 km² run's volumes read "0.0 million
+/// m³" when all were in millions).
+std::string volumeText(double m3);
+
 }  // namespace strata::scenario
