@@ -411,6 +411,8 @@ Status createGeoTiff(const std::string& path, const Georef& g, const WriteOption
   ds->SetSpatialRef(&*srs);
   ds->GetRasterBand(1)->SetNoDataValue(options.nodata);
   for (const auto& [name, value] : options.metadata) ds->SetMetadataItem(name.c_str(), value.c_str());
+  if (!options.description.empty()) ds->GetRasterBand(1)->SetDescription(options.description.c_str());
+  if (!options.units.empty()) ds->GetRasterBand(1)->SetUnitType(options.units.c_str());
   ds.reset();  // flush and close
   if (CPLGetLastErrorType() >= CE_Failure) {
     VSIUnlink(path.c_str());
@@ -462,6 +464,8 @@ Status writeGeoTiff(const std::string& path, const Raster& raster, const WriteOp
   if (!mem) return fail(path + ": cannot write: " + mem.message());
   (*mem)->GetRasterBand(1)->SetNoDataValue(options.nodata);
   for (const auto& [name, value] : options.metadata) (*mem)->SetMetadataItem(name.c_str(), value.c_str());
+  if (!options.description.empty()) (*mem)->GetRasterBand(1)->SetDescription(options.description.c_str());
+  if (!options.units.empty()) (*mem)->GetRasterBand(1)->SetUnitType(options.units.c_str());
 
   GdalErrorCapture errors;
   GDALDriver* driver = GetGDALDriverManager()->GetDriverByName(options.cog ? "COG" : "GTiff");

@@ -270,7 +270,8 @@ Status writeRows(const Ranks& ranks, const fs::path& runDir, const RowsBuilt& bu
   const auto& d = built.rows;
   STRATA_TRY_STATUS(writeModelInput(ranks, runDir, shape.bed.georef, d, int(shape.input.materials.size()),
                                     shape.input.waterDepthM.size() > 0, shape.input.rainMmPerHour.size() > 0));
-  return writeRaster(ranks, runDir / "maps" / "elevation.tif", shape.bed.georef, {}, {{0, d.firstRow, d.bed.values}});
+  return writeRaster(ranks, runDir / "maps" / "elevation.tif", shape.bed.georef, elevationMapOptions(),
+                     {{0, d.firstRow, d.bed.values}});
 }
 sim::RegionSource modelInputSource(const fs::path& runDir, const ScenarioDomain& shape) {
   sim::RegionSource region;

@@ -37,6 +37,13 @@ Result<std::vector<Piece>> readPieces(const sim::Solver& solver, const InputWind
   return pieces;
 }
 
+gis::WriteOptions elevationMapOptions() {
+  gis::WriteOptions o;
+  o.description = "bed elevation the model used (conditioned)";
+  o.units = "m";
+  return o;
+}
+
 Status writeRaster(const Ranks& ranks, const fs::path& file, const gis::Georef& georef,
                    const gis::WriteOptions& options, const std::vector<gis::GridWindow>& windows) {
   const std::string tmp = ranks.fromLead(ranks.lead() ? temporaryPathFor(file).string() : std::string());

@@ -40,6 +40,9 @@ using InputWindow = std::function<Result<sim::SimInput>(const gis::CellRect&)>;
 /// is kWallElevationM in the model input.
 Result<std::vector<Piece>> readPieces(const sim::Solver& solver, const InputWindow& input, bool erosion);
 
+/// How maps/elevation.tif is written: the bed the model used (conditioned), in metres.
+gis::WriteOptions elevationMapOptions();
+
 /// Collective: writes the GeoTIFF `file` (`georef` and `options` used by the lead only) from every
 /// rank's `windows` (cells of the grid). The lead creates a temporary beside `file`, the ranks
 /// write their windows into it in turn (rank order: GDAL has one writer at a time), and the lead

@@ -507,13 +507,19 @@ class Run {
   Status writeMaps(const std::vector<detail::Piece>& pieces) {
     const auto& maps = s_.outputs.maps;
     const bool layerMaps = std::find(maps.begin(), maps.end(), "layer_thickness") != maps.end();
-    // `values` of a piece, no data outside the region and, `wetOnly`, where it never was wet.
-    auto writeMap = [&](const std::string& file, bool asked, bool wetOnly,
+    // `values` of a piece, no data outside the region and, `wetOnly`, where it never was wet; the
+    // band described (gdalinfo and QGIS show it: times are in seconds). GDAL's unit type is set
+    // for lengths only: it is a DEM's vertical unit to GDAL and to gis::readDem, which refuse
+    // "s" and "m/s", and flood maps are read back as drapes; other units are in the description.
+    using Text = std::pair<std::string, std::string>;  // the band's description, its unit
+    auto writeMap = [&](const std::string& file, bool asked, bool wetOnly, const Text& text,
                         const std::function<gis::Grid<float>(const detail::Piece&)>& values,
                         const std::vector<std::pair<std::string, std::string>>& metadata = {}) -> Status {
       if (!asked) return {};
       gis::WriteOptions o;
       o.metadata = metadata;
+      o.description = text.first;
+      o.units = text.second;
       return detail::writeMapFile(ranks_, opt_.outDir / file, d_.bed.georef, o, pieces, [&](const detail::Piece& p) {
         gis::Grid<float> g = values(p);
         for (size_t i = 0; i < g.size(); ++i) {
@@ -524,26 +530,33 @@ class Run {
         return g;
       });
     };
-    auto map = [&](const std::string& name, bool wetOnly,
+    auto map = [&](const std::string& name, bool wetOnly, const Text& text,
                    const std::function<gis::Grid<float>(const detail::Piece&)>& values,
                    const std::vector<std::pair<std::string, std::string>>& metadata = {}) {
-      return writeMap("maps/" + name + ".tif", std::find(maps.begin(), maps.end(), name) != maps.end(), wetOnly, values,
-                      metadata);
+      return writeMap("maps/" + name + ".tif", std::find(maps.begin(), maps.end(), name) != maps.end(), wetOnly, text,
+                      values, metadata);
     };
-    STRATA_TRY_STATUS(map("max_depth", false, [](const detail::Piece& p) { return p.flood.maxDepthM; }));
-    STRATA_TRY_STATUS(map("max_speed", false, [](const detail::Piece& p) { return p.flood.maxSpeedMS; }));
-    STRATA_TRY_STATUS(map("arrival_time", true, [](const detail::Piece& p) { return p.flood.arrivalS; }));
-    STRATA_TRY_STATUS(map("inundation_duration", false, [](const detail::Piece& p) { return p.flood.wetDurationS; }));
-    STRATA_TRY_STATUS(map("final_depth", false, [](const detail::Piece& p) { return p.depth; }));
+    STRATA_TRY_STATUS(map("max_depth", false, {"largest water depth", "m"},
+                          [](const detail::Piece& p) { return p.flood.maxDepthM; }));
+    STRATA_TRY_STATUS(map("max_speed", false, {"largest flow speed (m/s)", ""},
+                          [](const detail::Piece& p) { return p.flood.maxSpeedMS; }));
+    STRATA_TRY_STATUS(map("arrival_time", true,
+                          {"time the water first passed the wet threshold, from the start (s)", ""},
+                          [](const detail::Piece& p) { return p.flood.arrivalS; }));
+    STRATA_TRY_STATUS(map("inundation_duration", false, {"time spent deeper than the wet threshold (s)", ""},
+                          [](const detail::Piece& p) { return p.flood.wetDurationS; }));
+    STRATA_TRY_STATUS(
+        map("final_depth", false, {"water depth at the end", "m"}, [](const detail::Piece& p) { return p.depth; }));
     if (!s_.erosion.enabled) return {};
     // terrain_change (net cut and fill, m), exposed_material (exposedLayer: bottom = 0; none: no
     // data), suspended_sediment (m of material in the water) and layer_thickness
     // (maps/layer_K.tif, K = 1 the bottom layer, each naming its material).
-    STRATA_TRY_STATUS(map("terrain_change", false, [](const detail::Piece& p) {
-      gis::Grid<float> g(p.rect.width, p.rect.height);
-      for (size_t i = 0; i < g.size(); ++i) g.data[i] = materialChange(p, i);
-      return g;
-    }));
+    STRATA_TRY_STATUS(map("terrain_change", false, {"net change of the surface: cut below 0, fill above", "m"},
+                          [](const detail::Piece& p) {
+                            gis::Grid<float> g(p.rect.width, p.rect.height);
+                            for (size_t i = 0; i < g.size(); ++i) g.data[i] = materialChange(p, i);
+                            return g;
+                          }));
     const int L = int(d_.input.materials.size());
     // Each value's material and colour (STRATA_MATERIAL_k, STRATA_COLOUR_k "r,g,b"): GIS tools
     // list them, and the plot draws its legend from them.
@@ -556,7 +569,7 @@ class Run {
       legend.push_back({"STRATA_COLOUR_" + std::to_string(l), rgb});
     }
     STRATA_TRY_STATUS(map(
-        "exposed_material", false,
+        "exposed_material", false, {"topmost layer holding material: layer number - 1, bottom 0", ""},
         [L](const detail::Piece& p) {
           gis::Grid<float> top(p.rect.width, p.rect.height, gis::kNoData);
           for (size_t i = 0; i < top.size(); ++i) {
@@ -566,13 +579,17 @@ class Run {
           return top;
         },
         legend));
-    STRATA_TRY_STATUS(map("suspended_sediment", false, [](const detail::Piece& p) { return p.suspended; }));
+    STRATA_TRY_STATUS(map("suspended_sediment", false, {"material carried by the water, as a thickness", "m"},
+                          [](const detail::Piece& p) { return p.suspended; }));
     for (int l = 0; l < std::min(L, kMaxLayerMaps); ++l) {
-      STRATA_TRY_STATUS(writeMap(layerMapFile(l + 1), layerMaps, false,
-                                 [l](const detail::Piece& p) { return p.layers[size_t(l)]; },
-                                 {{"STRATA_LAYER", std::to_string(l + 1)},
-                                  {"STRATA_MATERIAL", d_.input.materials[size_t(l)].name},
-                                  {"STRATA_UNITS", "m"}}));
+      STRATA_TRY_STATUS(writeMap(
+          layerMapFile(l + 1), layerMaps, false,
+          {"thickness of layer " + std::to_string(l + 1) + " (" + d_.input.materials[size_t(l)].name + ") at the end",
+           "m"},
+          [l](const detail::Piece& p) { return p.layers[size_t(l)]; },
+          {{"STRATA_LAYER", std::to_string(l + 1)},
+           {"STRATA_MATERIAL", d_.input.materials[size_t(l)].name},
+           {"STRATA_UNITS", "m"}}));
     }
     return {};
   }
@@ -808,8 +825,8 @@ class Session {
       STRATA_TRY_STATUS(detail::writeRows(ranks_, opt_.outDir, *rows));
       domain_ = std::move(rows->shape);  // this rank's rows: read back from input/ by its blocks
     } else {
-      STRATA_TRY_STATUS(detail::writeRaster(ranks_, opt_.outDir / "maps" / "elevation.tif", domain_.bed.georef, {},
-                                            {{0, 0, domain_.bed.values}}));
+      STRATA_TRY_STATUS(detail::writeRaster(ranks_, opt_.outDir / "maps" / "elevation.tif", domain_.bed.georef,
+                                            detail::elevationMapOptions(), {{0, 0, domain_.bed.values}}));
     }
     if (ranks_.lead()) {
       const auto& g = domain_.bed.georef;

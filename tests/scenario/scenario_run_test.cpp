@@ -56,6 +56,27 @@ TEST(ScenarioRun, FloodRunsOnTheCpuWithoutGl) {
     EXPECT_TRUE(std::filesystem::exists(opt.outDir / f)) << f;
   }
   EXPECT_NE(slurp(opt.outDir / "report.md").find("on CPU"), std::string::npos);
+  // Issue 31: each map's band says what it is and in which unit (gdalinfo shows both; the times
+  // are in seconds while the report writes hours). GDAL's unit type only for lengths (a DEM's
+  // vertical unit to GDAL and readDem: the maps stay readable as DEMs and drapes).
+  const struct {
+    const char* file;
+    const char* description;
+    const char* units;
+  } bands[] = {{"maps/max_depth.tif", "largest water depth", "m"},
+               {"maps/max_speed.tif", "largest flow speed (m/s)", ""},
+               {"maps/arrival_time.tif", "time the water first passed the wet threshold, from the start (s)", ""},
+               {"maps/inundation_duration.tif", "time spent deeper than the wet threshold (s)", ""},
+               {"maps/final_depth.tif", "water depth at the end", "m"},
+               {"maps/elevation.tif", "bed elevation the model used (conditioned)", "m"}};
+  for (const auto& b : bands) {
+    GDALDatasetH ds = GDALOpen((opt.outDir / b.file).string().c_str(), GA_ReadOnly);
+    ASSERT_NE(ds, nullptr) << b.file;
+    GDALRasterBandH band = GDALGetRasterBand(ds, 1);
+    EXPECT_STREQ(GDALGetDescription(band), b.description) << b.file;
+    EXPECT_STREQ(GDALGetRasterUnitType(band), b.units) << b.file;
+    GDALClose(ds);
+  }
 }
 
 // Issue 30: the pipe model does not converge (no friction); its report says that its depths are

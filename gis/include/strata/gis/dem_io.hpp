@@ -115,6 +115,9 @@ struct WriteOptions {
   bool overwrite = true;     ///< false: an existing `path` is an error (checked atomically at the rename)
   /// GDAL metadata items (name, value) written into the file (gdalinfo lists them).
   std::vector<std::pair<std::string, std::string>> metadata;
+  /// The band's description and unit (GDAL's band description and unit type: gdalinfo shows
+  /// them, QGIS lists the description as the band's name); empty: none.
+  std::string description, units;
 };
 
 /// Writes float32, DEFLATE-compressed, tiled GeoTIFF with CRS, geotransform and nodata; writes a
