@@ -895,16 +895,16 @@ class Session {
     }
     std::optional<Checkpoint> current, previous;
     Status status;
-    if (fs::exists(checkpointPath())) {
-      auto decoded = decodeCheckpoint(checkpointPath(), owner());
-      if (decoded) current = std::move(decoded).value();
+    // This rank's part (`previous`: the one before), if it has one; a part that does not decode
+    // (damaged, or of another scenario) fails the resume.
+    auto readPart = [&](bool isPrevious, std::optional<Checkpoint>& into) {
+      if (!status.ok() || !fs::exists(checkpointPath(isPrevious))) return;
+      auto decoded = decodeCheckpoint(checkpointPath(isPrevious), owner());
+      if (decoded) into = std::move(decoded).value();
       status = statusOf(decoded);
-    }
-    if (status.ok() && ranks_.distributed() && fs::exists(checkpointPath(true))) {
-      auto decoded = decodeCheckpoint(checkpointPath(true), owner());
-      if (decoded) previous = std::move(decoded).value();
-      status = statusOf(decoded);
-    }
+    };
+    readPart(false, current);
+    if (ranks_.distributed()) readPart(true, previous);
     if (status.ok() && !current && !previous) {
       status = fail(checkpointPath().string() + ": no checkpoint to resume from" + checkpointHint(opt_.outDir, ranks_));
     }
