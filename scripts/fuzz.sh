@@ -76,7 +76,7 @@ run_manifest() {
 
 build_scenario() {
   clang++ "${common[@]}" -I"$root/scenario/include" -I"$root/sim/include" \
-    "$root"/core/src/{check,log,progress,time_series,toml_screen}.cpp "$root/scenario/src/scenario.cpp" \
+    "$root"/core/src/{check,files,log,progress,time_series,toml_screen}.cpp "$root/scenario/src/scenario.cpp" \
     "$root/tests/scenario/fuzz/parse_scenario_fuzz.cpp" -o "$out/parse_scenario_fuzz"
 }
 
