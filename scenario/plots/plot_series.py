@@ -4,7 +4,9 @@
     plot_series.py RUN/series.csv OUTDIR
 
 Writes water.png (stored volume, cumulative inflow/rain/outflow), area.png (flooded area),
-balance.png (volume balance error) and, when the run moved sediment, sediment.png.
+balance.png (volume balance error) and, when the run moved sediment, sediment.png; with
+gauges.csv or sections.csv beside series.csv, gauges.png (depth and water level at each gauge)
+and sections.png (discharge across each section, and the volume that crossed).
 """
 import csv
 import sys
@@ -84,6 +86,54 @@ def main():
         ax.grid(alpha=0.3)
         ax.legend()
         save(fig, out, "sediment")
+
+    probes(Path(sys.argv[1]).parent, out)
+
+
+def by_name(path, key):
+    """Rows of a long-format CSV grouped by the probe's name, in file order."""
+    groups = {}
+    with open(path, newline="") as f:
+        for r in csv.DictReader(f):
+            groups.setdefault(r[key], []).append(r)
+    return groups
+
+
+def number(text):
+    return float(text) if text != "" else float("nan")
+
+
+def probes(run, out):
+    if (run / "gauges.csv").exists():
+        groups = by_name(run / "gauges.csv", "gauge")
+        fig, (top, bottom) = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
+        for name, rows in groups.items():
+            t = [float(r["time_s"]) / 3600.0 for r in rows]
+            top.plot(t, [number(r["depth_m"]) for r in rows], label=name)
+            bottom.plot(t, [number(r["level_m"]) for r in rows], label=name)
+        top.set_ylabel("depth (m)")
+        top.set_title("Gauges")
+        bottom.set_ylabel("water level (m)")
+        bottom.set_xlabel("time (h)")
+        for ax in (top, bottom):
+            ax.grid(alpha=0.3)
+        top.legend()
+        save(fig, out, "gauges")
+    if (run / "sections.csv").exists():
+        groups = by_name(run / "sections.csv", "section")
+        fig, (top, bottom) = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
+        for name, rows in groups.items():
+            t = [float(r["time_s"]) / 3600.0 for r in rows]
+            top.plot(t, [number(r["discharge_m3_s"]) for r in rows], label=name)
+            bottom.plot(t, [number(r["volume_m3"]) for r in rows], label=name)
+        top.set_ylabel("discharge (m³/s)")
+        top.set_title("Sections (positive from the line's left to its right)")
+        bottom.set_ylabel("volume across (m³)")
+        bottom.set_xlabel("time (h)")
+        for ax in (top, bottom):
+            ax.grid(alpha=0.3)
+        top.legend()
+        save(fig, out, "sections")
 
 
 if __name__ == "__main__":

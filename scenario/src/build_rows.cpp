@@ -330,6 +330,8 @@ Result<ScenarioDomain> buildDomain(const Scenario& s, uint64_t memoryBudgetBytes
   d.sourceNames = std::move(shape.sourceNames);
   d.levels = std::move(shape.levels);
   d.levelNames = std::move(shape.levelNames);
+  d.gauges = std::move(shape.gauges);
+  d.sections = std::move(shape.sections);
   d.rainMmPerHour = shape.rainMmPerHour;
   d.rainStartS = shape.rainStartS;
   d.rainEndS = shape.rainEndS;

@@ -17,7 +17,7 @@
 namespace strata::scenario {
 namespace {
 
-constexpr char kMagic[8] = {'S', 'T', 'R', 'A', 'T', 'A', 'C', '5'};
+constexpr char kMagic[8] = {'S', 'T', 'R', 'A', 'T', 'A', 'C', '6'};
 
 }  // namespace
 
@@ -37,6 +37,7 @@ std::string encodeCheckpoint(const CheckpointOwner& owner, const Checkpoint& c) 
   w.pod(c.wallS);
   w.vec(c.series);
   w.pod(c.spinUp);
+  w.vec(c.probes);
   w.str(sim::encodeState(c.state));
   w.pod(fnv1a(w.out));
   return w.out;
@@ -77,6 +78,7 @@ Result<Checkpoint> decodeCheckpoint(const std::filesystem::path& path, const Che
   r.pod(c.wallS);
   r.vec(c.series);
   r.pod(c.spinUp);
+  r.vec(c.probes);
   std::string state;
   r.str(state);
   if (!r.ok || r.at != body.size() || c.interval < 0 || !(c.wallS >= 0)) {

@@ -26,7 +26,8 @@ struct Checkpoint {
   int interval = 0;  ///< output intervals done
   double wallS = 0;  ///< wall time of the run so far (all its sessions, resumed ones included)
   std::vector<SeriesRow> series;
-  SpinUpSummary spinUp;  ///< for the report of a resumed run
+  SpinUpSummary spinUp;        ///< for the report of a resumed run
+  std::vector<double> probes;  ///< the gauges' and sections' rows and sums so far (detail::Probes::save)
   sim::SolverState state;
 };
 

@@ -8,6 +8,7 @@
 #include <map>
 #include <memory>
 #include <set>
+#include <tuple>
 
 #include <strata/core/memory.hpp>
 #include <strata/core/progress.hpp>
@@ -284,6 +285,44 @@ std::vector<std::pair<int, int>> cellsAlong(const std::vector<std::array<double,
     for (int k = 0; k <= n; ++k) add(pts[i - 1][0] + dx * k / n, pts[i - 1][1] + dy * k / n);
   }
   return cells;
+}
+
+std::vector<ScenarioDomain::SectionFace> facesCrossed(const std::vector<std::array<double, 2>>& pts, int width,
+                                                      int height) {
+  // Each face's centre-to-centre segment lies on a line x = const (a y face) or y = const (an x
+  // face); a polyline segment crosses it where it crosses that line within the face's span. The
+  // half-open test (a <= c) != (b <= c) counts a vertex on the line once. A face crossed twice sums.
+  std::map<std::tuple<bool, int, int>, float> sum;
+  for (size_t i = 1; i < pts.size(); ++i) {
+    const auto a = pts[i - 1], b = pts[i];
+    const double dx = b[0] - a[0], dy = b[1] - a[1];
+    if (!std::isfinite(dx) || !std::isfinite(dy)) continue;
+    // x faces (x, y): the line y + 0.5, between centres x - 0.5 and x + 0.5; positive east, which
+    // is from the left to the right of a line heading north (dy < 0 in pixels, rows go south).
+    const int ya = std::max(0, int(std::floor(std::min(a[1], b[1]) - 0.5)));
+    const int yb = std::min(height - 1, int(std::ceil(std::max(a[1], b[1]))));
+    for (int y = ya; y <= yb; ++y) {
+      const double c = y + 0.5;
+      if ((a[1] <= c) == (b[1] <= c)) continue;
+      const int x = int(std::floor(a[0] + (c - a[1]) * dx / dy + 0.5));
+      if (x >= 1 && x <= width - 1) sum[{true, x, y}] += dy > 0 ? -1.0f : 1.0f;
+    }
+    // y faces (x, y): the line x + 0.5, between centres y - 0.5 and y + 0.5; positive south,
+    // from the left to the right of a line heading east.
+    const int xa = std::max(0, int(std::floor(std::min(a[0], b[0]) - 0.5)));
+    const int xb = std::min(width - 1, int(std::ceil(std::max(a[0], b[0]))));
+    for (int x = xa; x <= xb; ++x) {
+      const double c = x + 0.5;
+      if ((a[0] <= c) == (b[0] <= c)) continue;
+      const int y = int(std::floor(a[1] + (c - a[0]) * dy / dx + 0.5));
+      if (y >= 1 && y <= height - 1) sum[{false, x, y}] += dx > 0 ? 1.0f : -1.0f;
+    }
+  }
+  std::vector<ScenarioDomain::SectionFace> faces;
+  for (const auto& [k, sign] : sum) {
+    if (sign != 0.0f) faces.push_back({std::get<0>(k), std::get<1>(k), std::get<2>(k), sign});
+  }
+  return faces;
 }
 
 bool insidePolygon(const std::vector<std::array<double, 2>>& poly, double x, double y) {
@@ -807,6 +846,31 @@ Status placeLevels(const Scenario& s, const Plan& plan, const RegionCells& regio
   return {};
 }
 
+// Step 10: gauges on their cells, sections on the faces their lines cross (inside the region).
+Status placeProbes(const Scenario& s, const Plan& plan, const RegionCells& region, ScenarioDomain& d) {
+  for (const auto& g : s.outputs.gauges) {
+    STRATA_TRY(auto demPx, plan.mapper.pixels(s, g.place));
+    STRATA_TRY(auto cells, lineCells(s, g.place, plan.frame.toRegion(demPx), region, "the gauge \"" + g.name + "\""));
+    d.gauges.push_back({g.name, cells.front().first, cells.front().second});
+  }
+  for (const auto& sec : s.outputs.sections) {
+    STRATA_TRY(auto demPx, plan.mapper.pixels(s, sec.place));
+    const auto px = plan.frame.toRegion(demPx);
+    STRATA_TRY(auto cells, lineCells(s, sec.place, px, region, "the section \"" + sec.name + "\""));
+    auto faces = facesCrossed(px, region.width, region.height);
+    std::erase_if(faces, [&](const auto& f) {
+      return !region.inside(f.x, f.y) || !region.inside(f.xFace ? f.x - 1 : f.x, f.xFace ? f.y : f.y - 1);
+    });
+    if (faces.empty()) {
+      return placeError(
+          s, sec.place,
+          "the section \"" + sec.name + "\" crosses no face between two cells (make it longer than a cell)");
+    }
+    d.sections.push_back({sec.name, std::move(faces), std::move(cells)});
+  }
+  return {};
+}
+
 // The lowest bed (base and layers) of each of the scenario's levels over the cells of `d`'s rows
 // (1e300 for a level with none there).
 std::vector<double> lowestLevelBeds(const Scenario& s, const ScenarioDomain& shape, const ScenarioDomain& d) {
@@ -1145,6 +1209,7 @@ Result<RowBuilder> RowBuilder::plan(const Scenario& s, uint64_t memoryBudgetByte
       plan.frame.polygonPx.empty() ? std::vector<std::array<double, 2>>{} : plan.frame.toRegion(plan.frame.polygonPx)};
   STRATA_TRY_STATUS(placeInflows(s, plan, region, shape));
   STRATA_TRY_STATUS(placeLevels(s, plan, region, shape));
+  STRATA_TRY_STATUS(placeProbes(s, plan, region, shape));
   STRATA_TRY_STATUS(placeRain(s, plan, shape));
   STRATA_TRY(auto dams, damBreakCells(s, plan, region));
   // One-cell markers (modelInputSource reads them): the rows have a rain raster, initial water.

@@ -30,7 +30,48 @@ std::string fmt(const char* f, double v) {
 // User text (a scenario's name and description, inflow and material names) as report.md shows
 // it: control characters written as visible \uXXXX escapes, so that none reaches a terminal or
 // a viewer raw; in a table cell ('cell'), '|' escaped and line breaks as spaces too.
-std::string userText(const std::string& text, bool cell = false) {
+std::string userText(const std::string& text, bool cell = false);
+std::string fmt(const char* f, double v);
+std::string hours(double s);
+std::string where(const gis::Georef& g, int x, int y);
+
+// The gauges' and sections' peaks and volumes; their rows are in gauges.csv and sections.csv.
+std::string probesSection(const RunSummary& sum, const ScenarioDomain& d, const fs::path& runDir) {
+  std::string md = "## Gauges and sections\n\n";
+  if (!sum.gauges.empty()) {
+    md +=
+        "Gauges (`gauges.csv`: depth, water level, speed and the bearing the water flows toward, every "
+        "`probe_interval`; the peak is taken after every step, as the max_depth map):\n\n";
+    md += "| gauge | where | peak depth | at |\n|---|---|---|---|\n";
+    for (const auto& g : sum.gauges) {
+      md += "| " + userText(g.name, true) + " | " + where(d.bed.georef, g.x, g.y) + " | " + fmt("%.3f", g.peak) +
+            " m | " + (g.peakTimeS >= 0 ? hours(g.peakTimeS) : std::string("never wet")) + " |\n";
+    }
+    md += "\n";
+  }
+  if (!sum.sections.empty()) {
+    md +=
+        "Sections (`sections.csv`: discharge across the line, positive from its left to its right facing from its "
+        "first point to its last, the volume so far and the mean water level along it). The discharge is summed "
+        "after every step from the fluxes the solver applied, so the volume is the water that crossed:\n\n";
+    md +=
+        "| section | faces | peak discharge | at | net volume | left to right | right to left |\n"
+        "|---|---|---|---|---|---|---|\n";
+    for (const auto& c : sum.sections) {
+      md += "| " + userText(c.name, true) + " | " + std::to_string(c.faces) + " | " + fmt("%.3g", c.peak) + " m³/s | " +
+            (c.peakTimeS >= 0 ? hours(c.peakTimeS) : std::string("nothing crossed")) + " | " + volumeText(c.volumeM3) +
+            " | " + volumeText(c.forwardM3) + " | " + volumeText(c.backM3) + " |\n";
+    }
+    md += "\n";
+  }
+  for (const char* p : {"gauges", "sections"}) {
+    if (fs::exists(runDir / "plots" / (std::string(p) + ".png")))
+      md += "![" + std::string(p) + "](plots/" + p + ".png)\n";
+  }
+  return md + "\n";
+}
+
+std::string userText(const std::string& text, bool cell) {
   std::string out;
   for (const char c : text) {
     const auto u = static_cast<unsigned char>(c);
@@ -317,6 +358,7 @@ Status writeReport(const fs::path& runDir, const ReportInput& in) {
     md += "\n";
   }
 
+  if (!sum.gauges.empty() || !sum.sections.empty()) md += probesSection(sum, d, runDir);
   if (s.erosion.enabled) md += erosionModelSection(s, d);
   if (sum.material) md += materialSection(*sum.material);
 

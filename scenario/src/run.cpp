@@ -30,6 +30,7 @@
 #include "checkpoint.hpp"
 #include "domain_rows.hpp"
 #include "pieces.hpp"
+#include "probes.hpp"
 
 namespace strata::scenario {
 namespace fs = std::filesystem;
@@ -59,14 +60,16 @@ constexpr int kMaxLayerMaps = 64;  // layers beyond this get no map (the report 
 // The files a run writes, relative to its folder: what --overwrite may remove and what makes a
 // folder "hold an earlier run".
 std::vector<std::string> runFolderFiles() {
-  std::vector<std::string> files{"scenario.toml", "series.csv", "checkpoint.bin", "report.md", "maps/elevation.tif"};
+  std::vector<std::string> files{"scenario.toml",  "series.csv", "gauges.csv",        "sections.csv",
+                                 "checkpoint.bin", "report.md",  "maps/elevation.tif"};
   for (const auto& m : knownOutputMaps()) {
     if (m == "layer_thickness") continue;  // one file per layer, below
     files.push_back("maps/" + m + ".tif");
     files.push_back("plots/" + m + ".png");
   }
   for (int k = 1; k <= kMaxLayerMaps; ++k) files.push_back(layerMapFile(k));
-  for (const char* p : {"water", "area", "balance", "sediment"}) files.push_back("plots/" + std::string(p) + ".png");
+  for (const char* p : {"water", "area", "balance", "sediment", "gauges", "sections"})
+    files.push_back("plots/" + std::string(p) + ".png");
   for (const char* p : {"before", "peak", "after", "max_depth"}) files.push_back("pictures/" + std::string(p) + ".png");
   for (const auto& f : detail::modelInputFiles(detail::kMaxInputLayers)) files.push_back(f);
   return files;
@@ -335,6 +338,16 @@ class Run {
   Run& operator=(const Run&) = delete;
 
   sim::Solver& solver() { return *e_.solver; }
+  /// The gauges and sections (null when the scenario has none): recording from start(), which a
+  /// fresh run calls at t = 0 (after any spin-up), a resumed one with its checkpoint's record.
+  detail::Probes* probes() { return probes_ ? &*probes_ : nullptr; }
+  Status startProbes(const std::vector<double>* saved) {
+    if (d_.gauges.empty() && d_.sections.empty()) return {};
+    probes_.emplace(d_, solver().grid(), s_.outputs.probeIntervalS);
+    if (saved) return probes_->restore(*saved);
+    probes_->row(solver());
+    return {};
+  }
   /// The solver when it runs over MPI ranks (else null).
   sim::DistributedSolver* distributed() { return e_.distributed; }
 
@@ -386,14 +399,19 @@ class Run {
     auto before = [](double t, double target) { return t < target - 1e-9 * std::max(1.0, std::abs(target)); };
     while (before(sv.timeS(), endS)) {
       double next = endS;
-      for (double edge : {d_.rainStartS, d_.rainEndS}) {
+      for (double edge : {d_.rainStartS, d_.rainEndS, probes_ ? probes_->nextRowS() : endS}) {
         if (before(sv.timeS(), edge) && edge < next) next = edge;
       }
       STRATA_TRY_STATUS(setRain(sv.timeS()));
       while (before(sv.timeS(), next)) {
         chosenDtS_ = sv.nextDt();
         minChosenDtS_ = std::min(minChosenDtS_, chosenDtS_);
-        sv.stepWithDt(std::min(chosenDtS_, next - sv.timeS()));
+        const double dtS = std::min(chosenDtS_, next - sv.timeS());
+        sv.stepWithDt(dtS);
+        if (probes_) {
+          probes_->afterStep(sv, dtS);
+          if (!before(sv.timeS(), probes_->nextRowS())) probes_->row(sv);
+        }
         if (tick) tick();
         if (ranks_.anyInterrupted()) return false;
       }
@@ -705,6 +723,7 @@ class Run {
   ScenarioDomain d_;
   Engine e_;
   detail::InputWindow input_;  // the model input of a window: what the solver started from
+  std::optional<detail::Probes> probes_;
   double chosenDtS_ = 0, minChosenDtS_ = 1e300;
 };
 
@@ -807,6 +826,10 @@ class Session {
   // the DEM or store (build_rows.hpp; the region needs a row per rank), writes them into input/
   // (the model input the run's blocks read) and runs on the domain's shape.
   Status buildDomain() {
+    if (ranks_.distributed() && (!s_.outputs.gauges.empty() || !s_.outputs.sections.empty())) {
+      return fail(s_.at(s_.outputs.gauges.empty() ? "outputs.section" : "outputs.gauge") +
+                  "gauges and sections are not recorded over MPI ranks yet: run this scenario in one process");
+    }
     STRATA_TRY(engine_, startContext(opt_.backend.value_or(s_.model.backend), opt_.pictures, ranks_));
     std::optional<detail::RowsBuilt> rows;
     if (ranks_.distributed()) {
@@ -891,6 +914,7 @@ class Session {
     summary_.backend = run_->backendName();
     summary_.ranks = ranks_.size();
     if (!opt_.resume) {
+      STRATA_TRY_STATUS(run_->startProbes(nullptr));
       return ranks_.agree(ranks_.lead() ? writeFileAtomic(opt_.outDir / "scenario.toml", scenarioText_) : Status{});
     }
     std::optional<Checkpoint> current, previous;
@@ -930,6 +954,7 @@ class Session {
     if (c.interval > intervals_) return fail(checkpointPath().string() + ": more intervals than the scenario has");
     STRATA_TRY_STATUS(run_->solver().restoreState(c.state));
     STRATA_TRY_STATUS(run_->setRain(c.state.counters.timeS));
+    if (auto st = run_->startProbes(&c.probes); !st.ok()) return fail(checkpointPath().string() + ": " + st.message());
     interval_ = c.interval;
     earlierWallS_ = c.wallS;
     spinUp_ = c.spinUp;
@@ -976,6 +1001,13 @@ class Session {
     summary_.wallS = wallSoFar();
     summary_.spinUp = spinUp_;
     summary_.files = {"scenario.toml", "series.csv"};
+    if (const auto* p = run_->probes()) {
+      summary_.gauges = p->gaugeSummaries();
+      summary_.sections = p->sectionSummaries();
+      for (const char* f : {"gauges.csv", "sections.csv"}) {
+        if (fs::exists(opt_.outDir / f)) summary_.files.push_back(f);
+      }
+    }
     if (ranks_.distributed()) {
       for (int r = 0; r < ranks_.size(); ++r) {
         summary_.files.push_back(rankCheckpointFile(r, ranks_.size()));
@@ -1058,6 +1090,11 @@ class Session {
     }
     Status status = run_->writeMaps(*pieces);
     if (status.ok() && ranks_.lead()) status = writeFileAtomic(opt_.outDir / "series.csv", seriesCsv(summary_.series));
+    if (const auto* p = run_->probes(); p && status.ok()) {
+      if (!p->gaugeSummaries().empty()) status = writeFileAtomic(opt_.outDir / "gauges.csv", p->gaugesCsv());
+      if (status.ok() && !p->sectionSummaries().empty())
+        status = writeFileAtomic(opt_.outDir / "sections.csv", p->sectionsCsv());
+    }
     STRATA_TRY_STATUS(ranks_.agree(status));
     // Over MPI ranks the blocks are dealt again by their work before each checkpoint.
     if (auto* d = run_->distributed()) {
@@ -1068,7 +1105,12 @@ class Session {
                                 << moved.seconds << " s";
       }
     }
-    const Checkpoint c{interval_, wallSoFar(), summary_.series, spinUp_, run_->solver().saveState()};
+    const Checkpoint c{interval_,
+                       wallSoFar(),
+                       summary_.series,
+                       spinUp_,
+                       run_->probes() ? run_->probes()->save() : std::vector<double>{},
+                       run_->solver().saveState()};
     return writeCheckpoint(c);
   }
 

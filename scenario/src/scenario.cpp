@@ -745,7 +745,8 @@ Status readOutputs(const Reader& r, const toml::table& root, Scenario& s) {
     s.outputs.maps.insert(s.outputs.maps.end(), erosionOutputMaps().begin(), erosionOutputMaps().end());
   }
   if (!t) return {};
-  STRATA_TRY_STATUS(r.onlyKeys(*t, "outputs", {"maps", "wet_threshold", "pictures", "plots"}));
+  STRATA_TRY_STATUS(
+      r.onlyKeys(*t, "outputs", {"maps", "wet_threshold", "pictures", "plots", "gauge", "section", "probe_interval"}));
   if (const auto* m = t->get("maps")) {
     const auto* arr = m->as_array();
     if (!arr) return r.error(*m, "outputs.maps", "expected a list of map names");
@@ -770,6 +771,40 @@ Status readOutputs(const Reader& r, const toml::table& root, Scenario& s) {
   if (const auto* p = t->get("plots")) {
     STRATA_TRY(s.outputs.plots, r.boolean(*p, "outputs.plots"));
   }
+  if (const auto* p = t->get("probe_interval")) {
+    STRATA_TRY(s.outputs.probeIntervalS, r.quantity(*p, "outputs.probe_interval", "time", kDuration));
+  }
+  // [[outputs.gauge]] (a point) and [[outputs.section]] (a line), each with an optional name.
+  auto probes = [&](const char* table, const char* base, bool single, auto&& add) -> Status {
+    const auto* node = t->get(table);
+    if (!node) return {};
+    const std::string outer = std::string("outputs.") + table;
+    const auto* arr = node->as_array();
+    if (!arr) return r.error(*node, outer, std::string("expected [[") + outer + "]] tables");
+    for (size_t i = 0; i < arr->size(); ++i) {
+      const std::string key = outer + "[" + std::to_string(i) + "]";
+      const auto* it = (*arr)[i].as_table();
+      if (!it) return r.error((*arr)[i], key, "expected a table");
+      const std::string ll = std::string(base) + "_lonlat", xy = std::string(base) + "_xy";
+      STRATA_TRY_STATUS(r.onlyKeys(*it, key, {"name", ll.c_str(), xy.c_str()}));
+      std::string name = std::string(table) + " " + std::to_string(i + 1);
+      if (const auto* n = it->get("name")) {
+        STRATA_TRY(name, r.string(*n, key + ".name"));
+      }
+      STRATA_TRY(auto place, r.placeKey(*it, key, base, single));
+      if (!place) return r.errorAt(int(it->source().begin.line), key, "missing " + ll + " or " + xy);
+      if (!single && place->points.size() < 2)
+        return r.errorAt(place->line, place->key, "a line needs at least 2 points");
+      add(std::move(name), std::move(*place));
+    }
+    return {};
+  };
+  STRATA_TRY_STATUS(probes("gauge", "at", true, [&](std::string n, Place p) {
+    s.outputs.gauges.push_back({std::move(n), std::move(p)});
+  }));
+  STRATA_TRY_STATUS(probes("section", "line", false, [&](std::string n, Place p) {
+    s.outputs.sections.push_back({std::move(n), std::move(p)});
+  }));
   return {};
 }
 
@@ -892,6 +927,10 @@ Result<Scenario> parseScenario(std::string_view text, const std::filesystem::pat
   if (s.spinUpTolerance > 0 && s.water.inflows.empty()) {
     return fail(s.at("time.spin_up_tolerance") +
                 "is a fraction of the base flow (the inflows at t = 0), and [water] has no inflow");
+  }
+  if (!s.outputs.sections.empty() && s.model.kind == sim::WaterModel::kVirtualPipes) {
+    return fail(s.at("outputs.section") +
+                "sections need the flood model's face fluxes; the pipe model has none (set [model] kind = \"flood\")");
   }
   for (const auto& m : erosionOutputMaps()) {
     if (std::find(s.outputs.maps.begin(), s.outputs.maps.end(), m) != s.outputs.maps.end() && !s.erosion.enabled) {

@@ -641,21 +641,46 @@ void CpuSolver::writeBlock(const CellBlock& b) {
   m.allocateFor(m.p);
 }
 
+namespace {
+
+// Flood mode's flux through x face (x, y) or y face (x, y) as the last corrector applied it:
+// scaled by its upwind cell's W25 limit (fvUpdatePass).
+template <class Impl>
+float appliedFaceFlux(const Impl& m, bool xFace, int x, int y) {
+  const float f = xFace ? m.faceX.mass.at(x, y) : m.faceY.mass.at(x, y);
+  const int ux = f > 0.0f ? (xFace ? x - 1 : x) : x, uy = f > 0.0f ? (xFace ? y : y - 1) : y;
+  return ux < 0 || uy < 0 || ux >= m.w || uy >= m.h ? f : f * m.limit.at(ux, uy);
+}
+
+}  // namespace
+
 std::vector<float> CpuSolver::readFaceMassFlux() const {
   const Impl& m = *impl_;
   STRATA_CHECK(params().waterModel == WaterModel::kFiniteVolume) << "face fluxes exist in flood mode only";
-  // The flux the last corrector applied: scaled by its upwind cell's W25 limit (fvUpdatePass).
-  auto limited = [&](float f, int xl, int yl, int xr, int yr) {
-    const int x = f > 0.0f ? xl : xr, y = f > 0.0f ? yl : yr;
-    return x < 0 || y < 0 || x >= m.w || y >= m.h ? f : f * m.limit.at(x, y);
-  };
   std::vector<float> out;
   out.reserve(size_t(m.w + 1) * size_t(m.h) + size_t(m.w) * size_t(m.h + 1));
   for (int y = 0; y < m.h; ++y) {
-    for (int x = 0; x <= m.w; ++x) out.push_back(limited(m.faceX.mass.at(x, y), x - 1, y, x, y));
+    for (int x = 0; x <= m.w; ++x) out.push_back(appliedFaceFlux(m, true, x, y));
   }
   for (int y = 0; y <= m.h; ++y) {
-    for (int x = 0; x < m.w; ++x) out.push_back(limited(m.faceY.mass.at(x, y), x, y - 1, x, y));
+    for (int x = 0; x < m.w; ++x) out.push_back(appliedFaceFlux(m, false, x, y));
+  }
+  return out;
+}
+
+std::vector<float> CpuSolver::readFaceMassFluxAt(const std::vector<size_t>& faces) const {
+  const Impl& m = *impl_;
+  STRATA_CHECK(params().waterModel == WaterModel::kFiniteVolume) << "face fluxes exist in flood mode only";
+  const size_t xFaces = size_t(m.w + 1) * size_t(m.h), all = xFaces + size_t(m.w) * size_t(m.h + 1);
+  std::vector<float> out;
+  out.reserve(faces.size());
+  for (size_t i : faces) {
+    STRATA_CHECK(i < all) << "face " << i << " outside the grid's " << all;
+    if (i < xFaces) {
+      out.push_back(appliedFaceFlux(m, true, int(i % size_t(m.w + 1)), int(i / size_t(m.w + 1))));
+    } else {
+      out.push_back(appliedFaceFlux(m, false, int((i - xFaces) % size_t(m.w)), int((i - xFaces) / size_t(m.w))));
+    }
   }
   return out;
 }

@@ -312,6 +312,17 @@ FloodStats Solver::readFloodStats() const {
 
 std::vector<gis::CellRect> Solver::localRects() const { return {{0, 0, grid_.width, grid_.height}}; }
 
+std::vector<float> Solver::readFaceMassFluxAt(const std::vector<size_t>& faces) const {
+  const std::vector<float> all = readFaceMassFlux();
+  std::vector<float> out;
+  out.reserve(faces.size());
+  for (size_t i : faces) {
+    STRATA_CHECK(i < all.size()) << "face " << i << " outside the grid's " << all.size();
+    out.push_back(all[i]);
+  }
+  return out;
+}
+
 CellBlock Solver::readLocal(const gis::CellRect& rect, unsigned parts) const {
   return readBlock(rect.x, rect.y, rect.width, rect.height, parts);
 }

@@ -107,7 +107,15 @@ void expectSameBits(const CpuSolver& a, const CpuSolver& b, const std::string& w
   EXPECT_EQ(bitDifferences(sa.flood, sb.flood), 0u) << what << ": flood statistics";
   EXPECT_EQ(bitDifferences(a.readBed().data, b.readBed().data), 0u) << what << ": bed";
   if (a.params().waterModel == WaterModel::kFiniteVolume) {
-    EXPECT_EQ(bitDifferences(a.readFaceMassFlux(), b.readFaceMassFlux()), 0u) << what << ": face fluxes";
+    const auto faces = a.readFaceMassFlux();
+    EXPECT_EQ(bitDifferences(faces, b.readFaceMassFlux()), 0u) << what << ": face fluxes";
+    // Some faces read alone (a cross-section's way) are those of the whole vector.
+    std::vector<size_t> some;
+    for (size_t i = 0; i < faces.size(); i += 7) some.push_back(i);
+    some.push_back(faces.size() - 1);
+    std::vector<float> picked;
+    for (size_t i : some) picked.push_back(faces[i]);
+    EXPECT_EQ(bitDifferences(a.readFaceMassFluxAt(some), picked), 0u) << what << ": faces read alone";
   }
   EXPECT_EQ(a.maxWaveSpeedMS(), b.maxWaveSpeedMS()) << what;
   EXPECT_EQ(a.timeS(), b.timeS()) << what;

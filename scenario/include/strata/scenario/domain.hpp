@@ -30,6 +30,27 @@ struct ScenarioDomain {
   std::vector<std::string> sourceNames;
   std::vector<sim::LevelBoundary> levels;  ///< fixed water levels, on cells (stage in m above the DEM's reference)
   std::vector<std::string> levelNames;
+  /// [[outputs.gauge]]: the cell of each gauge.
+  struct GaugeCell {
+    std::string name;
+    int x = 0, y = 0;
+  };
+  std::vector<GaugeCell> gauges;
+  /// [[outputs.section]]: the cell faces its line crosses. A face joins two cells' centres: an x
+  /// face (x, y) the cells (x - 1, y) and (x, y), a y face (x, y) the cells (x, y - 1) and
+  /// (x, y) (sim::Solver::readFaceMassFlux's numbering); `sign` turns the face's flux (positive
+  /// east or south) into the section's (positive from the line's left to its right).
+  struct SectionFace {
+    bool xFace = true;
+    int x = 0, y = 0;
+    float sign = 1;
+  };
+  struct SectionFaces {
+    std::string name;
+    std::vector<SectionFace> faces;
+    std::vector<std::pair<int, int>> cells;  ///< the cells the line passes through (its mean level)
+  };
+  std::vector<SectionFaces> sections;
   double rainMmPerHour = 0;              ///< uniform rain rate while it falls
   double rainStartS = 0, rainEndS = 0;   ///< rain falls in [start, end)
   double damBreakVolumeM3 = 0;           ///< initial water from dam breaks
@@ -82,6 +103,12 @@ sim::SimParams modelParams(const Scenario& scenario);
 /// Cells (x, y) a polyline passes through, each once, in order (sampled at a quarter cell).
 std::vector<std::pair<int, int>> cellsAlong(const std::vector<std::array<double, 2>>& pixelPoints, int width,
                                             int height);
+
+/// The faces between 4-neighbouring cells of a width x height grid (both cells inside it) whose
+/// centre-to-centre segment a polyline of pixel points crosses, each once, with the sign that makes
+/// a flux across it positive from the line's left to its right.
+std::vector<ScenarioDomain::SectionFace> facesCrossed(const std::vector<std::array<double, 2>>& pixelPoints, int width,
+                                                      int height);
 
 /// Whether pixel-space point (x, y) lies inside the polygon (even-odd rule).
 bool insidePolygon(const std::vector<std::array<double, 2>>& polygon, double x, double y);

@@ -95,6 +95,18 @@ struct SpinUpSummary {
 };
 
 /// What happened, for the report and the command's summary line.
+/// One gauge or section over the run (the report's table; the rows are in gauges.csv and
+/// sections.csv).
+struct ProbeSummary {
+  std::string name;
+  int x = 0, y = 0;                  ///< a gauge's cell (column, row of the region)
+  int faces = 0;                     ///< a section's cell faces
+  double peak = 0;                   ///< a gauge's largest depth (m); a section's largest discharge (m^3/s, signed)
+  double peakTimeS = -1;             ///< when (s; -1: never wet / nothing crossed)
+  double volumeM3 = 0;               ///< a section: the net volume across it, left to right
+  double forwardM3 = 0, backM3 = 0;  ///< a section: left to right and right to left (both >= 0)
+};
+
 struct RunSummary {
   bool completed = false;  ///< false: stopped by Ctrl-C or stopAfterIntervals
   std::string backend;     ///< what ran it (Solver::backendName)
@@ -105,6 +117,7 @@ struct RunSummary {
   std::vector<std::string> files;          ///< written, relative to the run folder
   std::optional<MaterialBudget> material;  ///< erosion runs
   SpinUpSummary spinUp;
+  std::vector<ProbeSummary> gauges, sections;  ///< [[outputs.gauge]], [[outputs.section]]
 };
 
 Result<RunSummary> runScenario(const strata::scenario::Scenario& scenario, const RunOptions& options);

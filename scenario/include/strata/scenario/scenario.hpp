@@ -59,6 +59,19 @@ struct Level {
   int stageLine = 0;     ///< line of `stage` in the file, for later messages
 };
 
+/// A gauge: depth, water level, speed and direction at a point, sampled through the run.
+struct Gauge {
+  std::string name;
+  Place place;  ///< one point
+};
+
+/// A cross-section: the discharge across a polyline (signed: positive from its left to its right,
+/// facing from its first point to its last) and the mean water level along it.
+struct Section {
+  std::string name;
+  Place place;  ///< a polyline of at least two points
+};
+
 enum class Boundary { Closed, Open };
 
 /// What runs the simulation: the GL backend on a hardware GPU and the CPU backend otherwise
@@ -159,6 +172,9 @@ struct Scenario {
     double wetThresholdM = 0.05;  ///< depth above which a cell counts as flooded
     bool pictures = true;
     bool plots = true;
+    std::vector<Gauge> gauges;      ///< [[outputs.gauge]]
+    std::vector<Section> sections;  ///< [[outputs.section]]
+    double probeIntervalS = 60;     ///< how often gauges and sections are written (s)
   } outputs;
 };
 

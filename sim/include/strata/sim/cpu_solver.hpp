@@ -41,6 +41,7 @@ class CpuSolver final : public Solver {
   CellBlock readBlock(int x0, int y0, int width, int height, unsigned parts = kBlockHalo) const override;
   void writeBlock(const CellBlock& block) override;
   std::vector<float> readFaceMassFlux() const override;
+  std::vector<float> readFaceMassFluxAt(const std::vector<size_t>& faces) const override;
 
   /// The OpenMP threads the passes run on.
   int threads() const;

@@ -239,6 +239,10 @@ class Solver {
   /// ((width + 1) x height, face x is the west face of cell x), then y faces (width x (height + 1),
   /// face y is the north face of row y).
   virtual std::vector<float> readFaceMassFlux() const = 0;
+  /// The same at some faces only (indices into readFaceMassFlux()'s vector, each inside it): what
+  /// a cross-section sums after every step. By default picked from the whole vector; a backend
+  /// that can read single faces cheaply reads only those.
+  virtual std::vector<float> readFaceMassFluxAt(const std::vector<size_t>& faces) const;
 
  protected:
   /// Sets up the shared bookkeeping from a validated input.

@@ -1,0 +1,201 @@
+// Issue 31: gauges and cross-sections ([[outputs.gauge]], [[outputs.section]]). A dam break in a
+// closed piece of the Grand Canyon with a section across the canyon below the dam: the volume the
+// section reports is the water that ended on its far side (all of it crossed the line), the
+// gauge's peak is the max_depth map's value at its cell, and a run stopped and resumed writes the
+// same rows as one that was not.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include <strata/scenario/domain.hpp>
+#include <strata/scenario/run.hpp>
+
+#include "scenario_fixture.hpp"
+#include "strata_test.hpp"
+
+namespace strata::scenario {
+namespace {
+
+using namespace test_support;
+
+std::string slurp(const std::filesystem::path& p) {
+  std::ifstream f(p);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+// Closed edges, a lake 100 m above the river held behind a dam in the east, 20 minutes. The
+// section runs from the north edge to the south edge at -112.1 (heading south, so positive is
+// from its left, east, to its right, west); the gauge stands in the canyon below it.
+std::string damBreakText(const std::string& probes) {
+  return "name = \"dam break with a gauge and a section\"\n"
+         "[terrain]\ndem = \"" +
+         strata::test::dataPath("grand_canyon/grand_canyon_512.tif") +
+         "\"\n"
+         "[region]\nbbox_lonlat = [-112.25, 36.02, -112.001, 36.18]\ncell_size = \"600 m\"\n"
+         "[model]\nkind = \"flood\"\nmanning_n = 0.04\nboundary = \"closed\"\n"
+         "[[water.dam_break]]\npolygon_lonlat = [[-112.08, 36.04], [-112.01, 36.04], [-112.01, 36.12], "
+         "[-112.08, 36.12]]\nsurface = \"850 m\"\n"
+         "[time]\nduration = \"20 min\"\noutput_interval = \"5 min\"\n"
+         "[outputs]\nprobe_interval = \"1 min\"\n" +
+         probes;
+}
+
+const std::string kProbes =
+    "[[outputs.gauge]]\nname = \"below the dam\"\nat_lonlat = [-112.1284, 36.098]\n"
+    "[[outputs.section]]\nname = \"across the canyon\"\nline_lonlat = [[-112.1, 36.1815], [-112.1, 36.02]]\n";
+
+Scenario load(const std::filesystem::path& dir, const std::string& text) {
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "dam.toml") << text;
+  auto s = loadScenario(dir / "dam.toml");
+  EXPECT_TRUE(s) << s.message();
+  return *s;
+}
+
+RunOptions cpuRun(const std::filesystem::path& out) {
+  RunOptions opt;
+  opt.outDir = out;
+  opt.backend = Backend::kCpu;
+  opt.pictures = false;
+  return opt;
+}
+
+TEST(ScenarioProbes, FacesCrossedByALineCarryTheSignOfItsRightHandSide) {
+  // A line heading south between columns 2 and 3 (x = 3.0 in pixels, the face between cells 2
+  // and 3) over rows 0..3: four x faces (3, y); its right is west, so an eastward flux counts -1.
+  auto south = facesCrossed({{3.0, 0.2}, {3.0, 3.8}}, 6, 4);
+  ASSERT_EQ(south.size(), 4u);
+  for (const auto& f : south) {
+    EXPECT_TRUE(f.xFace);
+    EXPECT_EQ(f.x, 3);
+    EXPECT_EQ(f.sign, -1.0f);
+  }
+  // Heading east along y = 2.0: the y faces (x, 2) for x = 0..4, a southward flux positive.
+  auto east = facesCrossed({{0.2, 2.0}, {4.9, 2.0}}, 6, 4);
+  ASSERT_EQ(east.size(), 5u);
+  for (const auto& f : east) {
+    EXPECT_FALSE(f.xFace);
+    EXPECT_EQ(f.y, 2);
+    EXPECT_EQ(f.sign, 1.0f);
+  }
+  // A diagonal crosses x and y faces alternately, each once; a line back over itself crosses none
+  // in net.
+  auto diagonal = facesCrossed({{0.7, 0.7}, {3.7, 3.7}}, 6, 4);
+  EXPECT_EQ(diagonal.size(), 6u);
+  EXPECT_TRUE(facesCrossed({{3.0, 0.2}, {3.0, 3.8}, {3.0, 0.2}}, 6, 4).empty());
+  // Faces at the grid's edge (one cell outside) are not section faces.
+  EXPECT_TRUE(facesCrossed({{0.0, 0.2}, {0.0, 3.8}}, 6, 4).empty());
+}
+
+TEST(ScenarioProbes, SectionVolumeIsTheWaterThatCrossedAndGaugePeakIsTheMap) {
+  const auto dir = strata::test::tempDir("probes");
+  const Scenario s = load(dir, damBreakText(kProbes));
+  auto summary = runScenario(s, cpuRun(dir / "run"));
+  ASSERT_TRUE(summary) << summary.message();
+  ASSERT_EQ(summary->sections.size(), 1u);
+  ASSERT_EQ(summary->gauges.size(), 1u);
+  const auto& section = summary->sections[0];
+  const auto& gauge = summary->gauges[0];
+
+  // The water west of the section's faces at the end, in the solver's cell areas (row dx x dy).
+  auto d = buildDomain(s);
+  ASSERT_TRUE(d) << d.message();
+  auto depth = gis::readDem((dir / "run" / "maps" / "final_depth.tif").string(), allowEmpty());
+  ASSERT_TRUE(depth) << depth.message();
+  ASSERT_EQ(d->sections.size(), 1u);
+  const int faceX = d->sections[0].faces.front().x;
+  for (const auto& f : d->sections[0].faces) ASSERT_EQ(f.x, faceX);  // a straight north-south line
+  EXPECT_EQ(section.faces, d->bed.georef.height);                    // edge to edge
+  double west = 0, initialWest = 0;
+  for (int y = 0; y < depth->georef.height; ++y) {
+    for (int x = 0; x < faceX; ++x) {
+      const double h = depth->values.at(x, y);
+      const double area = d->input.rowDxM[size_t(y)] * d->input.dyM;
+      if (std::isfinite(h)) west += h * area;
+      initialWest += double(d->input.waterDepthM.at(x, y)) * area;
+    }
+  }
+  EXPECT_EQ(initialWest, 0.0);
+  EXPECT_GT(west, 1e7) << "the flood crossed the section";
+  EXPECT_NEAR(section.volumeM3, west, 1e-5 * d->damBreakVolumeM3);
+  EXPECT_NEAR(section.forwardM3 - section.backM3, section.volumeM3, 1e-9 * section.forwardM3);
+  EXPECT_GT(section.peak, 0.0);  // east to west
+  EXPECT_GT(section.peakTimeS, 0.0);
+
+  // The gauge's peak: the max_depth map at its cell, exactly (both taken after every step).
+  auto maxDepth = gis::readDem((dir / "run" / "maps" / "max_depth.tif").string(), allowEmpty());
+  ASSERT_TRUE(maxDepth) << maxDepth.message();
+  EXPECT_GT(gauge.peak, 1.0);
+  EXPECT_EQ(float(gauge.peak), maxDepth->values.at(gauge.x, gauge.y));
+
+  // The rows: one a minute from t = 0, long format, the names quoted; the last volume is the summary's.
+  const std::string sections = slurp(dir / "run" / "sections.csv");
+  EXPECT_EQ(sections.rfind("time_s,section,discharge_m3_s,volume_m3,mean_level_m\n0.000,\"across the canyon\",0,0,", 0),
+            0u)
+      << sections;
+  EXPECT_EQ(std::count(sections.begin(), sections.end(), '\n'), 1 + 21);
+  const std::string gauges = slurp(dir / "run" / "gauges.csv");
+  EXPECT_EQ(std::count(gauges.begin(), gauges.end(), '\n'), 1 + 21);
+  for (const char* f : {"plots/gauges.png", "plots/sections.png"}) {
+    EXPECT_TRUE(std::filesystem::exists(dir / "run" / f)) << f;
+  }
+  const std::string report = slurp(dir / "run" / "report.md");
+  EXPECT_NE(report.find("## Gauges and sections"), std::string::npos);
+  EXPECT_NE(report.find("| across the canyon | 30 |"), std::string::npos) << report;
+}
+
+TEST(ScenarioProbes, AStoppedAndResumedRunWritesTheSameRows) {
+  const auto dir = strata::test::tempDir("probes-resume");
+  const Scenario s = load(dir, damBreakText(kProbes));
+  auto whole = cpuRun(dir / "whole");
+  whole.plots = false;
+  auto once = runScenario(s, whole);
+  ASSERT_TRUE(once) << once.message();
+  auto parts = cpuRun(dir / "parts");
+  parts.plots = false;
+  parts.stopAfterIntervals = 2;
+  auto first = runScenario(s, parts);
+  ASSERT_TRUE(first) << first.message();
+  EXPECT_FALSE(first->completed);
+  parts.stopAfterIntervals = -1;
+  parts.resume = true;
+  auto second = runScenario(s, parts);
+  ASSERT_TRUE(second) << second.message();
+  EXPECT_TRUE(second->completed);
+  for (const char* f : {"gauges.csv", "sections.csv"}) {
+    EXPECT_EQ(slurp(dir / "whole" / f), slurp(dir / "parts" / f)) << f;
+  }
+  EXPECT_EQ(second->sections[0].volumeM3, once->sections[0].volumeM3);
+  EXPECT_EQ(second->gauges[0].peak, once->gauges[0].peak);
+}
+
+TEST(ScenarioProbes, BadProbesAreRefusedNamingTheKey) {
+  const auto dir = strata::test::tempDir("probes-bad");
+  auto refused = [&](const std::string& text) {
+    std::ofstream(dir / "bad.toml") << text;
+    auto s = loadScenario(dir / "bad.toml");
+    if (!s) return s.message();
+    auto d = buildDomain(*s);
+    return d ? std::string("accepted") : d.message();
+  };
+  const std::string file = (dir / "bad.toml").string();
+  EXPECT_EQ(refused(damBreakText("[[outputs.section]]\nline_lonlat = [[-112.1, 36.1]]\n")),
+            file + ":20: key 'outputs.section[0].line_lonlat': a line needs at least 2 points");
+  EXPECT_EQ(refused(damBreakText("[[outputs.gauge]]\nname = \"g\"\n")),
+            file + ":19: key 'outputs.gauge[0]': missing at_lonlat or at_xy");
+  EXPECT_EQ(refused(damBreakText("[[outputs.gauge]]\nat_lonlat = [-111.5, 36.1]\n")),
+            file + ":20: key 'outputs.gauge[0].at_lonlat': the gauge \"gauge 1\" is outside the region");
+  EXPECT_EQ(refused(damBreakText("[[outputs.gauge]]\nat_lonlat = [-112.1, 36.1]\nheight = 3\n")),
+            file + ":21: key 'outputs.gauge[0].height': unknown key (expected one of: name, at_lonlat, at_xy)");
+  std::string pipe = damBreakText(kProbes);
+  pipe.replace(pipe.find("kind = \"flood\""), 14, "kind = \"pipe\"");
+  EXPECT_NE(refused(pipe).find("key 'outputs.section': sections need the flood model's face fluxes"), std::string::npos)
+      << refused(pipe);
+}
+
+}  // namespace
+}  // namespace strata::scenario
