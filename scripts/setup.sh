@@ -45,6 +45,8 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   # plots in reports
   python3-matplotlib python3-numpy python3-gdal
+  # a run folder's maps as QGIS shows them (tests load the .qml styles in headless QGIS)
+  python3-qgis
 )
 
 missing=()

@@ -4,8 +4,12 @@
     plot_maps.py RUN_FOLDER
 
 Reads RUN/maps/elevation.tif and every other RUN/maps/*.tif (max_depth, max_speed, arrival_time,
-inundation_duration, final_depth, terrain_change, exposed_material, suspended_sediment) and writes RUN/plots/<name>.png with lon/lat
-(or CRS) axes, a colour bar with units, and the terrain's hillshade underneath.
+inundation_duration, final_depth, hazard_rating, terrain_change, exposed_material,
+suspended_sediment) and writes RUN/plots/<name>.png with lon/lat (or CRS) axes, a colour bar with
+units, a scale bar and a north arrow, and the terrain's hillshade underneath. The flood maps are
+zoomed to where the water went (the cells max_depth shows wet, with a margin) when that is a small
+part of the region, with a locator inset of the whole region; depths are drawn on a log scale from
+the shallowest wet cell, in blues that start visibly darker than the hillshade's white.
 """
 import sys
 from pathlib import Path
@@ -14,6 +18,8 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.colors  # noqa: E402
+import matplotlib.patches  # noqa: E402
+import matplotlib.ticker  # noqa: E402
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from osgeo import gdal  # noqa: E402
@@ -26,6 +32,7 @@ STYLE = {
     "max_speed": ("Maximum flow speed", "m/s", "inferno", None),
     "arrival_time": ("Arrival time of the water", "h", "viridis_r", 1 / 3600.0),
     "inundation_duration": ("Time under water", "h", "magma_r", 1 / 3600.0),
+    "hazard_rating": ("Flood hazard to people (FD2321 rating)", "class", "hazard", None),
     "terrain_change": ("Terrain change (erosion < 0 < deposition)", "m", "RdBu", None),
     "exposed_material": ("Exposed material at the end", "layer", "tab10", None),
     "suspended_sediment": ("Suspended sediment at the end", "m", "YlOrBr", None),
@@ -65,6 +72,71 @@ def hillshade(z, gt, geographic):
     return np.clip(np.sin(alt) * np.cos(slope) + np.cos(alt) * np.sin(slope) * np.cos(az - aspect), 0, 1)
 
 
+FLOOD_MAPS = ("max_depth", "final_depth", "max_speed", "arrival_time", "inundation_duration", "hazard_rating")
+# FD2321's classes and their colours (the .qml styles' too).
+HAZARD_BOUNDS = [0.0, 0.75, 1.25, 2.0, np.inf]
+HAZARD_NAMES = ["low", "moderate", "significant", "extreme"]
+HAZARD_COLOURS = ["#fee08b", "#fdae61", "#f46d43", "#a50026"]
+# The depth ramp: matplotlib's Blues from 35 % on, so that the shallowest water is a clear blue
+# over the hillshade, not near-white.
+DEPTH_CMAP = matplotlib.colors.ListedColormap(plt.get_cmap("Blues")(np.linspace(0.35, 1.0, 256)))
+
+
+def wet_window(run, extent, shape):
+    """The extent of the cells max_depth.tif shows wet, with a margin of a tenth of its size (at
+    least 3 cells), or None when that covers most of the region or nothing is wet."""
+    path = run / "maps" / "max_depth.tif"
+    if not path.exists():
+        return None
+    a, _, _, _ = read(path)
+    wet = np.isfinite(a) & (a > 0)
+    if not wet.any() or a.shape != shape:
+        return None
+    rows, cols = np.where(wet)
+    ny, nx = a.shape
+    my = max(3, (rows.max() - rows.min() + 1) // 10)
+    mx = max(3, (cols.max() - cols.min() + 1) // 10)
+    r0, r1 = max(0, rows.min() - my), min(ny, rows.max() + 1 + my)
+    c0, c1 = max(0, cols.min() - mx), min(nx, cols.max() + 1 + mx)
+    if (r1 - r0) * (c1 - c0) > 0.5 * nx * ny:
+        return None
+    x0, x1, y0, y1 = extent
+    sx, sy = (x1 - x0) / nx, (y1 - y0) / ny  # y0 is the bottom: rows count from the top
+    return [x0 + c0 * sx, x0 + c1 * sx, y1 - r1 * sy, y1 - r0 * sy]
+
+
+def nice_length(m):
+    """The largest 1, 2 or 5 x 10^k not above m."""
+    k = 10 ** np.floor(np.log10(m))
+    return max(f * k for f in (1, 2, 5) if f * k <= m)
+
+
+def scale_bar_and_north(ax, window, geographic):
+    x0, x1, y0, y1 = window
+    mid_lat = 0.5 * (y0 + y1)
+    metres_per_unit = 111320.0 * np.cos(np.radians(mid_lat)) if geographic else 1.0
+    length_m = nice_length(0.25 * (x1 - x0) * metres_per_unit)
+    length = length_m / metres_per_unit
+    bx, by = x0 + 0.05 * (x1 - x0), y0 + 0.06 * (y1 - y0)
+    ax.plot([bx, bx + length], [by, by], color="black", lw=3, solid_capstyle="butt")
+    ax.plot([bx, bx + length], [by, by], color="white", lw=1, solid_capstyle="butt")
+    label = f"{length_m / 1000:g} km" if length_m >= 1000 else f"{length_m:g} m"
+    ax.text(bx + 0.5 * length, by + 0.02 * (y1 - y0), label, ha="center", va="bottom", fontsize=9,
+            bbox=dict(facecolor="white", alpha=0.7, edgecolor="none", pad=1))
+    nx, ny = x1 - 0.06 * (x1 - x0), y1 - 0.16 * (y1 - y0)
+    ax.annotate("N", xy=(nx, ny + 0.1 * (y1 - y0)), xytext=(nx, ny), ha="center", va="top", fontsize=11,
+                fontweight="bold", arrowprops=dict(facecolor="black", width=3, headwidth=9, headlength=8))
+
+
+def locator(inset, shade, extent, window):
+    inset.imshow(shade, extent=extent, cmap="gray", vmin=0, vmax=1)
+    x0, x1, y0, y1 = window
+    inset.add_patch(matplotlib.patches.Rectangle((x0, y0), x1 - x0, y1 - y0, fill=False, edgecolor="red", lw=1.5))
+    inset.set_xticks([])
+    inset.set_yticks([])
+    inset.set_title("region", fontsize=7)
+
+
 def main():
     if len(sys.argv) != 2:
         sys.exit(__doc__)
@@ -73,6 +145,7 @@ def main():
     shade = hillshade(z, gt, geographic)
     out = run / "plots"
     out.mkdir(exist_ok=True)
+    window = wet_window(run, extent, z.shape)
     for name, (title, unit, cmap, scale) in STYLE.items():
         path = run / "maps" / (name + ".tif")
         if not path.exists():
@@ -83,7 +156,22 @@ def main():
         a = np.ma.masked_invalid(a)
         if name.endswith("depth") or name in ("inundation_duration", "suspended_sediment"):
             a = np.ma.masked_less_equal(a, 0)
-        fig, ax = plt.subplots(figsize=(7.5, 6.2))
+        zoom = window if name in FLOOD_MAPS else None
+        if zoom:
+            # The map on the left; on the right the locator above the colour bar.
+            fig = plt.figure(figsize=(9.0, 6.2))
+            grid = fig.add_gridspec(2, 2, width_ratios=[3.2, 1], height_ratios=[1, 1.6])
+            ax = fig.add_subplot(grid[:, 0])
+            locator(fig.add_subplot(grid[0, 1]), shade, extent, zoom)
+            cax = fig.add_subplot(grid[1, 1])
+            cax.set_box_aspect(6)
+        else:
+            fig, ax = plt.subplots(figsize=(7.5, 6.2))
+            cax = None
+
+        def colorbar(im, **kw):
+            return fig.colorbar(im, cax=cax, **kw) if cax else fig.colorbar(im, ax=ax, shrink=0.8, **kw)
+
         ax.imshow(shade, extent=extent, cmap="gray", vmin=0, vmax=1)
         if a.count() > 0:
             if name == "terrain_change":
@@ -95,7 +183,7 @@ def main():
                 changed = changed[changed > 0]
                 lim = float(np.percentile(changed, 99)) if changed.size else 1.0
                 im = ax.imshow(a, extent=extent, cmap=cmap, vmin=-lim, vmax=lim, alpha=0.85)
-                fig.colorbar(im, ax=ax, shrink=0.8, extend="both", label=f"{title.lower()} ({unit})")
+                colorbar(im, extend="both", label=f"{title.lower()} ({unit})")
                 im = None
             elif name == "exposed_material":
                 # One colour per layer, the material's own (STRATA_COLOUR_k), labelled with its name
@@ -109,22 +197,38 @@ def main():
                     names = [f"{k + 1}: {meta[f'STRATA_MATERIAL_{k}']}" for k in range(n)]
                     im = ax.imshow(a, extent=extent, cmap=matplotlib.colors.ListedColormap(colours), vmin=-0.5,
                                    vmax=n - 0.5, alpha=0.9, interpolation="nearest")
-                    bar = fig.colorbar(im, ax=ax, shrink=0.8, ticks=range(n), label="layer: material")
+                    bar = colorbar(im, ticks=range(n), label="layer: material")
                     bar.ax.set_yticklabels(names)
                     im = None
                 else:
                     im = ax.imshow(a, extent=extent, cmap=cmap, vmin=-0.5, vmax=9.5, alpha=0.85,
                                    interpolation="nearest")
+            elif name == "hazard_rating":
+                classes = np.ma.masked_array(np.digitize(a.filled(0), HAZARD_BOUNDS[1:4]), mask=a.mask)
+                im = ax.imshow(classes, extent=extent, cmap=matplotlib.colors.ListedColormap(HAZARD_COLOURS),
+                               vmin=-0.5, vmax=3.5, alpha=0.9, interpolation="nearest")
+                bar = colorbar(im, ticks=range(4), label="hazard class (HR bounds 0.75, 1.25, 2)")
+                bar.ax.set_yticklabels(HAZARD_NAMES)
+                im = None
+            elif name.endswith("depth"):
+                lo, hi = float(a.min()), float(a.max())
+                norm = matplotlib.colors.LogNorm(vmin=lo, vmax=max(hi, 2 * lo))
+                im = ax.imshow(a, extent=extent, cmap=DEPTH_CMAP, norm=norm, alpha=0.9, interpolation="nearest")
             else:
                 im = ax.imshow(a, extent=extent, cmap=cmap, alpha=0.85)
             if im is not None:
-                fig.colorbar(im, ax=ax, shrink=0.8, label=f"{title.lower()} ({unit})")
-        ax.set_title(title)
+                colorbar(im, label=f"{title.lower()} ({unit})")
+        if zoom:
+            ax.set_xlim(zoom[0], zoom[1])
+            ax.set_ylim(zoom[2], zoom[3])
+        ax.xaxis.set_major_locator(matplotlib.ticker.MaxNLocator(5))
+        scale_bar_and_north(ax, zoom or extent, geographic)
+        ax.set_title(title + ("\n(zoomed to where the water went)" if zoom else ""))
         ax.set_xlabel("longitude (°)" if geographic else "x (m)")
         ax.set_ylabel("latitude (°)" if geographic else "y (m)")
         fig.tight_layout()
         tmp = out / (name + ".tmp.png")
-        fig.savefig(tmp, dpi=100)
+        fig.savefig(tmp, dpi=100, bbox_inches="tight")
         tmp.replace(out / (name + ".png"))
         plt.close(fig)
 

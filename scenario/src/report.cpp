@@ -33,6 +33,8 @@ std::string fmt(const char* f, double v) {
 std::string userText(const std::string& text, bool cell = false);
 std::string fmt(const char* f, double v);
 std::string hours(double s);
+// An area in the unit that fits: m² below a hectare's tenth... km² from 0.1 km².
+std::string areaText(double m2) { return m2 < 1e5 ? fmt("%.0f", m2) + " m²" : fmt("%.2f", m2 / 1e6) + " km²"; }
 std::string where(const gis::Georef& g, int x, int y);
 
 // The gauges' and sections' peaks and volumes; their rows are in gauges.csv and sections.csv.
@@ -333,7 +335,15 @@ Status writeReport(const fs::path& runDir, const ReportInput& in) {
     md += "| most water in the region | " + volumeText(peakW.waterM3) + " at " + hours(peakW.timeS) + " |\n";
     md += "| largest flooded area | " + fmt("%.1f", peakA.floodedAreaKm2) + " km² at " + hours(peakA.timeS) + " (" +
           fmt("%.1f", 100 * peakA.floodedAreaKm2 * 1e6 / d.totalAreaM2) + "% of the region) |\n";
-    md += "| area flooded at some time | " + fmt("%.1f", f.everWetM2 / 1e6) + " km² |\n";
+    md += "| area flooded at some time | " + areaText(f.everWetM2) + " |\n";
+    if (f.everWetM2 > 0) {
+      md += "| of which, by flood hazard to people (FD2321, " +
+            std::string(hazardLandUseName(s.outputs.hazardLandUse)) + " debris factors) |";
+      for (size_t k = 0; k < f.hazardClassM2.size(); ++k) {
+        md += std::string(k ? ";" : "") + " " + std::string(kHazardClassNames[k]) + " " + areaText(f.hazardClassM2[k]);
+      }
+      md += " (rated from each cell's largest depth and largest speed: an upper bound) |\n";
+    }
     md += "| deepest water | " + fmt("%.1f", f.deepest.value) + " m at " + where(g, f.deepest.x, f.deepest.y) + " |\n";
     md +=
         "| fastest water | " + fmt("%.1f", f.fastest.value) + " m/s at " + where(g, f.fastest.x, f.fastest.y) + " |\n";

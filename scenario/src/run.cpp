@@ -17,6 +17,7 @@
 #include <strata/core/progress.hpp>
 #include <strata/gis/dem_io.hpp>
 #include <strata/gis/geodesy.hpp>
+#include <strata/gis/polygons.hpp>
 #include <strata/gl/context.hpp>
 #include <strata/render/image_io.hpp>
 #include <strata/render/terrain_renderer.hpp>
@@ -31,6 +32,7 @@
 #include "domain_rows.hpp"
 #include "pieces.hpp"
 #include "probes.hpp"
+#include "styles.hpp"
 
 namespace strata::scenario {
 namespace fs = std::filesystem;
@@ -64,10 +66,14 @@ std::vector<std::string> runFolderFiles() {
                                  "checkpoint.bin", "report.md",  "maps/elevation.tif"};
   for (const auto& m : knownOutputMaps()) {
     if (m == "layer_thickness") continue;  // one file per layer, below
-    files.push_back("maps/" + m + ".tif");
+    files.push_back("maps/" + m + (m == "flood_outline" ? ".gpkg" : ".tif"));
     files.push_back("plots/" + m + ".png");
   }
   for (int k = 1; k <= kMaxLayerMaps; ++k) files.push_back(layerMapFile(k));
+  // QGIS styles beside every map (styles.hpp).
+  for (size_t i = 0, n = files.size(); i < n; ++i) {
+    if (files[i].starts_with("maps/")) files.push_back(fs::path(files[i]).replace_extension(".qml").string());
+  }
   for (const char* p : {"water", "area", "balance", "sediment", "gauges", "sections"})
     files.push_back("plots/" + std::string(p) + ".png");
   for (const char* p : {"before", "peak", "after", "max_depth"}) files.push_back("pictures/" + std::string(p) + ".png");
@@ -565,6 +571,21 @@ class Run {
                           [](const detail::Piece& p) { return p.flood.wetDurationS; }));
     STRATA_TRY_STATUS(
         map("final_depth", false, {"water depth at the end", "m"}, [](const detail::Piece& p) { return p.depth; }));
+    // FD2321's hazard rating (hazard.hpp) from each cell's largest depth and speed, where wet.
+    STRATA_TRY_STATUS(map("hazard_rating", true,
+                          {"flood hazard rating HR = d (v + 0.5) + DF (FD2321) from the largest depth and speed, "
+                           "classes at 0.75, 1.25, 2",
+                           ""},
+                          [this](const detail::Piece& p) {
+                            gis::Grid<float> g(p.rect.width, p.rect.height, 0.0f);
+                            for (size_t i = 0; i < g.size(); ++i) {
+                              g.data[i] = float(hazardRating(p.flood.maxDepthM.data[i], p.flood.maxSpeedMS.data[i],
+                                                             s_.outputs.hazardLandUse));
+                            }
+                            return g;
+                          },
+                          {{"HAZARD_LAND_USE", hazardLandUseName(s_.outputs.hazardLandUse)}}));
+    STRATA_TRY_STATUS(writeOutline(pieces));
     if (!s_.erosion.enabled) return {};
     // terrain_change (net cut and fill, m), exposed_material (exposedLayer: bottom = 0; none: no
     // data), suspended_sediment (m of material in the water) and layer_thickness
@@ -613,11 +634,46 @@ class Run {
   }
 
   // The flood's extremes and the area ever wet (collective: reduced over the ranks).
+  // maps/flood_outline.gpkg: the cells ever deeper than the wet threshold as polygons, one per
+  // connected (4-neighbour) wet area, with its area (the model's cell areas, as the report's) and
+  // largest depth. The largest depths are gathered to the lead, which traces and writes.
+  Status writeOutline(const std::vector<detail::Piece>& pieces) {
+    const auto& maps = s_.outputs.maps;
+    if (std::find(maps.begin(), maps.end(), "flood_outline") == maps.end()) return {};
+    const int w = e_.solver->grid().width, h = e_.solver->grid().height;
+    const float wet = float(s_.outputs.wetThresholdM);
+    const auto depth = detail::gatherStrided(ranks_, pieces, 1, w, h, [wet](const detail::Piece& p, size_t i) {
+      return p.inside.data[i] && p.flood.maxDepthM.data[i] > wet ? p.flood.maxDepthM.data[i] : 0.0f;
+    });
+    Status status;
+    if (ranks_.lead()) {
+      gis::Grid<uint8_t> mask(w, h, 0);
+      for (size_t i = 0; i < mask.size(); ++i) mask.data[i] = depth.data[i] > 0.0f;
+      int32_t count = 0;
+      const auto labels = gis::labelComponents(mask, &count);
+      gis::PolygonLayer layer{"flood_outline", {"area_m2", "max_depth_m"}, {}};
+      std::vector<sim::ExactSum> area(size_t(count) + 1);
+      std::vector<double> deepest(size_t(count) + 1, 0.0);
+      for (int y = 0; y < h; ++y) {
+        for (int x = 0; x < w; ++x) {
+          const int32_t k = labels.at(x, y);
+          if (k == 0) continue;
+          area[size_t(k)].add(e_.solver->grid().area(y));
+          deepest[size_t(k)] = std::max(deepest[size_t(k)], double(depth.at(x, y)));
+        }
+      }
+      for (int32_t k = 1; k <= count; ++k) layer.values[k] = {area[size_t(k)].value(), deepest[size_t(k)]};
+      status =
+          gis::writeLabelPolygons((opt_.outDir / "maps" / "flood_outline.gpkg").string(), d_.bed.georef, labels, layer);
+    }
+    return ranks_.agree(status);
+  }
+
   FloodSummary floodSummary(const std::vector<detail::Piece>& pieces) {
     const double wet = s_.outputs.wetThresholdM;
     const auto& g = d_.bed.georef;
     detail::Extreme deep, fast, far;
-    std::vector<sim::ExactSum> everWet(1);
+    std::vector<sim::ExactSum> everWet(5);  // all, then per hazard class
     std::optional<std::pair<int, int>> c0;
     std::optional<gis::LonLat> from;
     if (!d_.sources.empty()) {
@@ -634,7 +690,10 @@ class Run {
       // when none is farther).
       if (c0 && x == c0->first && y == c0->second && detail::beats({0, x, y, arrival}, far)) far = {0, x, y, arrival};
       if (!(depth > wet)) return;
-      if (p.inside.data[i]) everWet[0].add(area);
+      if (p.inside.data[i]) {
+        everWet[0].add(area);
+        everWet[1 + size_t(hazardClass(hazardRating(depth, speed, s_.outputs.hazardLandUse)))].add(area);
+      }
       if (!from) return;
       auto to = gis::pixelToLonLat(g, x + 0.5, y + 0.5);
       const double m = to ? gis::geodesicDistanceM(*from, *to, g.body) : 0;
@@ -650,6 +709,7 @@ class Run {
     f.farthest = {far.value, far.x, far.y};
     f.farthestArrivalS = far.with;
     f.everWetM2 = everWet[0].value();
+    for (size_t k = 0; k < f.hazardClassM2.size(); ++k) f.hazardClassM2[k] = everWet[1 + k].value();
     return f;
   }
 
@@ -696,7 +756,8 @@ class Run {
   std::vector<std::string> mapFiles() const {
     std::vector<std::string> files;
     for (const auto& m : s_.outputs.maps) {
-      if (fs::exists(opt_.outDir / "maps" / (m + ".tif"))) files.push_back("maps/" + m + ".tif");
+      const std::string file = "maps/" + m + (m == "flood_outline" ? ".gpkg" : ".tif");
+      if (fs::exists(opt_.outDir / file)) files.push_back(file);
     }
     return files;
   }
@@ -1038,7 +1099,9 @@ class Session {
       }
     }
     const FloodSummary flood = run_->floodSummary(*pieces);
-    if (!ranks_.lead()) return summary_;  // the lead writes the plots and the report
+    if (!ranks_.lead()) return summary_;  // the lead writes the styles, plots and the report
+    STRATA_TRY(auto styles, detail::writeMapStyles(opt_.outDir, s_.outputs.wetThresholdM));
+    summary_.files.insert(summary_.files.end(), styles.begin(), styles.end());
     if (opt_.plots) {
       STRATA_TRY(auto plots, writePlots(opt_.outDir, summary_.completed));
       summary_.files.insert(summary_.files.end(), plots.begin(), plots.end());

@@ -745,8 +745,9 @@ Status readOutputs(const Reader& r, const toml::table& root, Scenario& s) {
     s.outputs.maps.insert(s.outputs.maps.end(), erosionOutputMaps().begin(), erosionOutputMaps().end());
   }
   if (!t) return {};
-  STRATA_TRY_STATUS(
-      r.onlyKeys(*t, "outputs", {"maps", "wet_threshold", "pictures", "plots", "gauge", "section", "probe_interval"}));
+  STRATA_TRY_STATUS(r.onlyKeys(
+      *t, "outputs",
+      {"maps", "wet_threshold", "pictures", "plots", "gauge", "section", "probe_interval", "hazard_land_use"}));
   if (const auto* m = t->get("maps")) {
     const auto* arr = m->as_array();
     if (!arr) return r.error(*m, "outputs.maps", "expected a list of map names");
@@ -770,6 +771,19 @@ Status readOutputs(const Reader& r, const toml::table& root, Scenario& s) {
   }
   if (const auto* p = t->get("plots")) {
     STRATA_TRY(s.outputs.plots, r.boolean(*p, "outputs.plots"));
+  }
+  if (const auto* p = t->get("hazard_land_use")) {
+    STRATA_TRY(auto use, r.string(*p, "outputs.hazard_land_use"));
+    if (use == "pasture") {
+      s.outputs.hazardLandUse = HazardLandUse::kPasture;
+    } else if (use == "woodland") {
+      s.outputs.hazardLandUse = HazardLandUse::kWoodland;
+    } else if (use == "urban") {
+      s.outputs.hazardLandUse = HazardLandUse::kUrban;
+    } else {
+      return r.error(*p, "outputs.hazard_land_use",
+                     "unknown land use \"" + oneLine(use) + "\" (pasture, woodland, urban: FD2321's debris factors)");
+    }
   }
   if (const auto* p = t->get("probe_interval")) {
     STRATA_TRY(s.outputs.probeIntervalS, r.quantity(*p, "outputs.probe_interval", "time", kDuration));
@@ -844,9 +858,9 @@ const std::vector<std::string>& erosionOutputMaps() {
 }
 
 const std::vector<std::string>& knownOutputMaps() {
-  static const std::vector<std::string> kMaps{"max_depth",           "max_speed",          "arrival_time",
-                                              "inundation_duration", "final_depth",        "terrain_change",
-                                              "exposed_material",    "suspended_sediment", "layer_thickness"};
+  static const std::vector<std::string> kMaps{
+      "max_depth",     "max_speed",      "arrival_time",     "inundation_duration", "final_depth",    "hazard_rating",
+      "flood_outline", "terrain_change", "exposed_material", "suspended_sediment",  "layer_thickness"};
   return kMaps;
 }
 

@@ -252,8 +252,9 @@ TEST(StrataCli, OverTheFileSizeLimitTheFileIsNamed) {
   const auto dir = strata::test::tempDir("cli-fsize");
   writeCpuScenario(dir);
   std::string out;
-  // 64 KiB: the maps and the series fit, the checkpoint (~100 B a cell) does not.
-  const int code = strata({"flood", "flood.toml", "-o", "run", "--no-pictures", "--no-plots"}, dir, out, 65536);
+  // 100 KiB: the maps, the series and the outline's GeoPackage (96 KiB) fit, the checkpoint
+  // (~100 B a cell, 113 KiB) does not.
+  const int code = strata({"flood", "flood.toml", "-o", "run", "--no-pictures", "--no-plots"}, dir, out, 102400);
   EXPECT_EQ(code, 1) << "killed by signal " << code - 128 << ": " << out;
   EXPECT_NE(out.find("strata flood: run/checkpoint.bin: cannot write: File too large"), std::string::npos) << out;
   EXPECT_FALSE(fs::exists(dir / "run" / "checkpoint.bin"));

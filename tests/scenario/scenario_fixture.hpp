@@ -31,6 +31,23 @@ inline std::string scenarioText() {
          "[outputs]\nwet_threshold = \"0.1 m\"\n";
 }
 
+// A dam break in a closed ~24 x 18 km piece of the canyon at 600 m cells: a lake 100 m above the
+// river held behind a dam in the east, 20 minutes, rows of gauges and sections every minute;
+// `outputs` is appended to [outputs] ([[outputs.gauge]] and [[outputs.section]] tables).
+inline std::string damBreakText(const std::string& outputs = {}) {
+  return "name = \"dam break with a gauge and a section\"\n"
+         "[terrain]\ndem = \"" +
+         strata::test::dataPath("grand_canyon/grand_canyon_512.tif") +
+         "\"\n"
+         "[region]\nbbox_lonlat = [-112.25, 36.02, -112.001, 36.18]\ncell_size = \"600 m\"\n"
+         "[model]\nkind = \"flood\"\nmanning_n = 0.04\nboundary = \"closed\"\n"
+         "[[water.dam_break]]\npolygon_lonlat = [[-112.08, 36.04], [-112.01, 36.04], [-112.01, 36.12], "
+         "[-112.08, 36.12]]\nsurface = \"850 m\"\n"
+         "[time]\nduration = \"20 min\"\noutput_interval = \"5 min\"\n"
+         "[outputs]\nprobe_interval = \"1 min\"\n" +
+         outputs;
+}
+
 inline scenario::Scenario writeScenario(const std::filesystem::path& dir) {
   const auto file = dir / "flood.toml";
   std::ofstream(file) << scenarioText();

@@ -27,23 +27,9 @@ std::string slurp(const std::filesystem::path& p) {
   return s.str();
 }
 
-// Closed edges, a lake 100 m above the river held behind a dam in the east, 20 minutes. The
-// section runs from the north edge to the south edge at -112.1 (heading south, so positive is
-// from its left, east, to its right, west); the gauge stands in the canyon below it.
-std::string damBreakText(const std::string& probes) {
-  return "name = \"dam break with a gauge and a section\"\n"
-         "[terrain]\ndem = \"" +
-         strata::test::dataPath("grand_canyon/grand_canyon_512.tif") +
-         "\"\n"
-         "[region]\nbbox_lonlat = [-112.25, 36.02, -112.001, 36.18]\ncell_size = \"600 m\"\n"
-         "[model]\nkind = \"flood\"\nmanning_n = 0.04\nboundary = \"closed\"\n"
-         "[[water.dam_break]]\npolygon_lonlat = [[-112.08, 36.04], [-112.01, 36.04], [-112.01, 36.12], "
-         "[-112.08, 36.12]]\nsurface = \"850 m\"\n"
-         "[time]\nduration = \"20 min\"\noutput_interval = \"5 min\"\n"
-         "[outputs]\nprobe_interval = \"1 min\"\n" +
-         probes;
-}
-
+// On the fixture's dam break (damBreakText): the section runs from the north edge to the south
+// edge at -112.1 (heading south, so positive is from its left, east, to its right, west); the
+// gauge stands in the canyon below it.
 const std::string kProbes =
     "[[outputs.gauge]]\nname = \"below the dam\"\nat_lonlat = [-112.1284, 36.098]\n"
     "[[outputs.section]]\nname = \"across the canyon\"\nline_lonlat = [[-112.1, 36.1815], [-112.1, 36.02]]\n";

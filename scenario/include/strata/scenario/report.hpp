@@ -2,6 +2,7 @@
 // The run folder's plots and report.md: the scenario and what happened, in numbers people can
 // put in front of others, with the maps, plots and pictures next to it.
 
+#include <array>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -25,6 +26,8 @@ struct FloodSummary {
   AtCell farthest;               ///< the wet cell farthest (geodesic, m) from the first inflow's first cell
   double farthestArrivalS = -1;  ///< when water first reached it (-1: never above the threshold)
   double everWetM2 = 0;          ///< area of the cells wet at some time (the model's cell areas)
+  /// That area by hazard class (hazard.hpp: low, moderate, significant, extreme).
+  std::array<double, 4> hazardClassM2{};
 };
 
 struct ReportInput {

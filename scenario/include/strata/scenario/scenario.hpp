@@ -15,6 +15,7 @@
 
 #include <strata/core/result.hpp>
 #include <strata/core/time_series.hpp>
+#include <strata/scenario/hazard.hpp>
 #include <strata/sim/params.hpp>
 
 namespace strata::scenario {
@@ -168,7 +169,10 @@ struct Scenario {
   double spinUpTolerance = 0;
 
   struct {
-    std::vector<std::string> maps{"max_depth", "max_speed", "arrival_time", "inundation_duration", "final_depth"};
+    std::vector<std::string> maps{"max_depth",   "max_speed",     "arrival_time", "inundation_duration",
+                                  "final_depth", "hazard_rating", "flood_outline"};
+    /// The land use whose debris factor the hazard rating takes (hazard.hpp).
+    HazardLandUse hazardLandUse = HazardLandUse::kUrban;
     double wetThresholdM = 0.05;  ///< depth above which a cell counts as flooded
     bool pictures = true;
     bool plots = true;

@@ -1,0 +1,115 @@
+// Issue 31: a run folder a GIS user opens as it is. The flood outline (maps/flood_outline.gpkg)
+// has the maps' CRS and, feature by feature, the area of the cells the max_depth map shows wet;
+// its polygons' own geodesic area agrees; the hazard rating map is FD2321's formula of the
+// max_depth and max_speed maps; and headless QGIS applies the .qml style beside every map.
+#include <gtest/gtest.h>
+#include <ogrsf_frmts.h>
+
+#include <cmath>
+#include <fstream>
+
+#include <strata/gis/geodesy.hpp>
+#include <strata/scenario/domain.hpp>
+#include <strata/scenario/hazard.hpp>
+#include <strata/scenario/run.hpp>
+
+#include "scenario_fixture.hpp"
+#include "strata_test.hpp"
+
+namespace strata::scenario {
+namespace {
+
+using namespace test_support;
+
+// The area of an OGR polygon in lon/lat on the body's ellipsoid (rings: the first adds, the others
+// subtract). Cells are bounded by parallels, which are not geodesics: the edges are cut into
+// 1e-4 degree pieces first (a geodesic that short strays from its parallel by nothing measurable).
+double ellipsoidArea(const OGRPolygon& polygon, const gis::Body& body) {
+  OGRPolygon p(polygon);
+  p.segmentize(1e-4);
+  double area = 0;
+  for (int r = 0; r <= p.getNumInteriorRings(); ++r) {
+    const OGRLinearRing* ring = r == 0 ? p.getExteriorRing() : p.getInteriorRing(r - 1);
+    std::vector<gis::LonLat> pts;
+    for (int i = 0; i + 1 < ring->getNumPoints(); ++i) pts.push_back({ring->getX(i), ring->getY(i)});
+    const double a = std::abs(gis::geodesicPolygonAreaM2(pts, body));
+    area += r == 0 ? a : -a;
+  }
+  return area;
+}
+
+TEST(ScenarioOutputs, OutlineHazardAndStylesAreWhatAGisUserOpens) {
+  const auto dir = strata::test::tempDir("outputs");
+  std::ofstream(dir / "dam.toml") << damBreakText();
+  auto s = loadScenario(dir / "dam.toml");
+  ASSERT_TRUE(s) << s.message();
+  RunOptions opt;
+  opt.outDir = dir / "run";
+  opt.backend = Backend::kCpu;
+  opt.pictures = false;
+  opt.plots = false;
+  auto summary = runScenario(*s, opt);
+  ASSERT_TRUE(summary) << summary.message();
+  auto d = buildDomain(*s);
+  ASSERT_TRUE(d) << d.message();
+  auto maxDepth = gis::readDem((opt.outDir / "maps" / "max_depth.tif").string(), allowEmpty());
+  auto maxSpeed = gis::readDem((opt.outDir / "maps" / "max_speed.tif").string(), allowEmpty());
+  auto hazard = gis::readDem((opt.outDir / "maps" / "hazard_rating.tif").string(), allowEmpty());
+  ASSERT_TRUE(maxDepth && maxSpeed && hazard);
+
+  // The wet area the map shows, in the model's cell areas (row dx x its float32 dy, as the
+  // solver's totals and the report's).
+  const double wet = s->outputs.wetThresholdM;
+  double wetArea = 0;
+  int wetCells = 0, rated = 0;
+  for (int y = 0; y < maxDepth->georef.height; ++y) {
+    for (int x = 0; x < maxDepth->georef.width; ++x) {
+      const float depth = maxDepth->values.at(x, y), rating = hazard->values.at(x, y);
+      if (!(depth > wet)) {
+        EXPECT_TRUE(std::isnan(rating)) << "no rating where it was never wet: " << x << ", " << y;
+        continue;
+      }
+      wetArea += d->input.rowDxM[size_t(y)] * double(float(d->input.dyM));
+      ++wetCells;
+      const double expected = hazardRating(depth, maxSpeed->values.at(x, y), HazardLandUse::kUrban);
+      EXPECT_NEAR(rating, expected, 1e-5 * expected) << x << ", " << y;
+      rated += hazardClass(rating) == 3;
+    }
+  }
+  ASSERT_GT(wetCells, 20);
+  EXPECT_GT(rated, 0) << "a 100 m dam break has extreme hazard somewhere";
+
+  GDALDatasetH ds = GDALOpenEx((opt.outDir / "maps" / "flood_outline.gpkg").string().c_str(), GDAL_OF_VECTOR, nullptr,
+                               nullptr, nullptr);
+  ASSERT_NE(ds, nullptr);
+  OGRLayer* layer = GDALDataset::FromHandle(ds)->GetLayerByName("flood_outline");
+  ASSERT_NE(layer, nullptr);
+  OGRSpatialReference mapCrs(maxDepth->georef.crsWkt.c_str());
+  mapCrs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  ASSERT_NE(layer->GetSpatialRef(), nullptr);
+  EXPECT_TRUE(layer->GetSpatialRef()->IsSame(&mapCrs));
+  double attributeArea = 0, polygonArea = 0;
+  for (auto& f : *layer) {
+    attributeArea += f->GetFieldAsDouble("area_m2");
+    EXPECT_GT(f->GetFieldAsDouble("max_depth_m"), wet);
+    const auto* g = f->GetGeometryRef()->toMultiPolygon();
+    for (const auto* p : *g) polygonArea += ellipsoidArea(*p, maxDepth->georef.body);
+  }
+  GDALClose(ds);
+  EXPECT_NEAR(attributeArea, wetArea, 1e-9 * wetArea);
+  // The traced polygons themselves: the same area on the ellipsoid (the model's rows take the
+  // middle column's cell area; on a lon/lat grid every column's is the same; its dy is float32).
+  EXPECT_NEAR(polygonArea, wetArea, 1e-6 * wetArea);
+
+  // QGIS (python3-qgis, installed by scripts/setup.sh) loads every style and the outline.
+  const auto qgis =
+      strata::test::runProgram({"/usr/bin/python3", STRATA_SOURCE_DIR "/tests/scenario/qgis/check_styles.py",
+                                opt.outDir.string(), std::to_string(wetArea)});
+  EXPECT_EQ(qgis.status, 0) << qgis.output;
+  for (const char* m : {"max_depth", "hazard_rating", "elevation", "flood_outline"}) {
+    EXPECT_NE(qgis.output.find(m), std::string::npos) << qgis.output;
+  }
+}
+
+}  // namespace
+}  // namespace strata::scenario
