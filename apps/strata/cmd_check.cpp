@@ -1,9 +1,13 @@
 // strata check STORE: verifies a tile store (manifest, CRS, every tile's size, checksum,
 // decoding, georeference, values against its recorded range and error, orphan files, whether
-// its ingest finished) and summarises it. Exit status 1, with one line per problem on stderr,
-// when anything is wrong.
+// its ingest finished) and summarises it.
+// strata check SCENARIO.toml: every problem of a scenario file in one pass, in file order
+// (file:line: key 'k': ...), raster paths included, without running it.
+// Exit status 1, with one line per problem on stderr, when anything is wrong.
 #include <cstdio>
+#include <filesystem>
 
+#include <strata/scenario/scenario.hpp>
 #include <strata/terrain/tile_store.hpp>
 
 #include "commands.hpp"
@@ -12,10 +16,23 @@ namespace strata::app {
 
 void addCheckCommand(CLI::App& app) {
   auto* cmd = app.add_subcommand(
-      "check", "Verify a terrain tile store: complete, manifest and CRS, tile checksums, decoding, values, orphans");
+      "check",
+      "Verify a terrain tile store (complete, manifest and CRS, tile checksums, decoding, values, orphans) or a "
+      "scenario file (every problem in one pass, raster paths included, without running it)");
   auto dir = std::make_shared<std::string>();
-  cmd->add_option("store", *dir, "Store folder (holds manifest.toml)")->required();
+  cmd->add_option("store_or_scenario", *dir, "Store folder (holds manifest.toml) or scenario file (.toml)")->required();
   cmd->callback([dir] {
+    std::error_code ec;
+    if (!std::filesystem::is_directory(*dir, ec)) {
+      const auto problems = scenario::checkScenarioFile(*dir);
+      for (const auto& p : problems) std::fprintf(stderr, "strata check: %s\n", p.c_str());
+      if (!problems.empty()) {
+        std::printf("result    %zu problem(s)\n", problems.size());
+        throw CLI::RuntimeError(1);
+      }
+      std::printf("result    OK: %s would run\n", dir->c_str());
+      return;
+    }
     auto store =
         terrain::TileStore::open(*dir, {.budgetBytes = size_t(64) << 20, .prefetch = false}, {.allowIncomplete = true});
     if (!store) {

@@ -1100,7 +1100,11 @@ class Session {
     }
     const FloodSummary flood = run_->floodSummary(*pieces);
     if (!ranks_.lead()) return summary_;  // the lead writes the styles, plots and the report
-    STRATA_TRY(auto styles, detail::writeMapStyles(opt_.outDir, s_.outputs.wetThresholdM));
+    std::vector<std::string> written;
+    for (const auto& f : summary_.files) {
+      if (f.starts_with("maps/")) written.push_back(f);
+    }
+    STRATA_TRY(auto styles, detail::writeMapStyles(opt_.outDir, written, s_.outputs.wetThresholdM));
     summary_.files.insert(summary_.files.end(), styles.begin(), styles.end());
     if (opt_.plots) {
       STRATA_TRY(auto plots, writePlots(opt_.outDir, summary_.completed));

@@ -83,6 +83,22 @@ bool inRange(double v, const Range& r) { return (r.loOpen ? v > r.lo : v >= r.lo
 // "nan", "inf", "-inf" as TOML writes them.
 std::string nonFinite(double v) { return std::isnan(v) ? "nan" : (v > 0 ? "inf" : "-inf"); }
 
+// Levenshtein distance, for "did you mean".
+size_t editDistance(const std::string& a, const std::string& b) {
+  std::vector<size_t> row(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (size_t i = 1; i <= a.size(); ++i) {
+    size_t diagonal = row[0];
+    row[0] = i;
+    for (size_t j = 1; j <= b.size(); ++j) {
+      const size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = up;
+    }
+  }
+  return row[b.size()];
+}
+
 // Errors carry "file:line: key 'path': message". Every key read is recorded with its line
 // (Scenario::keyLines) for checks that come later.
 struct Reader {
@@ -107,9 +123,16 @@ struct Reader {
     for (auto&& [k, v] : table) {
       const std::string key(k.str());
       if (std::none_of(allowed.begin(), allowed.end(), [&](const char* a) { return key == a; })) {
-        std::string list;
-        for (const char* a : allowed) list += (list.empty() ? "" : ", ") + std::string(a);
-        return error(v, prefix.empty() ? key : prefix + "." + key, "unknown key (expected one of: " + list + ")");
+        std::string list, nearest;
+        size_t nearestDistance = 3;  // a near miss: at most 2 edits from an allowed key the table lacks
+        for (const char* a : allowed) {
+          list += (list.empty() ? "" : ", ") + std::string(a);
+          const size_t d = editDistance(key, a);
+          if (d < nearestDistance && !table.contains(a)) nearest = a, nearestDistance = d;
+        }
+        return error(v, prefix.empty() ? key : prefix + "." + key,
+                     "unknown key (expected one of: " + list + ")" +
+                         (nearest.empty() ? std::string() : "; did you mean '" + nearest + "'?"));
       }
     }
     return {};
@@ -898,20 +921,12 @@ Result<Backend> parseBackend(std::string_view name) {
   return fail("expected \"auto\", \"cpu\" or \"gpu\", got \"" + std::string(name) + "\"");
 }
 
-Result<Scenario> parseScenario(std::string_view text, const std::filesystem::path& fileName) {
-  text = withoutBom(text);
+namespace {
+
+// The scenario a parsed TOML table describes (everything parseScenario checks after the syntax).
+Result<Scenario> readScenario(const toml::table& root, const std::filesystem::path& fileName) {
   Scenario s;
   Reader r{fileName.string(), fileName.parent_path(), &s.keyLines};
-  TomlScreenOptions screen;
-  screen.kind = "scenario";
-  screen.dateHint = "durations are quantities such as \"3 h\"";
-  STRATA_TRY_STATUS(screenToml(text, r.file, screen));
-  toml::table root;
-  try {
-    root = toml::parse(text, fileName.string());
-  } catch (const toml::parse_error& e) {
-    return fail(r.file + ":" + std::to_string(e.source().begin.line) + ": " + oneLine(e.description()));
-  }
   STRATA_TRY_STATUS(r.onlyKeys(
       root, "",
       {"name", "description", "terrain", "region", "model", "erosion", "materials", "water", "time", "outputs"}));
@@ -952,6 +967,195 @@ Result<Scenario> parseScenario(std::string_view text, const std::filesystem::pat
     }
   }
   return s;
+}
+
+// The TOML of a scenario: screened (toml++'s defects), then parsed; syntax errors name the line.
+Result<toml::table> parseToml(std::string_view text, const std::string& file) {
+  TomlScreenOptions screen;
+  screen.kind = "scenario";
+  screen.dateHint = "durations are quantities such as \"3 h\"";
+  STRATA_TRY_STATUS(screenToml(text, file, screen));
+  try {
+    return toml::parse(text, file);
+  } catch (const toml::parse_error& e) {
+    return fail(file + ":" + std::to_string(e.source().begin.line) + ": " + oneLine(e.description()));
+  }
+}
+
+// --- Every problem of a file in one pass (scenarioProblems) --------------------------------
+
+// A message's line and key ("FILE:LINE: key 'KEY': ..."; 0 and "" when it names neither).
+struct Located {
+  int line = 0;
+  std::string key;
+};
+Located locate(const std::string& message, const std::string& file) {
+  Located l;
+  if (!message.starts_with(file + ":")) return l;
+  const size_t at = file.size() + 1;
+  size_t end = at;
+  while (end < message.size() && std::isdigit(static_cast<unsigned char>(message[end]))) ++end;
+  if (end == at || message.compare(end, 7, ": key '") != 0) return l;
+  l.line = std::stoi(message.substr(at, end - at));
+  const size_t k0 = end + 7, k1 = message.find("': ", k0);
+  if (k1 != std::string::npos) l.key = message.substr(k0, k1 - k0);
+  return l;
+}
+
+// "water.inflow[0].hydrograph" -> {"water", "inflow", "[0]", "hydrograph"}.
+std::vector<std::string> keyParts(const std::string& key) {
+  std::vector<std::string> parts;
+  std::string cur;
+  for (char c : key) {
+    if (c == '.' || c == '[') {
+      if (!cur.empty()) parts.push_back(cur);
+      cur = c == '[' ? "[" : "";
+    } else if (c == ']') {
+      parts.push_back(cur + "]");
+      cur.clear();
+    } else {
+      cur += c;
+    }
+  }
+  if (!cur.empty()) parts.push_back(cur);
+  return parts;
+}
+
+// The node holding the last part of `parts` (a table or an array), or null.
+toml::node* parentOf(toml::table& root, const std::vector<std::string>& parts) {
+  toml::node* n = &root;
+  for (size_t i = 0; i + 1 < parts.size() && n; ++i) {
+    const auto& p = parts[i];
+    if (p.starts_with("[")) {
+      auto* a = n->as_array();
+      const size_t k = size_t(std::strtoul(p.c_str() + 1, nullptr, 10));
+      n = a && k < a->size() ? a->get(k) : nullptr;
+    } else {
+      auto* t = n->as_table();
+      n = t ? t->get(p) : nullptr;
+    }
+  }
+  return n;
+}
+
+bool erase(toml::table& root, const std::vector<std::string>& parts) {
+  if (parts.empty()) return false;
+  toml::node* parent = parentOf(root, parts);
+  if (!parent) return false;
+  const auto& last = parts.back();
+  if (last.starts_with("[")) {
+    auto* a = parent->as_array();
+    const size_t k = size_t(std::strtoul(last.c_str() + 1, nullptr, 10));
+    if (!a || k >= a->size()) return false;
+    a->erase(a->begin() + std::ptrdiff_t(k));
+    return true;
+  }
+  auto* t = parent->as_table();
+  return t && t->erase(last) > 0;
+}
+
+// Values that stand in for a required key once its own is refused, so that the rest of its
+// table is read too (each is valid wherever the key occurs).
+bool placeholder(toml::table& root, const std::vector<std::string>& parts) {
+  toml::node* parent = parentOf(root, parts);
+  auto* t = parent ? parent->as_table() : nullptr;
+  if (!t || parts.empty()) return false;
+  const std::string& leaf = parts.back();
+  auto curve = [] {
+    toml::array a;
+    a.push_back(toml::array{0, 0});
+    a.push_back(toml::array{1, 0});
+    return a;
+  };
+  if (leaf == "duration") {
+    t->insert_or_assign(leaf, "1 h");
+  } else if (leaf == "dem") {
+    t->insert_or_assign(leaf, "refused.tif");
+  } else if (leaf == "rate" || leaf == "surface" || leaf == "thickness") {
+    t->insert_or_assign(leaf, 0);
+  } else if (leaf == "material") {
+    t->insert_or_assign(leaf, "rock");
+  } else if (leaf == "hydrograph" || leaf == "stage") {
+    t->insert_or_assign(leaf, curve());
+  } else {
+    return false;
+  }
+  return true;
+}
+
+// An unknown key that is a near miss (at most 2 edits) of an allowed key its table lacks is
+// renamed to it, as the user meant: its value is then read (and checked) under that name.
+bool renameNearMiss(toml::table& root, const std::vector<std::string>& parts, const std::string& message) {
+  const size_t a = message.find("expected one of: "), b = message.find(')', a);
+  toml::node* parent = parentOf(root, parts);
+  auto* t = parent ? parent->as_table() : nullptr;
+  if (!t || a == std::string::npos || b == std::string::npos || b < a) return false;
+  std::stringstream list(message.substr(a + 17, b - a - 17));
+  std::string best, candidate;
+  size_t bestDistance = 3;
+  while (std::getline(list, candidate, ',')) {
+    candidate.erase(0, candidate.find_first_not_of(' '));
+    const size_t d = editDistance(parts.back(), candidate);
+    if (d < bestDistance && !t->contains(candidate)) best = candidate, bestDistance = d;
+  }
+  if (best.empty()) return false;
+  toml::node* node = t->get(parts.back());
+  if (!node) return false;
+  node->visit([&](auto& value) { t->insert_or_assign(best, value); });
+  t->erase(parts.back());
+  return true;
+}
+
+}  // namespace
+
+Result<Scenario> parseScenario(std::string_view text, const std::filesystem::path& fileName) {
+  STRATA_TRY(const auto root, parseToml(withoutBom(text), fileName.string()));
+  return readScenario(root, fileName);
+}
+
+ScenarioCheck checkScenarioText(std::string_view text, const std::filesystem::path& fileName) {
+  ScenarioCheck check;
+  const std::string file = fileName.string();
+  auto parsed = parseToml(withoutBom(text), file);
+  if (!parsed) {
+    check.problems.push_back({0, "", parsed.message()});
+    return check;
+  }
+  toml::table root = std::move(parsed).value();
+  std::set<std::string> replaced;  // keys given a placeholder (a problem of theirs again is a cascade)
+  // Each pass reads the file up to its first problem; the key it names is then set aside (a
+  // near-miss name renamed, a refused required value replaced by a valid one, anything else
+  // removed) and the next pass reads on. A problem on a key already reported is its cascade.
+  for (int pass = 0; pass < 200; ++pass) {
+    auto s = readScenario(root, fileName);
+    if (s) {
+      check.scenario = std::move(s).value();
+      break;
+    }
+    const std::string message = s.message();
+    const Located at = locate(message, file);
+    if (at.key.empty()) {  // a whole-file check (no key): only meaningful when nothing else is wrong
+      if (check.problems.empty()) check.problems.push_back({0, "", message});
+      break;
+    }
+    const bool cascade = check.hasProblem(at.key);
+    if (!cascade) check.problems.push_back({at.line, at.key, message});
+    const auto parts = keyParts(at.key);
+    bool moved = false;
+    if (!cascade && message.find("unknown key") != std::string::npos) moved = renameNearMiss(root, parts, message);
+    if (!moved && !replaced.count(at.key)) {
+      moved = placeholder(root, parts);
+      if (moved) replaced.insert(at.key);
+    }
+    if (!moved) moved = erase(root, parts);
+    if (!moved && parts.size() > 1) moved = erase(root, {parts.begin(), parts.end() - 1});
+    if (!moved) break;
+  }
+  return check;
+}
+
+bool ScenarioCheck::hasProblem(const std::string& key) const {
+  return std::any_of(problems.begin(), problems.end(), [&](const Problem& p) { return p.key == key; });
 }
 
 Result<Scenario> loadScenario(const std::filesystem::path& file) {

@@ -126,16 +126,19 @@ std::string outlineStyle() {
          "</qgis>\n";
 }
 
-Result<std::vector<std::string>> writeMapStyles(const std::filesystem::path& runDir, double wetThresholdM) {
+Result<std::vector<std::string>> writeMapStyles(const std::filesystem::path& runDir,
+                                                const std::vector<std::string>& maps, double wetThresholdM) {
   namespace fs = std::filesystem;
   std::vector<std::string> written;
-  std::error_code ec;
-  std::vector<fs::path> maps;
-  for (const auto& e : fs::directory_iterator(runDir / "maps", ec)) {
-    if (e.path().extension() == ".tif" && e.is_regular_file()) maps.push_back(e.path());
-  }
-  std::sort(maps.begin(), maps.end());
-  for (const auto& map : maps) {
+  for (const auto& rel : maps) {
+    const fs::path map = runDir / rel;
+    const std::string name = map.stem().string();
+    const std::string style = fs::path(rel).replace_extension(".qml").string();
+    if (map.extension() == ".gpkg") {
+      STRATA_TRY_STATUS(writeFileAtomic(runDir / style, outlineStyle()));
+      written.push_back(style);
+      continue;
+    }
     // The range from at most ~4 million of its cells (every k-th of each row and column).
     STRATA_TRY(const auto info, gis::probeDem(map.string()));
     const double cells = double(info.georef.width) * double(info.georef.height);
@@ -145,15 +148,9 @@ Result<std::vector<std::string>> writeMapStyles(const std::filesystem::path& run
       if (std::isfinite(v)) low = std::min(low, double(v)), high = std::max(high, double(v));
     }
     if (!std::isfinite(low)) low = 0, high = 1;
-    const std::string name = map.stem().string();
-    const std::string rel = "maps/" + name + ".qml";
     STRATA_TRY_STATUS(writeFileAtomic(
-        runDir / rel, rasterStyle(name.starts_with("layer_") ? "layer" : name, low, high, wetThresholdM)));
-    written.push_back(rel);
-  }
-  if (fs::exists(runDir / "maps" / "flood_outline.gpkg")) {
-    STRATA_TRY_STATUS(writeFileAtomic(runDir / "maps" / "flood_outline.qml", outlineStyle()));
-    written.push_back("maps/flood_outline.qml");
+        runDir / style, rasterStyle(name.starts_with("layer_") ? "layer" : name, low, high, wetThresholdM)));
+    written.push_back(style);
   }
   return written;
 }

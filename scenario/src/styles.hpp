@@ -19,8 +19,10 @@ std::string rasterStyle(const std::string& name, double low, double high, double
 /// The .qml of the flood outline's polygons.
 std::string outlineStyle();
 
-/// Writes a style beside each map of `runDir`/maps that exists (the raster's range read from it),
-/// returning the files written (relative to the run folder).
-Result<std::vector<std::string>> writeMapStyles(const std::filesystem::path& runDir, double wetThresholdM);
+/// Writes a style beside each of `maps` (the run's map files, relative to `runDir`: maps/NAME.tif,
+/// the raster's range read from it, or maps/flood_outline.gpkg), returning the files written
+/// (relative to the run folder). Nothing else in the folder is read.
+Result<std::vector<std::string>> writeMapStyles(const std::filesystem::path& runDir,
+                                                const std::vector<std::string>& maps, double wetThresholdM);
 
 }  // namespace strata::scenario::detail

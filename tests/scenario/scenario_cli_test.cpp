@@ -95,6 +95,55 @@ void writeCpuScenario(const fs::path& dir) {
   std::ofstream(dir / "flood.toml") << text;
 }
 
+// Issue 31: `strata check SCENARIO` prints every problem of the file in one pass, in file order,
+// each with its line and key (a raster path included), and exits 1; a good file exits 0. A key
+// spelt one letter off ("duraton") is reported once, and read on as the key it meant.
+TEST(StrataCli, CheckFindsEveryProblemOfAScenarioInOnePass) {
+  const auto dir = strata::test::tempDir("cli-check");
+  std::string text = scenarioText();
+  // Seven mistakes a user makes, top to bottom.
+  auto plant = [&](const std::string& from, const std::string& to) {
+    const size_t at = text.find(from);
+    ASSERT_NE(at, std::string::npos) << from;
+    text.replace(at, from.size(), to);
+  };
+  plant("cell_size = \"600 m\"", "cell_size = \"600 meters\"");               // a unit
+  plant("kind = \"flood\"", "kind = \"flod\"");                               // a name
+  plant("east = \"closed\"", "east = \"shut\"");                              // a choice
+  plant("[20, 20000]]", "[20, -5]]");                                         // a negative discharge
+  plant("duration = \"20 min\"", "duraton = \"20 min\"");                     // a typo of a key
+  plant("[outputs]\n", "[outputs]\nmaps = [\"max_depth\", \"max_sped\"]\n");  // an unknown map
+  text += "[water.rain]\nrate = \"10 mm/h\"\nraster = \"radar.tif\"\n";       // a missing raster
+  std::ofstream(dir / "seven.toml") << text;
+  std::string out;
+  EXPECT_EQ(strata({"check", "seven.toml"}, dir, out), 1) << out;
+  std::vector<std::string> lines;
+  std::stringstream ss(out);
+  for (std::string l; std::getline(ss, l);) {
+    if (l.starts_with("strata check: ")) lines.push_back(l);
+  }
+  const std::vector<std::string> keys{"region.cell_size",           "model.kind",   "model.boundary.east",
+                                      "water.inflow[0].hydrograph", "time.duraton", "outputs.maps",
+                                      "water.rain.raster"};
+  ASSERT_EQ(lines.size(), keys.size()) << out;
+  int previous = 0;
+  for (size_t i = 0; i < keys.size(); ++i) {
+    EXPECT_TRUE(lines[i].starts_with("strata check: seven.toml:")) << lines[i];
+    EXPECT_NE(lines[i].find("key '" + keys[i] + "'"), std::string::npos) << lines[i];
+    const int line = std::stoi(lines[i].substr(std::string("strata check: seven.toml:").size()));
+    EXPECT_GT(line, previous) << "in file order: " << lines[i];
+    previous = line;
+  }
+  EXPECT_NE(out.find("did you mean 'duration'?"), std::string::npos) << out;
+  EXPECT_NE(out.find("radar.tif: no such file"), std::string::npos) << out;
+  EXPECT_NE(out.find("result    7 problem(s)"), std::string::npos) << out;
+
+  writeCpuScenario(dir);
+  EXPECT_EQ(strata({"check", "flood.toml"}, dir, out), 0) << out;
+  EXPECT_NE(out.find("result    OK: flood.toml would run"), std::string::npos) << out;
+  EXPECT_FALSE(fs::exists(dir / "runs")) << "check runs nothing";
+}
+
 // mpirun and its flags, running `np` ranks (what STRATA_MPIEXEC_FLAGS holds, ';'-separated).
 std::vector<std::string> mpirun(int np) {
   std::vector<std::string> w{STRATA_MPIEXEC, "-np", std::to_string(np)};

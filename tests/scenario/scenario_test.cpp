@@ -95,7 +95,7 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Values(
         BadCase{"unknown key", "duration = \"6 h\"", "duraton = \"6 h\"",
                 "/data/runs/gc.toml:22: key 'time.duraton': unknown key (expected one of: duration, output_interval, "
-                "spin_up, spin_up_tolerance)"},
+                "spin_up, spin_up_tolerance); did you mean 'duration'?"},
         BadCase{
             "wrong unit", "duration = \"6 h\"", "duration = \"6 m\"",
             "/data/runs/gc.toml:22: key 'time.duration': unit 'm' is a length, not a time (use one of s, min, h, d)"},

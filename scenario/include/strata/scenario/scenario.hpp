@@ -191,6 +191,35 @@ Result<Scenario> loadScenario(const std::filesystem::path& file);
 /// The same from text; `fileName` is used in messages and to resolve relative paths.
 Result<Scenario> parseScenario(std::string_view text, const std::filesystem::path& fileName);
 
+/// Every problem of a scenario's text, not only the first: what `strata check SCENARIO` prints.
+struct ScenarioCheck {
+  struct Problem {
+    int line = 0;         ///< 0: the whole file
+    std::string key;      ///< "" for the whole file
+    std::string message;  ///< "file:line: key 'k': what is wrong", as loadScenario words it
+  };
+  std::vector<Problem> problems;  ///< in the order found (checkScenarioFile sorts them by line)
+  /// The scenario as read once every problem's key was set aside (a refused value replaced by a
+  /// valid stand-in or removed): for the checks that follow (raster paths); none when the file's
+  /// syntax or a whole-file check failed.
+  std::optional<Scenario> scenario;
+  bool hasProblem(const std::string& key) const;
+};
+
+/// Reads `text` as parseScenario does, but on: each problem's key is set aside (an unknown key
+/// that is a near miss of a missing allowed one, such as "duraton", renamed to it; a refused
+/// required value replaced by a valid stand-in; anything else removed) and the reading goes on,
+/// so that one pass finds every problem of the file; a problem that only follows from one found
+/// (its key's value missing once removed) is not repeated. Whole-file checks (no key) are
+/// reported only when nothing else is wrong.
+ScenarioCheck checkScenarioText(std::string_view text, const std::filesystem::path& fileName);
+
+/// `strata check SCENARIO`: checkScenarioText on the file, then every raster it names (DEMs, layer
+/// and rain rasters; a store's manifest) opened as the run would, each problem "file:line: key
+/// 'k': path: what is wrong"; all of them sorted by line. Empty: the file would run (as far as
+/// anything short of building the domain can tell).
+std::vector<std::string> checkScenarioFile(const std::filesystem::path& file);
+
 /// "6 h" -> 21600. `dimension` is "time", "length", "rate" (m/s), "discharge" (m3/s), "speed" or
 /// "stress" (Pa).
 Result<double> parseQuantity(std::string_view text, std::string_view dimension);
