@@ -117,11 +117,12 @@ Status runPlotScript(const std::string& script, const std::vector<std::string>& 
 
 }  // namespace
 
-Result<std::vector<std::string>> writePlots(const fs::path& runDir, bool completed) {
-  (void)completed;
+Result<std::vector<std::string>> writePlots(const fs::path& runDir, bool haveSeries) {
   std::error_code ec;
   fs::create_directories(runDir / "plots", ec);
-  STRATA_TRY_STATUS(runPlotScript("plot_series.py", {(runDir / "series.csv").string(), (runDir / "plots").string()}));
+  if (haveSeries) {
+    STRATA_TRY_STATUS(runPlotScript("plot_series.py", {(runDir / "series.csv").string(), (runDir / "plots").string()}));
+  }
   STRATA_TRY_STATUS(runPlotScript("plot_maps.py", {runDir.string()}));
   std::vector<std::string> files{"maps/elevation.tif"};
   for (const auto& e : fs::directory_iterator(runDir / "plots")) {
@@ -218,6 +219,11 @@ Status writeReport(const fs::path& runDir, const ReportInput& in) {
   }
 
   // --- Scenario
+  if (const auto warnings = runWarnings(in); !warnings.empty()) {
+    md += "## Warnings\n\n";
+    for (const auto& w : warnings) md += "- **" + w + "**\n";
+    md += "\n";
+  }
   md += "## Scenario\n\n";
   const auto [lo, hi] = d.bedRangeM;
   md += "| | |\n|---|---|\n";
@@ -393,6 +399,44 @@ Status writeReport(const fs::path& runDir, const ReportInput& in) {
   md += "\n## Files\n\n";
   for (const auto& f : sum.files) md += "- `" + f + "`\n";
   return writeFileAtomic(runDir / "report.md", md);
+}
+
+std::vector<std::string> runWarnings(const ReportInput& in) {
+  std::vector<std::string> out;
+  const auto& f = in.flood;
+  const auto& g = in.domain.bed.georef;
+  if (f.waterAtEndM3 > 0 && f.pondedM3 > 0.2 * f.waterAtEndM3) {
+    out.push_back(volumeText(f.pondedM3) + " (" + fmt("%.0f", 100 * f.pondedM3 / f.waterAtEndM3) +
+                  "% of the water in the region at the end) stands in closed depressions of the bed, pits that "
+                  "drain nowhere, up to " +
+                  fmt("%.1f", f.deepestPonded.value) + " m deep at " + where(g, f.deepestPonded.x, f.deepestPonded.y) +
+                  ". Where they are artefacts of the DEM (SRTM has them in narrow valleys and under voids), "
+                  "`[terrain] fill_depressions = true` raises them to their spill level and `breach_inflows = true` "
+                  "carves each inflow's path out (docs/scenario.md, \"Conditioning the DEM\").");
+  }
+  if (f.fastest.value > 10.0) {
+    // Next to an inflow (within 2 cells of one of its cells) the speed is the inflow line's doing.
+    std::string why =
+        "it usually comes from a step in the DEM (a void's edge, a dam, SRTM's stairs on steep slopes) or cells too "
+        "coarse for the channel. Look at `maps/max_speed.tif` there before trusting speeds and hazard near it.";
+    const auto& d = in.domain;
+    for (size_t i = 0; i < d.sources.size() && i < d.sourceNames.size(); ++i) {
+      const bool near = std::any_of(d.sources[i].cells.begin(), d.sources[i].cells.end(), [&](const auto& c) {
+        return std::abs(c.first - f.fastest.x) <= 2 && std::abs(c.second - f.fastest.y) <= 2;
+      });
+      if (!near) continue;
+      double peak = 0;
+      for (const auto& sample : d.sources[i].dischargeM3S.samples()) peak = std::max(peak, sample[1]);
+      why = "it is next to the inflow \"" + userText(d.sourceNames[i]) + "\", which puts up to " + fmt("%.0f", peak) +
+            " m³/s into " + std::to_string(d.sources[i].cells.size()) +
+            " cell(s): the speed there is set by how wide the inflow line is, not by the valley. A line across the "
+            "whole channel's width (`line_lonlat`) spreads it as the river would arrive.";
+      break;
+    }
+    out.push_back("The fastest water, " + fmt("%.1f", f.fastest.value) + " m/s at " +
+                  where(g, f.fastest.x, f.fastest.y) + ", is faster than floods run but over steep chutes: " + why);
+  }
+  return out;
 }
 
 std::string volumeText(double m3) {

@@ -16,6 +16,7 @@
 #include <strata/core/log.hpp>
 #include <strata/core/progress.hpp>
 #include <strata/gis/dem_io.hpp>
+#include <strata/gis/fill_depressions.hpp>
 #include <strata/gis/geodesy.hpp>
 #include <strata/gis/polygons.hpp>
 #include <strata/gl/context.hpp>
@@ -669,6 +670,62 @@ class Run {
     return ranks_.agree(status);
   }
 
+  // The water at the end that stands in closed depressions of the bed (report.hpp, pondedM3),
+  // on the lead: the depth (and, in an erosion run, the bed as it ends) gathered, the bed
+  // otherwise the one the model used (maps/elevation.tif), a priority flood from the open edges.
+  Status addPonding(const std::vector<detail::Piece>& pieces, FloodSummary& f) {
+    const int w = e_.solver->grid().width, h = e_.solver->grid().height;
+    const auto depth = detail::gatherStrided(ranks_, pieces, 1, w, h, [](const detail::Piece& p, size_t i) {
+      return p.inside.data[i] ? std::max(0.0f, p.depth.data[i]) : 0.0f;
+    });
+    const auto inside = detail::gatherStrided(ranks_, pieces, 1, w, h,
+                                              [](const detail::Piece& p, size_t i) { return float(p.inside.data[i]); });
+    gis::Grid<float> bed;
+    if (s_.erosion.enabled) {
+      bed = detail::gatherStrided(ranks_, pieces, 1, w, h,
+                                  [](const detail::Piece& p, size_t i) { return p.bed.data[i]; });
+    }
+    if (!ranks_.lead()) return {};
+    if (!s_.erosion.enabled) {
+      STRATA_TRY(auto map, detail::readStrided(opt_.outDir / "maps" / "elevation.tif", 1));
+      bed = std::move(map.values);
+    }
+    if (bed.width != w || bed.height != h)
+      return fail(opt_.outDir.string() + "/maps/elevation.tif: not the region's size");
+    gis::Grid<uint8_t> in(w, h, 0), drains(w, h, 0);
+    const auto& open = s_.model.boundaries;  // W E S N
+    for (int y = 0; y < h; ++y) {
+      for (int x = 0; x < w; ++x) {
+        const bool cell = inside.at(x, y) > 0.5f && std::isfinite(bed.at(x, y));
+        in.at(x, y) = cell;
+        if (!std::isfinite(bed.at(x, y))) bed.at(x, y) = kWallElevationM;
+        const bool edge = (x == 0 && open[0] == Boundary::Open) || (x == w - 1 && open[1] == Boundary::Open) ||
+                          (y == h - 1 && open[2] == Boundary::Open) || (y == 0 && open[3] == Boundary::Open);
+        drains.at(x, y) = cell && edge;
+      }
+    }
+    gis::FillInput fill;
+    fill.elevation = &bed;
+    fill.inside = &in;
+    fill.drains = &drains;
+    const auto filled = gis::fillDepressions(fill, {gis::CellRect{0, 0, w, h}});
+    sim::ExactSum ponded, all;
+    for (int y = 0; y < h; ++y) {
+      const double area = e_.solver->grid().area(y);
+      for (int x = 0; x < w; ++x) {
+        const double d = depth.at(x, y);
+        all.add(d * area);
+        const double below = std::min(d, double(filled.at(x, y)) - double(bed.at(x, y)));
+        if (!in.at(x, y) || !(below > 0)) continue;
+        ponded.add(below * area);
+        if (d > f.deepestPonded.value) f.deepestPonded = {d, x, y};
+      }
+    }
+    f.pondedM3 = ponded.value();
+    f.waterAtEndM3 = all.value();
+    return {};
+  }
+
   FloodSummary floodSummary(const std::vector<detail::Piece>& pieces) {
     const double wet = s_.outputs.wetThresholdM;
     const auto& g = d_.bed.georef;
@@ -930,8 +987,8 @@ class Session {
     STRATA_TRY_STATUS(scenario::startSolver(engine_, domain_, ranks_, opt_.outDir));
     engine_.solver->enableFloodStats(float(s_.outputs.wetThresholdM));
     run_.emplace(s_, opt_, ranks_, std::move(domain_), std::move(engine_));
+    installInterruptHandler();  // before "running on": from that line on a Ctrl-C stops the run cleanly
     log::info(opt_.command) << "running on " << run_->backendName();
-    installInterruptHandler();
     return {};
   }
 
@@ -976,7 +1033,16 @@ class Session {
     summary_.ranks = ranks_.size();
     if (!opt_.resume) {
       STRATA_TRY_STATUS(run_->startProbes(nullptr));
-      return ranks_.agree(ranks_.lead() ? writeFileAtomic(opt_.outDir / "scenario.toml", scenarioText_) : Status{});
+      STRATA_TRY_STATUS(
+          ranks_.agree(ranks_.lead() ? writeFileAtomic(opt_.outDir / "scenario.toml", scenarioText_) : Status{}));
+      // The state at t = 0 (after any spin-up): a run stopped before its first output interval
+      // ends can be resumed too.
+      return writeCheckpoint(Checkpoint{0,
+                                        wallSoFar(),
+                                        {},
+                                        spinUp_,
+                                        run_->probes() ? run_->probes()->save() : std::vector<double>{},
+                                        run_->solver().saveState()});
     }
     std::optional<Checkpoint> current, previous;
     Status status;
@@ -1046,9 +1112,11 @@ class Session {
     summary_.completed = interval_ >= intervals_;
     if (summary_.completed) {
       progress.finish(std::to_string(run_->solver().stats().steps) + " steps");
+    } else if (summary_.series.empty()) {
+      log::warn(opt_.command)
+          << "stopped before the first output interval ended: no outputs yet; --resume continues from t = 0";
     } else {
-      log::warn(opt_.command) << "stopped at "
-                              << formatDuration(summary_.series.empty() ? 0 : summary_.series.back().timeS)
+      log::warn(opt_.command) << "stopped at " << formatDuration(summary_.series.back().timeS)
                               << "; outputs are those of that interval; continue with --resume";
     }
     return {};
@@ -1098,7 +1166,8 @@ class Session {
         if (fs::exists(opt_.outDir / layerMapFile(k))) summary_.files.push_back(layerMapFile(k));
       }
     }
-    const FloodSummary flood = run_->floodSummary(*pieces);
+    FloodSummary flood = run_->floodSummary(*pieces);
+    STRATA_TRY_STATUS(ranks_.agree(run_->addPonding(*pieces, flood)));
     if (!ranks_.lead()) return summary_;  // the lead writes the styles, plots and the report
     std::vector<std::string> written;
     for (const auto& f : summary_.files) {
@@ -1107,11 +1176,12 @@ class Session {
     STRATA_TRY(auto styles, detail::writeMapStyles(opt_.outDir, written, s_.outputs.wetThresholdM));
     summary_.files.insert(summary_.files.end(), styles.begin(), styles.end());
     if (opt_.plots) {
-      STRATA_TRY(auto plots, writePlots(opt_.outDir, summary_.completed));
+      STRATA_TRY(auto plots, writePlots(opt_.outDir, !summary_.series.empty()));
       summary_.files.insert(summary_.files.end(), plots.begin(), plots.end());
     }
-    STRATA_TRY_STATUS(writeReport(opt_.outDir, ReportInput{s_, run_->domain(), summary_, flood, run_->backendName(),
-                                                           pictureFiles, maxDepthLegend()}));
+    const ReportInput report{s_, run_->domain(), summary_, flood, run_->backendName(), pictureFiles, maxDepthLegend()};
+    for (const auto& w : runWarnings(report)) log::warn(opt_.command) << w;
+    STRATA_TRY_STATUS(writeReport(opt_.outDir, report));
     summary_.files.push_back("report.md");
     return summary_;
   }

@@ -296,6 +296,39 @@ TEST(StrataCli, CtrlCWhilePlotsAreDrawnKeepsTheReport) {
   EXPECT_TRUE(fs::exists(dir / "run" / "plots" / "max_depth.png"));
 }
 
+// Issue 31: a Ctrl-C before the first output interval ended left a Python traceback (no
+// series to plot) and nothing to resume. Now the run's t = 0 state is checkpointed when it
+// starts: the report is written, marked stopped, and --resume runs it to the end.
+TEST(StrataCli, CtrlCBeforeTheFirstOutputLeavesAResumableRun) {
+  const auto dir = strata::test::tempDir("cli-ctrl-c-early");
+  std::string text = damBreakText();
+  text.replace(text.find("cell_size = \"600 m\""), 19, "cell_size = \"60 m\"");  // ~5 s of stepping
+  text.replace(text.find("output_interval = \"5 min\""), 25, "output_interval = \"20 min\"");
+  text.replace(text.find("kind = \"flood\""), 14, "kind = \"flood\"\nbackend = \"cpu\"");
+  std::ofstream(dir / "dam.toml") << text;
+  const pid_t pid = spawn({"flood", "dam.toml", "-o", "run", "--no-pictures"}, dir, dir / "run.log");
+  ASSERT_TRUE(waitUntil([&] { return slurp(dir / "run.log").find("running on") != std::string::npos; }, 120))
+      << slurp(dir / "run.log");
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  ASSERT_EQ(::kill(-pid, SIGINT), 0);
+  const int code = waitFor(pid);
+  const std::string log = slurp(dir / "run.log");
+  EXPECT_EQ(code, 130) << log;  // a run the user stopped (128 + SIGINT, the shell's convention)
+  EXPECT_NE(log.find("stopped before the first output interval ended: no outputs yet; --resume continues from t = 0"),
+            std::string::npos)
+      << log;
+  EXPECT_EQ(log.find("Traceback"), std::string::npos) << log;
+  EXPECT_TRUE(fs::exists(dir / "run" / "checkpoint.bin"));
+  const std::string report = slurp(dir / "run" / "report.md");
+  EXPECT_NE(report.find("The run was stopped before the end"), std::string::npos) << report;
+  EXPECT_NE(report.find("No interval finished."), std::string::npos) << report;
+
+  std::string out;
+  EXPECT_EQ(strata({"flood", "dam.toml", "-o", "run", "--resume", "--no-pictures", "--no-plots"}, dir, out), 0) << out;
+  EXPECT_NE(out.find("resuming at 0.0 s (interval 0)"), std::string::npos) << out;
+  EXPECT_EQ(readCsv(dir / "run" / "series.csv").size(), 1u) << out;
+}
+
 // SIGXFSZ killed strata silently at the file size limit; now the write fails and says where.
 TEST(StrataCli, OverTheFileSizeLimitTheFileIsNamed) {
   const auto dir = strata::test::tempDir("cli-fsize");

@@ -28,6 +28,11 @@ struct FloodSummary {
   double everWetM2 = 0;          ///< area of the cells wet at some time (the model's cell areas)
   /// That area by hazard class (hazard.hpp: low, moderate, significant, extreme).
   std::array<double, 4> hazardClassM2{};
+  /// Water at the end that stands in closed depressions of the bed: in cells a priority flood
+  /// from the open edges raises (gis::fillDepressions), the part of the depth below the spill
+  /// level (m^3, the model's cell areas); the deepest such water and its cell; all water at the end.
+  double pondedM3 = 0, waterAtEndM3 = 0;
+  AtCell deepestPonded;
 };
 
 struct ReportInput {
@@ -44,7 +49,12 @@ struct ReportInput {
 /// maps/elevation.tif (scenario/plots/plot_maps.py; the run writes the elevation map once the
 /// domain is built), with Debian's matplotlib. Returns the files written (relative), the
 /// elevation map first.
-Result<std::vector<std::string>> writePlots(const std::filesystem::path& runDir, bool completed);
+/// What the report warns about (one paragraph each, Markdown): water ending in closed depressions
+/// of the bed (more than a fifth of the water at the end), speeds above 10 m/s. Also logged.
+std::vector<std::string> runWarnings(const ReportInput& in);
+
+/// `haveSeries` false (a run stopped before its first output interval): no series plots.
+Result<std::vector<std::string>> writePlots(const std::filesystem::path& runDir, bool haveSeries);
 
 /// report.md.
 Status writeReport(const std::filesystem::path& runDir, const ReportInput& input);
