@@ -34,6 +34,7 @@ STYLE = {
     "inundation_duration": ("Time under water", "h", "magma_r", 1 / 3600.0),
     "hazard_rating": ("Flood hazard to people (FD2321 rating)", "class", "hazard", None),
     "terrain_change": ("Terrain change (erosion < 0 < deposition)", "m", "RdBu", None),
+    "conditioning": ("DEM changed by conditioning (cut < 0 < raised)", "m", "RdBu", None),
     "exposed_material": ("Exposed material at the end", "layer", "tab10", None),
     "suspended_sediment": ("Suspended sediment at the end", "m", "YlOrBr", None),
 }
@@ -174,7 +175,7 @@ def main():
 
         ax.imshow(shade, extent=extent, cmap="gray", vmin=0, vmax=1)
         if a.count() > 0:
-            if name == "terrain_change":
+            if name in ("terrain_change", "conditioning"):
                 # The colour range is the 99th percentile of the cells that changed, not the largest
                 # change: a few cells of tens of metres (a pit filled, a bank slumped) would
                 # otherwise wash out every channel. Beyond it the colour saturates (the colour bar
@@ -211,7 +212,13 @@ def main():
                 bar.ax.set_yticklabels(HAZARD_NAMES)
                 im = None
             elif name.endswith("depth"):
-                lo, hi = float(a.min()), float(a.max())
+                # From the run's wet threshold (the map's STRATA_WET_THRESHOLD_M): shallower cells
+                # are not flooded and are not drawn.
+                meta = gdal.Open(str(path)).GetMetadata()
+                wet = float(meta.get("STRATA_WET_THRESHOLD_M", "0"))
+                if wet > 0:
+                    a = np.ma.masked_less_equal(a, wet)
+                lo, hi = (float(a.min()), float(a.max())) if a.count() else (1.0, 2.0)
                 norm = matplotlib.colors.LogNorm(vmin=lo, vmax=max(hi, 2 * lo))
                 im = ax.imshow(a, extent=extent, cmap=DEPTH_CMAP, norm=norm, alpha=0.9, interpolation="nearest")
             else:
@@ -222,6 +229,7 @@ def main():
             ax.set_xlim(zoom[0], zoom[1])
             ax.set_ylim(zoom[2], zoom[3])
         ax.xaxis.set_major_locator(matplotlib.ticker.MaxNLocator(5))
+        ax.ticklabel_format(useOffset=False)  # -112.08, not -0.08 and "-1.12e2" in a corner
         scale_bar_and_north(ax, zoom or extent, geographic)
         ax.set_title(title + ("\n(zoomed to where the water went)" if zoom else ""))
         ax.set_xlabel("longitude (°)" if geographic else "x (m)")

@@ -213,6 +213,9 @@ Result<RowsBuilt> buildByRows(const RowBuilder& b, const Scenario& s, const Rank
 
   std::vector<int> rowStarts;
   for (int k = 0; k <= n; ++k) rowStarts.push_back(firstRowOf(k));
+  // The bed before conditioning, for the map of what breach_inflows and fill_depressions changed.
+  const bool conditioned = s.terrain.breachInflows || s.terrain.fillDepressions;
+  gis::Grid<float> raw = conditioned ? d.bed.values : gis::Grid<float>();
   STRATA_TRY_STATUS(breachInflowPaths(s, ranks, rowStarts, shape.sources, shape.sourceNames, d));
   shape.breach = d.breach;
   if (s.terrain.fillDepressions) {
@@ -227,6 +230,12 @@ Result<RowsBuilt> buildByRows(const RowBuilder& b, const Scenario& s, const Rank
     shape.filled.maxM = deepest[0];
   }
   keepRows(d, own);
+  if (conditioned) {
+    d.conditioningM = gis::Grid<float>(w, own, 0.0f);
+    for (size_t i = 0; i < d.conditioningM.size(); ++i) {
+      d.conditioningM.data[i] = d.inside.data[i] ? d.bed.values.data[i] - raw.data[i] : gis::kNoData;
+    }
+  }
 
   // The levels' stages against their lowest bed, and the bed's range, over all rows.
   std::vector<double> levelBeds = b.lowestLevelBeds(d);
@@ -270,8 +279,11 @@ Status writeRows(const Ranks& ranks, const fs::path& runDir, const RowsBuilt& bu
   const auto& d = built.rows;
   STRATA_TRY_STATUS(writeModelInput(ranks, runDir, shape.bed.georef, d, int(shape.input.materials.size()),
                                     shape.input.waterDepthM.size() > 0, shape.input.rainMmPerHour.size() > 0));
-  return writeRaster(ranks, runDir / "maps" / "elevation.tif", shape.bed.georef, elevationMapOptions(),
-                     {{0, d.firstRow, d.bed.values}});
+  STRATA_TRY_STATUS(writeRaster(ranks, runDir / "maps" / "elevation.tif", shape.bed.georef, elevationMapOptions(),
+                                {{0, d.firstRow, d.bed.values}}));
+  if (d.conditioningM.size() == 0) return {};
+  return writeRaster(ranks, runDir / "maps" / "conditioning.tif", shape.bed.georef, conditioningMapOptions(),
+                     {{0, d.firstRow, d.conditioningM}});
 }
 sim::RegionSource modelInputSource(const fs::path& runDir, const ScenarioDomain& shape) {
   sim::RegionSource region;

@@ -44,6 +44,13 @@ gis::WriteOptions elevationMapOptions() {
   return o;
 }
 
+gis::WriteOptions conditioningMapOptions() {
+  gis::WriteOptions o;
+  o.description = "bed change made by conditioning the DEM: cut < 0 < raised (breach_inflows, fill_depressions)";
+  o.units = "m";
+  return o;
+}
+
 Status writeRaster(const Ranks& ranks, const fs::path& file, const gis::Georef& georef,
                    const gis::WriteOptions& options, const std::vector<gis::GridWindow>& windows) {
   const std::string tmp = ranks.fromLead(ranks.lead() ? temporaryPathFor(file).string() : std::string());

@@ -42,6 +42,8 @@ Result<std::vector<Piece>> readPieces(const sim::Solver& solver, const InputWind
 
 /// How maps/elevation.tif is written: the bed the model used (conditioned), in metres.
 gis::WriteOptions elevationMapOptions();
+/// How maps/conditioning.tif is written: the bed the model used less the DEM's, in metres.
+gis::WriteOptions conditioningMapOptions();
 
 /// Collective: writes the GeoTIFF `file` (`georef` and `options` used by the lead only) from every
 /// rank's `windows` (cells of the grid). The lead creates a temporary beside `file`, the ranks

@@ -272,6 +272,13 @@ Status writeReport(const fs::path& runDir, const ReportInput& in) {
           " cells that drained to no open edge raised to their spill level ([terrain] fill_depressions), by up to " +
           fmt("%.0f", d.filled.maxM) + " m, " + volumeText(d.filled.volumeM3) + " in all |\n";
   }
+  if (s.terrain.breachInflows || s.terrain.fillDepressions) {
+    md +=
+        "| where the DEM was changed | `maps/conditioning.tif`: the bed the model used less the DEM, cell by cell "
+        "(cut < 0 < raised)" +
+        std::string(fs::exists(runDir / "plots" / "conditioning.png") ? ", drawn in `plots/conditioning.png`" : "") +
+        " |\n";
+  }
   for (size_t l = 0; l < s.terrain.layers.size() && l < d.layerCellsTooSteep.size(); ++l) {
     if (!s.terrain.layers[l].atRest) continue;
     const size_t k = d.input.materials.size() - s.terrain.layers.size() + l;  // the scenario's layers are on top

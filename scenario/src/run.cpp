@@ -561,8 +561,13 @@ class Run {
       return writeMap("maps/" + name + ".tif", std::find(maps.begin(), maps.end(), name) != maps.end(), wetOnly, text,
                       values, metadata);
     };
-    STRATA_TRY_STATUS(map("max_depth", false, {"largest water depth", "m"},
-                          [](const detail::Piece& p) { return p.flood.maxDepthM; }));
+    // The wet threshold in the depth maps' metadata: plots draw depths from it (plot_maps.py).
+    char wet[32];
+    std::snprintf(wet, sizeof wet, "%.9g", s_.outputs.wetThresholdM);
+    const std::vector<std::pair<std::string, std::string>> wetMeta{{"STRATA_WET_THRESHOLD_M", wet}};
+    STRATA_TRY_STATUS(map(
+        "max_depth", false, {"largest water depth", "m"}, [](const detail::Piece& p) { return p.flood.maxDepthM; },
+        wetMeta));
     STRATA_TRY_STATUS(map("max_speed", false, {"largest flow speed (m/s)", ""},
                           [](const detail::Piece& p) { return p.flood.maxSpeedMS; }));
     STRATA_TRY_STATUS(map("arrival_time", true,
@@ -570,8 +575,9 @@ class Run {
                           [](const detail::Piece& p) { return p.flood.arrivalS; }));
     STRATA_TRY_STATUS(map("inundation_duration", false, {"time spent deeper than the wet threshold (s)", ""},
                           [](const detail::Piece& p) { return p.flood.wetDurationS; }));
-    STRATA_TRY_STATUS(
-        map("final_depth", false, {"water depth at the end", "m"}, [](const detail::Piece& p) { return p.depth; }));
+    STRATA_TRY_STATUS(map(
+        "final_depth", false, {"water depth at the end", "m"}, [](const detail::Piece& p) { return p.depth; },
+        wetMeta));
     // FD2321's hazard rating (hazard.hpp) from each cell's largest depth and speed, where wet.
     STRATA_TRY_STATUS(map("hazard_rating", true,
                           {"flood hazard rating HR = d (v + 0.5) + DF (FD2321) from the largest depth and speed, "
@@ -968,6 +974,10 @@ class Session {
     } else {
       STRATA_TRY_STATUS(detail::writeRaster(ranks_, opt_.outDir / "maps" / "elevation.tif", domain_.bed.georef,
                                             detail::elevationMapOptions(), {{0, 0, domain_.bed.values}}));
+      if (domain_.conditioningM.size() > 0) {
+        STRATA_TRY_STATUS(detail::writeRaster(ranks_, opt_.outDir / "maps" / "conditioning.tif", domain_.bed.georef,
+                                              detail::conditioningMapOptions(), {{0, 0, domain_.conditioningM}}));
+      }
     }
     if (ranks_.lead()) {
       const auto& g = domain_.bed.georef;
@@ -1150,7 +1160,9 @@ class Session {
     } else {
       summary_.files.push_back("checkpoint.bin");
     }
-    if (fs::exists(opt_.outDir / "maps" / "elevation.tif")) summary_.files.push_back("maps/elevation.tif");
+    for (const char* f : {"maps/elevation.tif", "maps/conditioning.tif"}) {
+      if (fs::exists(opt_.outDir / f)) summary_.files.push_back(f);
+    }
     const auto maps = run_->mapFiles();
     summary_.files.insert(summary_.files.end(), maps.begin(), maps.end());
     std::vector<std::string> pictureFiles;

@@ -97,7 +97,7 @@ std::string rasterStyle(const std::string& name, double low, double high, double
   if (name == "max_speed") return pseudocolor(0, high, kHeat, false, false);
   if (name == "arrival_time" || name == "inundation_duration") return pseudocolor(0, high, kViridis, false, false);
   if (name == "elevation") return pseudocolor(low, high, kTerrain, false, false);
-  if (name == "terrain_change") {
+  if (name == "terrain_change" || name == "conditioning") {
     const double a = std::max({std::abs(low), std::abs(high), 1e-3});
     return pseudocolor(-a, a, kCutFill, false, false);
   }

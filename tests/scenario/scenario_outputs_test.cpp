@@ -147,6 +147,24 @@ TEST(ScenarioOutputs, TheReportWarnsOfPondedWaterAndOfInflowSpeeds) {
   }
   const std::string report = run("conditioned", conditioned);
   EXPECT_EQ(report.find("closed depressions"), std::string::npos) << report;
+  EXPECT_FALSE(std::filesystem::exists(dir / "raw" / "maps" / "conditioning.tif"));
+  // Where conditioning changed the DEM, as a map: its volume is what the report says was cut and
+  // raised (breach_inflows, then fill_depressions).
+  std::ofstream(dir / "c.toml") << conditioned;
+  auto d = buildDomain(*loadScenario(dir / "c.toml"));
+  ASSERT_TRUE(d) << d.message();
+  auto change = gis::readDem((dir / "conditioned" / "maps" / "conditioning.tif").string(), allowEmpty());
+  ASSERT_TRUE(change) << change.message();
+  double net = 0;
+  for (int y = 0; y < change->georef.height; ++y) {
+    for (int x = 0; x < change->georef.width; ++x) {
+      if (std::isfinite(change->values.at(x, y))) net += change->values.at(x, y) * d->cellAreaM2.at(x, y);
+    }
+  }
+  const double expected = d->breach.fillM3 + d->filled.volumeM3 - d->breach.cutM3;
+  EXPECT_GT(d->breach.cutM3 + d->filled.volumeM3, 1e6);
+  EXPECT_NEAR(net, expected, 1e-5 * (d->breach.cutM3 + d->breach.fillM3 + d->filled.volumeM3));
+  EXPECT_NE(report.find("`maps/conditioning.tif`"), std::string::npos) << report;
   EXPECT_NE(report.find("is next to the inflow \"Colorado\", which puts up to 50000 m³/s into 4 cell(s)"),
             std::string::npos)
       << report;

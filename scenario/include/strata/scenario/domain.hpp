@@ -68,6 +68,10 @@ struct ScenarioDomain {
   int voidCells = 0;
   /// Per [[terrain.layer]]: the cells left without it by at_rest (too steep for its material).
   std::vector<int> layerCellsTooSteep;
+  /// What conditioning ([terrain] breach_inflows, fill_depressions) did to the bed, cell by cell:
+  /// the bed after less the bed before (m; < 0 cut, > 0 raised; no data outside the region);
+  /// empty when neither is on. maps/conditioning.tif.
+  gis::Grid<float> conditioningM;
   /// What [terrain] fill_depressions raised (nothing when off).
   struct {
     int cells = 0;
