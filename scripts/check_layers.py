@@ -16,7 +16,7 @@ import sys
 
 # scenario/src's floors, lowest first: a file's floor is its stem's.
 SCENARIO_FLOORS = {
-    "domain_rows": 0, "domain": 0, "scenario": 0, "settle": 1, "breach": 1, "pieces": 2, "probes": 2, "styles": 2, "check_scenario": 1, "checkpoint": 2,
+    "domain_rows": 0, "domain": 0, "scenario": 0, "settle": 1, "breach": 1, "pieces": 2, "probes": 2, "styles": 2, "check_scenario": 1, "compare": 3, "checkpoint": 2,
     "report": 2, "build_rows": 3, "run": 4,
 }
 MPI_OK = ("/mpi/", "tests/support/mpi_support.hpp", "tests/sim/mpi_compare.hpp", "bench/", "scenario/src/")

@@ -13,6 +13,7 @@ void addRenderCommand(CLI::App& app);
 void addCheckCommand(CLI::App& app);
 void addIngestCommand(CLI::App& app);
 void addExportCommand(CLI::App& app);
+void addCompareCommand(CLI::App& app);
 
 /// Whether strata runs as one rank of an MPI job (launched by mpirun or mpiexec: main initialises
 /// MPI then), this process's rank and the number of ranks; else false, 0, 1.

@@ -67,6 +67,7 @@ int main(int argc, char** argv) {
   strata::app::addCheckCommand(app);
   strata::app::addIngestCommand(app);
   strata::app::addExportCommand(app);
+  strata::app::addCompareCommand(app);
   const int rc = [&] {
     CLI11_PARSE(app, argc, argv);
     return 0;

@@ -147,7 +147,13 @@ def main():
     out = run / "plots"
     out.mkdir(exist_ok=True)
     window = wet_window(run, extent, z.shape)
-    for name, (title, unit, cmap, scale) in STYLE.items():
+    # A comparison folder (strata compare) holds NAME_difference.tif: B - A, drawn diverging.
+    styles = dict(STYLE)
+    for name, (title, unit, _, scale) in STYLE.items():
+        styles[name + "_difference"] = ("Change in " + title[0].lower() + title[1:] + " (B − A)", unit, "RdBu", scale)
+    for extra in ("elevation",):
+        styles[extra + "_difference"] = ("Change in the bed elevation (B − A)", "m", "RdBu", None)
+    for name, (title, unit, cmap, scale) in styles.items():
         path = run / "maps" / (name + ".tif")
         if not path.exists():
             continue
@@ -155,7 +161,9 @@ def main():
         if scale:
             a = a * scale
         a = np.ma.masked_invalid(a)
-        if name.endswith("depth") or name in ("inundation_duration", "suspended_sediment"):
+        if name.endswith("_difference"):
+            a = np.ma.masked_equal(a, 0)  # unchanged cells show the terrain
+        elif name.endswith("depth") or name in ("inundation_duration", "suspended_sediment"):
             a = np.ma.masked_less_equal(a, 0)
         zoom = window if name in FLOOD_MAPS else None
         if zoom:
@@ -175,7 +183,7 @@ def main():
 
         ax.imshow(shade, extent=extent, cmap="gray", vmin=0, vmax=1)
         if a.count() > 0:
-            if name in ("terrain_change", "conditioning"):
+            if name in ("terrain_change", "conditioning") or name.endswith("_difference"):
                 # The colour range is the 99th percentile of the cells that changed, not the largest
                 # change: a few cells of tens of metres (a pit filled, a bank slumped) would
                 # otherwise wash out every channel. Beyond it the colour saturates (the colour bar
@@ -184,7 +192,7 @@ def main():
                 changed = changed[changed > 0]
                 lim = float(np.percentile(changed, 99)) if changed.size else 1.0
                 im = ax.imshow(a, extent=extent, cmap=cmap, vmin=-lim, vmax=lim, alpha=0.85)
-                colorbar(im, extend="both", label=f"{title.lower()} ({unit})")
+                colorbar(im, extend="both", label=f"{title[0].lower() + title[1:]} ({unit})")
                 im = None
             elif name == "exposed_material":
                 # One colour per layer, the material's own (STRATA_COLOUR_k), labelled with its name
@@ -204,7 +212,7 @@ def main():
                 else:
                     im = ax.imshow(a, extent=extent, cmap=cmap, vmin=-0.5, vmax=9.5, alpha=0.85,
                                    interpolation="nearest")
-            elif name == "hazard_rating":
+            elif name == "hazard_rating" and not name.endswith("_difference"):
                 classes = np.ma.masked_array(np.digitize(a.filled(0), HAZARD_BOUNDS[1:4]), mask=a.mask)
                 im = ax.imshow(classes, extent=extent, cmap=matplotlib.colors.ListedColormap(HAZARD_COLOURS),
                                vmin=-0.5, vmax=3.5, alpha=0.9, interpolation="nearest")
@@ -224,7 +232,7 @@ def main():
             else:
                 im = ax.imshow(a, extent=extent, cmap=cmap, alpha=0.85)
             if im is not None:
-                colorbar(im, label=f"{title.lower()} ({unit})")
+                colorbar(im, label=f"{title[0].lower() + title[1:]} ({unit})")
         if zoom:
             ax.set_xlim(zoom[0], zoom[1])
             ax.set_ylim(zoom[2], zoom[3])

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include <strata/gis/geodesy.hpp>
+#include <strata/scenario/compare.hpp>
 #include <strata/scenario/domain.hpp>
 #include <strata/scenario/hazard.hpp>
 #include <strata/scenario/run.hpp>
@@ -168,6 +169,65 @@ TEST(ScenarioOutputs, TheReportWarnsOfPondedWaterAndOfInflowSpeeds) {
   EXPECT_NE(report.find("is next to the inflow \"Colorado\", which puts up to 50000 m³/s into 4 cell(s)"),
             std::string::npos)
       << report;
+}
+
+// Issue 31: strata compare. The fixture's flood with Manning n 0.04 against 0.08: every map's
+// difference is B - A cell by cell (never-wet cells count as 0 depth), the headline table has
+// both runs and the change, and a folder that holds anything, or runs of other grids, are refused.
+TEST(ScenarioOutputs, CompareGivesDifferenceMapsAndTheHeadlineNumbers) {
+  const auto dir = strata::test::tempDir("compare");
+  auto run = [&](const std::string& name, const std::string& text) {
+    std::ofstream(dir / (name + ".toml")) << text;
+    auto s = loadScenario(dir / (name + ".toml"));
+    ASSERT_TRUE(s) << s.message();
+    RunOptions opt;
+    opt.outDir = dir / name;
+    opt.backend = Backend::kCpu;
+    opt.pictures = false;
+    opt.plots = false;
+    auto summary = runScenario(*s, opt);
+    ASSERT_TRUE(summary) << summary.message();
+  };
+  std::string rough = scenarioText();
+  rough.replace(rough.find("manning_n = 0.04"), 16, "manning_n = 0.08");
+  run("smooth", scenarioText());
+  run("rough", rough);
+  CompareOptions o{dir / "smooth", dir / "rough", dir / "what-changed", true};
+  auto written = compareRuns(o);
+  ASSERT_TRUE(written) << written.message();
+  for (const char* f : {"compare.md", "maps/max_depth_difference.tif", "maps/max_depth_difference.qml",
+                        "plots/max_depth_difference.png", "maps/arrival_time_difference.tif"}) {
+    EXPECT_TRUE(std::filesystem::exists(o.outDir / f)) << f;
+  }
+  auto a = gis::readDem((o.runA / "maps" / "max_depth.tif").string(), allowEmpty());
+  auto b = gis::readDem((o.runB / "maps" / "max_depth.tif").string(), allowEmpty());
+  auto d = gis::readDem((o.outDir / "maps" / "max_depth_difference.tif").string(), allowEmpty());
+  ASSERT_TRUE(a && b && d);
+  int changed = 0;
+  for (size_t i = 0; i < d->values.size(); ++i) {
+    const float x = std::isfinite(a->values.data[i]) ? a->values.data[i] : 0.0f;
+    const float y = std::isfinite(b->values.data[i]) ? b->values.data[i] : 0.0f;
+    if (!std::isfinite(a->values.data[i]) && !std::isfinite(b->values.data[i])) continue;
+    EXPECT_EQ(d->values.data[i], y - x) << i;
+    changed += y != x;
+  }
+  EXPECT_GT(changed, 10) << "a rougher bed changes the depths";
+  std::ifstream f(o.outDir / "compare.md");
+  std::stringstream md;
+  md << f.rdbuf();
+  EXPECT_NE(md.str().find("| largest flooded area | "), std::string::npos) << md.str();
+  EXPECT_NE(md.str().find("![max_depth_difference](plots/max_depth_difference.png)"), std::string::npos);
+
+  // Refusals: the output folder holds something; a run of other cells.
+  auto again = compareRuns(o);
+  ASSERT_FALSE(again);
+  EXPECT_EQ(again.message(), o.outDir.string() + ": exists and is not empty (choose a new folder)");
+  std::string coarse = scenarioText();
+  coarse.replace(coarse.find("cell_size = \"600 m\""), 19, "cell_size = \"900 m\"");
+  run("coarse", coarse);
+  auto other = compareRuns({dir / "smooth", dir / "coarse", dir / "other", false});
+  ASSERT_FALSE(other);
+  EXPECT_NE(other.message().find("not on the grid of"), std::string::npos) << other.message();
 }
 
 }  // namespace
