@@ -26,12 +26,12 @@ std::vector<std::string> modelInputFiles(int layers);
 /// Layers a distributed run can have (one model input file each).
 inline constexpr int kMaxInputLayers = 64;
 
-/// Collective: writes the model input (base, layers, initial water and rain raster when present)
-/// as float32 GeoTIFFs in the region's CRS (`georef`, the whole region's) into `runDir`/input:
-/// each rank its rows of the region, `d` (its grids' rows from d.firstRow). `layers`, `water` and
-/// `rain`: which files the region has (the same on every rank).
+/// Collective: writes the model input (base, layers, initial water, rain raster and roughness map
+/// when present) as float32 GeoTIFFs in the region's CRS (`georef`, the whole region's) into
+/// `runDir`/input: each rank its rows of the region, `d` (its grids' rows from d.firstRow).
+/// `layers`, `water`, `rain` and `manning`: which files the region has (the same on every rank).
 Status writeModelInput(const Ranks& ranks, const std::filesystem::path& runDir, const gis::Georef& georef,
-                       const ScenarioDomain& d, int layers, bool water, bool rain);
+                       const ScenarioDomain& d, int layers, bool water, bool rain, bool manning);
 
 class RowBuilder;
 /// A domain built by the ranks: its shape (the same on every rank, with the report's numbers of

@@ -696,8 +696,11 @@ Status fillVoidsOfRows(const Scenario& s, const Plan& plan, int y0, int y1, Scen
 
 // The rows [y0, y0 + height) of a raster warped onto the region's grid (a rain or layer raster):
 // the whole warp's bits there.
-Result<gis::Grid<float>> readRows(const std::string& path, const gis::Georef& grid, int y0, int height) {
-  STRATA_TRY(auto reader, gis::MosaicReader::open({gis::MosaicInput{path}}, grid));
+Result<gis::Grid<float>> readRows(const std::string& path, const gis::Georef& grid, int y0, int height,
+                                  gis::Resampling resampling = gis::Resampling::Bilinear) {
+  gis::MosaicInput input{path};
+  input.resampling = resampling;
+  STRATA_TRY(auto reader, gis::MosaicReader::open({input}, grid));
   return reader.read({0, y0, grid.width, height});
 }
 
@@ -951,6 +954,46 @@ Status placeRain(const Scenario& s, const Plan& plan, ScenarioDomain& d) {
   for (size_t i = 0; i < r.size(); ++i) {
     const float v = r.data[i];
     d.input.rainMmPerHour.data[i] = gis::isNoData(v) ? 0.0f : float(std::max(0.0f, v) * rate);
+  }
+  return {};
+}
+
+// Step 10b: a roughness map ([model] manning_raster, or land_cover with its table): Manning's n
+// per cell of these rows; no data takes [model] manning_n; a value outside 0..1, or a class the
+// table lacks, is refused naming the key, the value and a cell.
+Status placeManning(const Scenario& s, const Plan& plan, ScenarioDomain& d) {
+  const bool classes = !s.model.landCoverRaster.empty();
+  if (s.model.manningRaster.empty() && !classes) return {};
+  const int h = d.bed.values.height;
+  if (h == 0) return {};  // a shape: no rows
+  const std::string key = classes ? "model.land_cover.raster" : "model.manning_raster";
+  const std::string& path = classes ? s.model.landCoverRaster : s.model.manningRaster;
+  auto read = readRows(path, plan.grid, d.firstRow, h, classes ? gis::Resampling::Nearest : gis::Resampling::Bilinear);
+  if (!read) return fail(s.at(key) + oneLine(read.message()));
+  const auto& r = *read;
+  d.input.manningN = gis::Grid<float>(plan.grid.width, h, float(s.model.manningN));
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < plan.grid.width; ++x) {
+      const float v = r.at(x, y);
+      if (gis::isNoData(v)) continue;
+      char where[96];
+      std::snprintf(where, sizeof where, " at column %d, row %d of the region", x, d.firstRow + y);
+      if (classes) {
+        const long long code = std::llround(v);
+        const auto n = s.model.landCoverManning.find(code);
+        if (n == s.model.landCoverManning.end()) {
+          return fail(s.at("model.land_cover.manning") + "no n for class " + std::to_string(code) + " of " +
+                      oneLine(path) + where + ": add it to the table");
+        }
+        d.input.manningN.at(x, y) = float(n->second);
+      } else {
+        if (!(v >= 0.0f && v <= 1.0f)) {
+          return fail(s.at(key) + oneLine(path) + ": Manning's n " + std::to_string(v) + where +
+                      " (s/m^(1/3), 0 to 1)");
+        }
+        d.input.manningN.at(x, y) = v;
+      }
+    }
   }
   return {};
 }
@@ -1214,6 +1257,9 @@ Result<RowBuilder> RowBuilder::plan(const Scenario& s, uint64_t memoryBudgetByte
   STRATA_TRY(auto dams, damBreakCells(s, plan, region));
   // One-cell markers (modelInputSource reads them): the rows have a rain raster, initial water.
   if (s.water.rain && !s.water.rain->raster.empty()) shape.input.rainMmPerHour = gis::Grid<float>(1, 1, 0.0f);
+  if (!s.model.manningRaster.empty() || !s.model.landCoverRaster.empty()) {
+    shape.input.manningN = gis::Grid<float>(1, 1, 0.0f);
+  }
   if (!dams.empty()) shape.input.waterDepthM = gis::Grid<float>(1, 1, 0.0f);
   return RowBuilder(std::make_unique<Impl>(Impl{s, std::move(plan), std::move(shape), std::move(dams)}));
 }
@@ -1232,6 +1278,7 @@ Result<ScenarioDomain> RowBuilder::rows(int y0, int y1) const {
   STRATA_TRY_STATUS(measureRegion(plan, d));
   STRATA_TRY_STATUS(statusOf(stackLayers(s, plan, storeLayers, d)));  // (the caller finds the lowest bed of its rows)
   STRATA_TRY_STATUS(placeRain(s, plan, d));
+  STRATA_TRY_STATUS(placeManning(s, plan, d));
   return d;
 }
 

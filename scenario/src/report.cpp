@@ -37,6 +37,23 @@ std::string hours(double s);
 std::string areaText(double m2) { return m2 < 1e5 ? fmt("%.0f", m2) + " m²" : fmt("%.2f", m2 / 1e6) + " km²"; }
 std::string where(const gis::Georef& g, int x, int y);
 
+// The roughness: one n, or a map (a raster of n, or land-cover classes and their n).
+std::string manningText(const Scenario& s) {
+  const std::string n = fmt("%.3f", s.model.manningN) + " s/m^(1/3)";
+  if (!s.model.manningRaster.empty()) {
+    return "Manning n per cell from `" + userText(s.model.manningRaster, true) + "` (" + n + " where it has no data)";
+  }
+  if (!s.model.landCoverRaster.empty()) {
+    std::string table;
+    for (const auto& [code, v] : s.model.landCoverManning) {
+      table += (table.empty() ? "" : ", ") + std::to_string(code) + ": " + fmt("%.3f", v);
+    }
+    return "Manning n per cell from the land cover `" + userText(s.model.landCoverRaster, true) + "` (class: n " +
+           table + "; " + n + " where it has no data)";
+  }
+  return "Manning n = " + n;
+}
+
 // The gauges' and sections' peaks and volumes; their rows are in gauges.csv and sections.csv.
 std::string probesSection(const RunSummary& sum, const ScenarioDomain& d, const fs::path& runDir) {
   std::string md = "## Gauges and sections\n\n";
@@ -249,7 +266,7 @@ Status writeReport(const fs::path& runDir, const ReportInput& in) {
              : "virtual pipes: an interactive authoring model without friction, whose depths and speeds depend on "
                "the pipe area and the time step and are not physical (kind = \"flood\" for analysis, "
                "docs/sim-water.md)") +
-        ", Manning n = " + fmt("%.3f", s.model.manningN) + " s/m^(1/3), CFL " + fmt("%.2f", s.model.cfl) +
+        ", " + manningText(s) + ", CFL " + fmt("%.2f", s.model.cfl) +
         (s.model.kind == sim::WaterModel::kFiniteVolume ? (s.model.sharpSlopes ? ", MC slopes" : ", minmod slopes")
                                                         : "") +
         " |\n";

@@ -466,7 +466,41 @@ Status readRegion(const Reader& r, const toml::table& root, Scenario& s) {
 Status readModel(const Reader& r, const toml::table& root, Scenario& s) {
   const auto* t = root["model"].as_table();
   if (!t) return {};
-  STRATA_TRY_STATUS(r.onlyKeys(*t, "model", {"kind", "manning_n", "cfl", "max_step", "slopes", "boundary", "backend"}));
+  STRATA_TRY_STATUS(r.onlyKeys(
+      *t, "model",
+      {"kind", "manning_n", "manning_raster", "land_cover", "cfl", "max_step", "slopes", "boundary", "backend"}));
+  if (const auto* m = t->get("manning_raster")) {
+    STRATA_TRY(auto path, r.string(*m, "model.manning_raster"));
+    s.model.manningRaster = r.path(path);
+  }
+  if (const auto* lc = t->get("land_cover")) {
+    const auto* lt = lc->as_table();
+    if (!lt) return r.error(*lc, "model.land_cover", "expected a table (raster = \"landcover.tif\", manning = {...})");
+    STRATA_TRY_STATUS(r.onlyKeys(*lt, "model.land_cover", {"raster", "manning"}));
+    if (!lt->get("raster")) return r.errorAt(int(lt->source().begin.line), "model.land_cover.raster", "missing");
+    STRATA_TRY(auto path, r.string(*lt->get("raster"), "model.land_cover.raster"));
+    s.model.landCoverRaster = r.path(path);
+    const auto* table = lt->get("manning") ? lt->get("manning")->as_table() : nullptr;
+    if (!table || table->empty()) {
+      return r.errorAt(int(lt->source().begin.line), "model.land_cover.manning",
+                       "missing: Manning's n per class code, e.g. manning = { 10 = 0.1, 30 = 0.035, 80 = 0.03 }");
+    }
+    for (auto&& [k, v] : *table) {
+      const std::string key = "model.land_cover.manning." + std::string(k.str());
+      long long code = 0;
+      const auto [end, ec] = std::from_chars(k.str().data(), k.str().data() + k.str().size(), code);
+      if (ec != std::errc() || end != k.str().data() + k.str().size()) {
+        return r.error(v, key,
+                       "a class code is a whole number (the raster's value), got \"" + std::string(k.str()) + "\"");
+      }
+      STRATA_TRY(const double n, r.number(v, key, kManning));
+      s.model.landCoverManning[code] = n;
+    }
+  }
+  if (!s.model.manningRaster.empty() && !s.model.landCoverRaster.empty()) {
+    return r.errorAt(s.keyLines.count("model.land_cover") ? s.keyLines.at("model.land_cover") : 0, "model.land_cover",
+                     "give either manning_raster or land_cover, not both");
+  }
   if (const auto* k = t->get("kind")) {
     STRATA_TRY(auto v, r.string(*k, "model.kind"));
     if (v == "flood") {

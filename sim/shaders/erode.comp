@@ -11,6 +11,7 @@ layout(std430, binding = SLOT_BED) buffer Bed { float bed[]; };
 layout(std430, binding = SLOT_STATE_IN) buffer StateIn { vec4 state[]; };
 layout(std430, binding = SLOT_TILT) readonly buffer Tilt { float tilt[]; };
 layout(std430, binding = SLOT_SCOUR) writeonly buffer Scour { float scour[]; };
+layout(std430, binding = SLOT_MANNING) readonly buffer Manning { float manningN2[]; };  // n^2 per cell; < 0: P.manningN
 
 // (1 - exp(-l)) / l, 1 at l = 0: what a relaxation at rate k moves over a step, as a share of
 // (target - now) k dt, with l = k dt.
@@ -35,7 +36,8 @@ void main() {
     int top = topLayer(i);
     float net;  // > 0: the flow takes from the bed
     if (P.erosionLaw == 0) {
-      const float rhoGn2 = P.waterDensityKgM3 * P.gravityMS2 * P.manningN * P.manningN;
+      const float n2 = manningN2[i] >= 0.0 ? manningN2[i] : P.manningN * P.manningN;
+      const float rhoGn2 = P.waterDensityKgM3 * P.gravityMS2 * n2;
       const float tau = rhoGn2 * (q2 / (h * h)) / pow(h, 1.0 / 3.0);
       const float entrain = top >= 0 ? materials[top].shearErodibility * max(tau - materials[top].criticalShearPa, 0.0) : 0.0;
       const float ws = materials[sedimentLayer].settlingVelocityMS;

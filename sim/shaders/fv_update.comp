@@ -14,6 +14,7 @@ layout(std430, binding = SLOT_FACE_X) readonly buffer FaceX { vec4 faceX[]; };
 layout(std430, binding = SLOT_FACE_Y) readonly buffer FaceY { vec4 faceY[]; };
 layout(std430, binding = SLOT_TILT) writeonly buffer Tilt { float tilt[]; };
 layout(std430, binding = SLOT_FV_LIMIT) readonly buffer Limit { float limit_[]; };  // W25, from fv_limit.comp
+layout(std430, binding = SLOT_MANNING) readonly buffer Manning { float manningN2[]; };  // n^2 per cell; < 0: P.manningN
 uniform int final_;
 vec4 stateAt(int which, int i) { return which == 0 ? state[i] : stage[i]; }
 #include "sim_fv.glsl"
@@ -52,7 +53,8 @@ void main() {
   const ivec2 p = ivec2(gl_GlobalInvocationID.xy);
   if (!insideGrid(p)) return;
   const int i = cellOf(p), w = P.width;
-  const float dt = P.dtS, g = P.gravityMS2, dry = P.dryDepthM, n2 = P.manningN * P.manningN;
+  const float dt = P.dtS, g = P.gravityMS2, dry = P.dryDepthM;
+  const float n2 = manningN2[i] >= 0.0 ? manningN2[i] : P.manningN * P.manningN;
   const float A = cellArea(p.y), wN = faceWidthY(p.y), wS = faceWidthY(p.y + 1), dy = P.dyM;
   vec4 W = faceX[p.y * (w + 1) + p.x], E = faceX[p.y * (w + 1) + p.x + 1];
   vec4 N = faceY[p.y * w + p.x], S = faceY[(p.y + 1) * w + p.x];

@@ -69,6 +69,7 @@ Result<AdaptiveSolver> AdaptiveSolver::create(const SimInput& input, const SimPa
   l0.baseM = input.baseM;
   l0.layersM = input.layersM;
   l0.rainMmH = input.rainMmPerHour.size() > 0 ? input.rainMmPerHour : gis::Grid<float>(w, h, 0.0f);
+  l0.manningN = input.manningN;
   l0.rowDxM = a.grid().rowDxM;
   a.mips_.push_back(std::move(l0));
   for (int L = 1; L <= options.maxLevel; ++L) {
@@ -78,6 +79,7 @@ Result<AdaptiveSolver> AdaptiveSolver::create(const SimInput& input, const SimPa
     m.height = prev.height / 2;
     m.baseM = terrain::boxDownsample(prev.baseM, 2);
     m.rainMmH = terrain::boxDownsample(prev.rainMmH, 2);
+    if (prev.manningN.size() > 0) m.manningN = terrain::boxDownsample(prev.manningN, 2);
     for (const auto& l : prev.layersM) m.layersM.push_back(terrain::boxDownsample(l, 2));
     for (int y = 0; y < m.height; ++y) m.rowDxM.push_back(prev.rowDxM[size_t(2 * y)] + prev.rowDxM[size_t(2 * y + 1)]);
     a.mips_.push_back(std::move(m));
@@ -161,6 +163,7 @@ Status AdaptiveSolver::ensureSim(Tile& t, int L) {
   for (const auto& l : m.layersM) sub.layersM.push_back(crop(l, ex0, ey0, ex1, ey1));
   sub.materials = input_.materials;
   sub.rainMmPerHour = crop(m.rainMmH, ex0, ey0, ex1, ey1);
+  if (m.manningN.size() > 0) sub.manningN = crop(m.manningN, ex0, ey0, ex1, ey1);
   sub.rowDxM.assign(m.rowDxM.begin() + ey0, m.rowDxM.begin() + ey1);
   sub.dyM = input_.dyM * double(1 << L);
   sub.datumM = input_.datumM;

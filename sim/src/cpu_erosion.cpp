@@ -23,6 +23,7 @@ struct Stack {
 
 struct ErosionConst {
   float dt, dry, rhoGn2;  // rhoGn2: rho g n^2 of the bed shear stress (E1)
+  float rhoG;             // rho g, times a roughness map's n^2 where there is one
   bool forceBased;        // ErosionLaw::kForceBased
   float deepWater, capacityK, minSinTilt, dropShare, slowWater, settling;
   // per layer; pickShare: the force-based law's 1 - exp(-Ks erodibility dt)
@@ -214,21 +215,26 @@ inline void erodeCell(const ErosionConst& c, const Stack& st, float* s, float* b
 // E1's bed shear stress and E2-E3's relaxation share of each cell of a row, for the shear-stress
 // law: plain arithmetic in a loop of its own, which vectorises (the layer walk of the cell loop
 // does not: GCC 12 keeps branches in it).
-STRATA_ROW_KERNEL void shearRow(const ErosionConst& c, const float* h, const float* hu, const float* hv, float* shear,
-                                float* relax, int x0, int x1) {
+STRATA_ROW_KERNEL void shearRow(const ErosionConst& c, const float* h, const float* hu, const float* hv,
+                                const float* n2row, float* shear, float* relax, int x0, int x1) {
+  auto cells = [&](auto kMap) {
 #pragma omp simd
-  for (int x = x0; x < x1; ++x) {
-    const float hw = h[x] > c.dry ? h[x] : 1.0f;
-    const float q2 = hu[x] * hu[x] + hv[x] * hv[x];
-    shear[x] = c.rhoGn2 * (q2 / (hw * hw)) / cubeRoot(hw);  // rho g n^2 |u|^2 / h^(1/3)
-    relax[x] = relaxShare(c.settling * c.dt / hw);
-  }
+    for (int x = x0; x < x1; ++x) {
+      const float hw = h[x] > c.dry ? h[x] : 1.0f;
+      const float q2 = hu[x] * hu[x] + hv[x] * hv[x];
+      float rhoGn2 = c.rhoGn2;
+      if constexpr (decltype(kMap)::value) rhoGn2 = c.rhoG * n2row[x];
+      shear[x] = rhoGn2 * (q2 / (hw * hw)) / cubeRoot(hw);  // rho g n^2 |u|^2 / h^(1/3)
+      relax[x] = relaxShare(c.settling * c.dt / hw);
+    }
+  };
+  n2row ? cells(std::true_type{}) : cells(std::false_type{});
 }
 
 STRATA_ROW_KERNEL void erosionRow(const ErosionConst& c, const Stack& st, float* s, float* bed, const float* base,
                                   const float* h, const float* hu, const float* hv, const float* tilt, float* scour,
-                                  float* shear, float* relax, int x0, int x1) {
-  if (!c.forceBased) shearRow(c, h, hu, hv, shear, relax, x0, x1);
+                                  const float* n2row, float* shear, float* relax, int x0, int x1) {
+  if (!c.forceBased) shearRow(c, h, hu, hv, n2row, shear, relax, x0, x1);
   auto cells = [&](auto kForce) {
     withLayerCount(st.count, [&](auto kL) {
 #pragma omp simd
@@ -251,6 +257,7 @@ void Impl::erosionPass() {
     const ErosionConst c{dt,
                          p.dryDepthM,
                          p.waterDensityKgM3 * p.gravityMS2 * p.manningN * p.manningN,
+                         p.waterDensityKgM3 * p.gravityMS2,
                          p.erosionLaw == ErosionLaw::kForceBased,
                          p.deepWaterM,
                          p.capacityK,
@@ -266,7 +273,8 @@ void Impl::erosionPass() {
     Plane& sc = erosionScratch[size_t(thread)];
     for (int y = r.y0; y < r.y1; ++y) {
       erosionRow(c, Stack{layers.row(y), layerStride, L}, u.s.row(y), bed.row(y), base.row(y), u.h.row(y), u.hu.row(y),
-                 u.hv.row(y), tilt.row(y), scour.row(y), sc.row(0), sc.row(1), r.x0, r.x1);
+                 u.hv.row(y), tilt.row(y), scour.row(y), manningN2.empty() ? nullptr : manningN2.row(y), sc.row(0),
+                 sc.row(1), r.x0, r.x1);
     }
   });
 }

@@ -102,6 +102,7 @@ struct Impl {
   Plane layers;            // L * h rows: layer l, row y is row l * h + y
   size_t layerStride = 0;  // floats from one layer to the next
   Plane rain;              // raster rain (mm/h); empty when there is none
+  Plane manningN2;         // n^2 per cell (W19, E1) of SimInput::manningN; empty: SimParams::manningN everywhere
   Water state[2];          // ping-pong: state[cur] is the current state
   int cur = 0;
   Plane flux[4], fluxDiag[4];  // pipes: outflows W, E, N, S and NW, NE, SW, SE (m^3/s)

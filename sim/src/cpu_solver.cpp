@@ -91,6 +91,12 @@ Impl::Impl(const SimInput& input, const SimParams& params, int threadCount, bool
       for (int x = 0; x < w; ++x) state[0].h.at(x, y) = input.waterDepthM.at(x, y);
     }
   }
+  if (input.manningN.size() > 0) {
+    manningN2 = Plane(w, h);
+    for (int y = 0; y < h; ++y) {
+      for (int x = 0; x < w; ++x) manningN2.at(x, y) = input.manningN.at(x, y) * input.manningN.at(x, y);
+    }
+  }
   if (input.rainMmPerHour.size() > 0 && std::any_of(input.rainMmPerHour.data.begin(), input.rainMmPerHour.data.end(),
                                                     [](float r) { return r != 0.0f; })) {
     rain = Plane(w, h);

@@ -676,18 +676,24 @@ STRATA_ROW_KERNEL void fvUpdateRow(const FvConst& c, const FvRow& r, int x0, int
 // W19, implicit Manning friction on a row's new state: the discharge divided by
 // (1 + sqrt(1 + 4 dt g n^2 |u| / h^(4/3))) / 2 where the cell is wet (h^(4/3) = h cbrt(h) with
 // cubeRoot, which vectorises; fv_update.comp uses pow).
+// `n2row`: n^2 per cell (a roughness map), or null for `n2` everywhere.
 STRATA_ROW_KERNEL void frictionRow(const float* h, float* hu, float* hv, int x0, int x1, float dtg, float n2,
-                                   float dry) {
+                                   const float* n2row, float dry) {
+  auto cells = [=](auto kMap) {
 #pragma omp simd
-  for (int x = x0; x < x1; ++x) {
-    const float hx = h[x];
-    const bool wet = hx > dry;
-    const float hw = wet ? hx : 1.0f;
-    const float dtgnSpeed = dtg * n2 * (std::sqrt(hu[x] * hu[x] + hv[x] * hv[x]) / hx);
-    const float cf = 0.5f + 0.5f * std::sqrt(1.0f + 4.0f * (dtgnSpeed / (hw * cubeRoot(hw))));
-    hu[x] = wet ? hu[x] / cf : hu[x];
-    hv[x] = wet ? hv[x] / cf : hv[x];
-  }
+    for (int x = x0; x < x1; ++x) {
+      const float hx = h[x];
+      const bool wet = hx > dry;
+      const float hw = wet ? hx : 1.0f;
+      float n2x = n2;
+      if constexpr (decltype(kMap)::value) n2x = n2row[x];
+      const float dtgnSpeed = dtg * n2x * (std::sqrt(hu[x] * hu[x] + hv[x] * hv[x]) / hx);
+      const float cf = 0.5f + 0.5f * std::sqrt(1.0f + 4.0f * (dtgnSpeed / (hw * cubeRoot(hw))));
+      hu[x] = wet ? hu[x] / cf : hu[x];
+      hv[x] = wet ? hv[x] / cf : hv[x];
+    }
+  };
+  n2row ? cells(std::true_type{}) : cells(std::false_type{});
 }
 
 // sim/shaders/fv_update.comp: W18 (conservative update with the face fluxes). The predictor
@@ -750,7 +756,10 @@ void Impl::fvUpdatePass(bool final) {
       };
       forEdgesAndInterior(run.x0, run.x1, w, y == 0 || y == h - 1, edgeCell,
                           [&](int xa, int xb) { fvUpdateRow(c, r, xa, xb, final, sed); });
-      if (n2 > 0.0f) frictionRow(r.oh, r.ohu, r.ohv, run.x0, run.x1, dt * p.gravityMS2, n2, p.dryDepthM);
+      if (n2 > 0.0f || !manningN2.empty()) {
+        frictionRow(r.oh, r.ohu, r.ohv, run.x0, run.x1, dt * p.gravityMS2, n2,
+                    manningN2.empty() ? nullptr : manningN2.row(y), p.dryDepthM);
+      }
       if (!final) continue;
       if (p.erosionEnabled) tiltRows(y, run.x0, run.x1);
     }

@@ -34,6 +34,7 @@ Result<TiledSolver> TiledSolver::create(const SimInput& input, const SimParams& 
       sub.materials = input.materials;
       sub.waterDepthM = crop(input.waterDepthM, ex0, ey0, ex1, ey1);
       sub.rainMmPerHour = crop(input.rainMmPerHour, ex0, ey0, ex1, ey1);
+      sub.manningN = crop(input.manningN, ex0, ey0, ex1, ey1);
       sub.rowDxM.assign(t.grid().rowDxM.begin() + ey0, t.grid().rowDxM.begin() + ey1);
       sub.dyM = input.dyM;
       sub.datumM = input.datumM;

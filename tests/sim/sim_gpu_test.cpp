@@ -227,6 +227,12 @@ TEST_F(GlTest, SimFloodAgreesWithCpuReference) {
   auto mc = floodParams();  // the other slope limiter (W21)
   mc.slopeLimiter = strata::sim::SlopeLimiter::kMonotonizedCentral;
   expectAgreement(in, mc, 150, 1e-4, 1e-6, nullptr);
+  // Issue 31: a roughness map (Manning's n per cell: 0.02 west, 0.1 east) read by both backends.
+  in.manningN = strata::gis::Grid<float>(32, 32, 0.02f);
+  for (int y = 0; y < 32; ++y) {
+    for (int x = 16; x < 32; ++x) in.manningN.at(x, y) = 0.1f;
+  }
+  expectAgreement(in, floodParams(), 150, 1e-4, 1e-6, nullptr);
 }
 
 TEST_F(GlTest, SimFloodLongStepAgreesWithCpuAndKeepsBalance) {

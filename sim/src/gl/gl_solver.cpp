@@ -31,7 +31,7 @@ struct GlSolver::Impl {
   int layers = 0;
 
   gl::Buffer params, materials, rowDx, base, bed, layerBuf, stateA, stateB, stage, flux, fluxDiag, faceX, faceY, tilt,
-      accum, rain, thermal, scour, sourceEntries, maxSpeed, floodStats, fvLimit, levelEntries;
+      accum, rain, manning, thermal, scour, sourceEntries, maxSpeed, floodStats, fvLimit, levelEntries;
   bool aIsCurrent = true;
   gl::Program pSources, pPointSources, pWaveSpeed, pPipeFlux, pPipeUpdate, pFvFace, pFvLimit, pFvUpdate, pErode,
       pThermalFlux, pThermalApply, pFloodStats, pLevel, pCopyRect, pBedRect;
@@ -59,6 +59,7 @@ struct GlSolver::Impl {
     tilt.bind(slots::kTilt);
     accum.bind(slots::kAccum);
     rain.bind(slots::kRain);
+    manning.bind(slots::kManning);
     thermal.bind(slots::kThermal);
     scour.bind(slots::kScour);
     sourceEntries.bind(slots::kSources);
@@ -301,6 +302,10 @@ Result<GlSolver> GlSolver::create(const SimInput& input, const SimParams& params
   s.accum = gl::Buffer(32 * n);
   s.accum.fill(0u);
   s.rain = gl::Buffer::from(std::span<const float>(rain));
+  // n^2 per cell of a roughness map; -1 (the uniform P.manningN, which setParams may change) without.
+  std::vector<float> manningN2(n, -1.0f);
+  for (size_t i = 0; i < input.manningN.size(); ++i) manningN2[i] = input.manningN.data[i] * input.manningN.data[i];
+  s.manning = gl::Buffer::from(std::span<const float>(manningN2));
   s.thermal = gl::Buffer(16 * n);
   s.thermal.fill(0u);
   s.scour = gl::Buffer(4 * n);
@@ -345,9 +350,9 @@ size_t GlSolver::gpuBytes() const {
   const Impl& s = *impl_;
   size_t total = 0;
   for (const gl::Buffer* b :
-       {&s.params,  &s.materials, &s.rowDx,         &s.base,     &s.bed,        &s.layerBuf, &s.stateA, &s.stateB,
-        &s.stage,   &s.flux,      &s.fluxDiag,      &s.faceX,    &s.faceY,      &s.tilt,     &s.accum,  &s.rain,
-        &s.thermal, &s.scour,     &s.sourceEntries, &s.maxSpeed, &s.floodStats, &s.fvLimit}) {
+       {&s.params,  &s.materials, &s.rowDx,    &s.base,          &s.bed,      &s.layerBuf,   &s.stateA, &s.stateB,
+        &s.stage,   &s.flux,      &s.fluxDiag, &s.faceX,         &s.faceY,    &s.tilt,       &s.accum,  &s.rain,
+        &s.manning, &s.thermal,   &s.scour,    &s.sourceEntries, &s.maxSpeed, &s.floodStats, &s.fvLimit}) {
     total += b->size();
   }
   return total;

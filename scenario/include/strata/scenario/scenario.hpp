@@ -126,9 +126,14 @@ struct Scenario {
   struct {
     sim::WaterModel kind = sim::WaterModel::kFiniteVolume;
     Backend backend = Backend::kAuto;
-    double manningN = 0.035;   ///< s/m^(1/3)
-    double cfl = 0.45;         ///< flood mode needs <= 0.5 (positivity of the finite-volume scheme)
-    double maxStepS = 30.0;    ///< cap on the adaptive step (s); see docs/scenario.md
+    double manningN = 0.035;  ///< s/m^(1/3); where a roughness map has no data too
+    /// A roughness map: Manning's n per cell from a raster (bilinear), or from a land-cover
+    /// raster's classes (nearest) through a table of n per class. Empty: manningN everywhere.
+    std::string manningRaster;
+    std::string landCoverRaster;
+    std::map<long long, double> landCoverManning;  ///< class code -> n
+    double cfl = 0.45;                             ///< flood mode needs <= 0.5 (positivity of the finite-volume scheme)
+    double maxStepS = 30.0;                        ///< cap on the adaptive step (s); see docs/scenario.md
     bool sharpSlopes = false;  ///< flood mode: MC slopes instead of minmod (W21); see docs/sim-water.md
     std::array<Boundary, 4> boundaries{Boundary::Open, Boundary::Open, Boundary::Open, Boundary::Open};  ///< W E S N
   } model;

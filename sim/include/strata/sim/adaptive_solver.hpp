@@ -83,6 +83,7 @@ class AdaptiveSolver final : public Solver {
   struct Pyramid {  // one level of the region's mip pyramid
     int width = 0, height = 0;
     gis::Grid<float> baseM, rainMmH;  // absolute base elevation (m), rain raster (mm/h)
+    gis::Grid<float> manningN;        // the roughness map, box means (empty: the uniform n)
     std::vector<gis::Grid<float>> layersM;
     std::vector<float> bed;      // relative to the datum, as the solvers compute it
     std::vector<double> rowDxM;  // per level row

@@ -22,9 +22,12 @@ struct SimInput {
   std::vector<terrain::Material> materials;  ///< one per layer
   gis::Grid<float> waterDepthM;    ///< initial water depth (m, >= 0); empty = dry (a dam-break volume goes here)
   gis::Grid<float> rainMmPerHour;  ///< rain raster (mm/h); empty = none (uniform rain is in SimParams)
-  std::vector<double> rowDxM;      ///< cell size east-west per row (m): one value, or one per row (geographic grids)
-  double dyM = 1.0;                ///< cell size north-south (m)
-  double datumM = 0.0;             ///< elevations are stored relative to this (m)
+  /// Manning's n per cell (s m^-1/3, >= 0; W19, E1): a roughness map; empty = SimParams::manningN
+  /// everywhere (and then a setParams changes it).
+  gis::Grid<float> manningN;
+  std::vector<double> rowDxM;  ///< cell size east-west per row (m): one value, or one per row (geographic grids)
+  double dyM = 1.0;            ///< cell size north-south (m)
+  double datumM = 0.0;         ///< elevations are stored relative to this (m)
 };
 
 /// A point or line of inflow: its discharge over time (m^3/s) split equally over `cells` (W12).

@@ -36,10 +36,11 @@ inline constexpr gl::Binding kLevels{"SLOT_LEVELS", kBuf, 21, "Levels"};        
 inline constexpr gl::Binding kCopyGrid{"SLOT_COPY_GRID", kBuf, 22, "Grid"};            ///< copy_rect: a per-cell buffer
 inline constexpr gl::Binding kCopyPacked{"SLOT_COPY_PACKED", kBuf, 23, "Rect"};  ///< copy_rect: the packed rectangle
 inline constexpr gl::Binding kScour{"SLOT_SCOUR", kBuf, 24, "Scour"};            ///< the step's toe scour (E8)
+inline constexpr gl::Binding kManning{"SLOT_MANNING", kBuf, 25, "Manning"};      ///< n^2 per cell; < 0: P.manningN
 
 inline constexpr gl::Binding kAll[] = {kParams,   kMaterials, kRowDx,      kBase,     kBed,      kLayers,     kStateIn,
                                        kStateOut, kStage,     kFlux,       kFaceX,    kFaceY,    kTilt,       kAccum,
                                        kRain,     kThermal,   kSources,    kMaxSpeed, kFluxDiag, kFloodStats, kFvLimit,
-                                       kLevels,   kCopyGrid,  kCopyPacked, kScour};
+                                       kLevels,   kCopyGrid,  kCopyPacked, kScour,    kManning};
 
 }  // namespace strata::sim::slots
