@@ -115,6 +115,12 @@ TEST(ScenarioRoughness, AManningMapActsAsEachHalfsOwnN) {
   EXPECT_LT(worst[0], 0.05 * differ) << "west";
   EXPECT_LT(worst[1], 0.05 * differ) << "east";
 
+  // A map of one value is that n everywhere, bit for bit.
+  ASSERT_TRUE(gis::writeGeoTiff((dir / "n008.tif").string(), grid(0.08f)));
+  auto constant = maxDepth(dir, "constant", "manning_n = 0.05\nmanning_raster = \"n008.tif\"");
+  ASSERT_TRUE(constant) << constant.message();
+  EXPECT_EQ(constant->values.data, rough->values.data);
+
   // The same map from land-cover classes and a table of n per class: the same answer, bit for bit.
   auto classes = maxDepth(dir, "classes",
                           "manning_n = 0.05\n[model.land_cover]\nraster = \"classes.tif\"\nmanning = { 30 = "
