@@ -22,8 +22,10 @@ void addCheckCommand(CLI::App& app) {
   auto dir = std::make_shared<std::string>();
   cmd->add_option("store_or_scenario", *dir, "Store folder (holds manifest.toml) or scenario file (.toml)")->required();
   cmd->callback([dir] {
+    // A scenario: a file, or a path ending in .toml; anything else is a store folder.
     std::error_code ec;
-    if (!std::filesystem::is_directory(*dir, ec)) {
+    const std::filesystem::path path(*dir);
+    if (std::filesystem::is_regular_file(path, ec) || path.extension() == ".toml") {
       const auto problems = scenario::checkScenarioFile(*dir);
       for (const auto& p : problems) std::fprintf(stderr, "strata check: %s\n", p.c_str());
       if (!problems.empty()) {
