@@ -103,38 +103,31 @@ def number(text):
     return float(text) if text != "" else float("nan")
 
 
+def two_panels(path, key, title, panels, out, name):
+    """One figure of a long-format probe CSV: a line per probe in each of two panels, over time.
+    `panels`: two (column, y label) pairs."""
+    groups = by_name(path, key)
+    fig, axes = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
+    for probe, rows in groups.items():
+        t = [float(r["time_s"]) / 3600.0 for r in rows]
+        for ax, (column, _) in zip(axes, panels):
+            ax.plot(t, [number(r[column]) for r in rows], label=probe)
+    for ax, (_, label) in zip(axes, panels):
+        ax.set_ylabel(label)
+        ax.grid(alpha=0.3)
+    axes[0].set_title(title)
+    axes[1].set_xlabel("time (h)")
+    axes[0].legend()
+    save(fig, out, name)
+
+
 def probes(run, out):
     if (run / "gauges.csv").exists():
-        groups = by_name(run / "gauges.csv", "gauge")
-        fig, (top, bottom) = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
-        for name, rows in groups.items():
-            t = [float(r["time_s"]) / 3600.0 for r in rows]
-            top.plot(t, [number(r["depth_m"]) for r in rows], label=name)
-            bottom.plot(t, [number(r["level_m"]) for r in rows], label=name)
-        top.set_ylabel("depth (m)")
-        top.set_title("Gauges")
-        bottom.set_ylabel("water level (m)")
-        bottom.set_xlabel("time (h)")
-        for ax in (top, bottom):
-            ax.grid(alpha=0.3)
-        top.legend()
-        save(fig, out, "gauges")
+        two_panels(run / "gauges.csv", "gauge", "Gauges", [("depth_m", "depth (m)"), ("level_m", "water level (m)")],
+                   out, "gauges")
     if (run / "sections.csv").exists():
-        groups = by_name(run / "sections.csv", "section")
-        fig, (top, bottom) = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
-        for name, rows in groups.items():
-            t = [float(r["time_s"]) / 3600.0 for r in rows]
-            top.plot(t, [number(r["discharge_m3_s"]) for r in rows], label=name)
-            bottom.plot(t, [number(r["volume_m3"]) for r in rows], label=name)
-        top.set_ylabel("discharge (m³/s)")
-        top.set_title("Sections (positive from the line's left to its right)")
-        bottom.set_ylabel("volume across (m³)")
-        bottom.set_xlabel("time (h)")
-        for ax in (top, bottom):
-            ax.grid(alpha=0.3)
-        top.legend()
-        save(fig, out, "sections")
-
+        two_panels(run / "sections.csv", "section", "Sections (positive from the line's left to its right)",
+                   [("discharge_m3_s", "discharge (m³/s)"), ("volume_m3", "volume across (m³)")], out, "sections")
 
 if __name__ == "__main__":
     main()

@@ -30,13 +30,6 @@ namespace {
 using namespace test_support;
 namespace fs = std::filesystem;
 
-std::string slurp(const fs::path& p) {
-  std::ifstream f(p, std::ios::binary);
-  std::stringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
-
 // `strata ARGS...` in `cwd`, in its own process group (as a terminal's foreground job), its
 // output in `log`; with a file size limit when `fsizeBytes` > 0, and `env` ("NAME=value") set;
 // `wrapper` (a program and its arguments) runs strata when given.

@@ -56,6 +56,14 @@ inline scenario::Scenario writeScenario(const std::filesystem::path& dir) {
   return *s;
 }
 
+// A file's bytes ("" when it cannot be read).
+inline std::string slurp(const std::filesystem::path& p) {
+  std::ifstream f(p, std::ios::binary);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
 inline gis::ReadOptions allowEmpty() {
   gis::ReadOptions o;
   o.allowAllNoData = true;

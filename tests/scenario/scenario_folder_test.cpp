@@ -22,13 +22,6 @@ namespace {
 using namespace test_support;
 namespace fs = std::filesystem;
 
-std::string slurp(const fs::path& p) {
-  std::ifstream f(p, std::ios::binary);
-  std::stringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
-
 RunOptions cpuRun(const fs::path& dir) {
   RunOptions opt;
   opt.outDir = dir;

@@ -40,6 +40,20 @@ double ellipsoidArea(const OGRPolygon& polygon, const gis::Body& body) {
   return area;
 }
 
+// `text` run as dir/name.toml into dir/name on the CPU backend, without pictures and plots.
+void cpuRun(const std::filesystem::path& dir, const std::string& name, const std::string& text) {
+  std::ofstream(dir / (name + ".toml")) << text;
+  auto s = loadScenario(dir / (name + ".toml"));
+  ASSERT_TRUE(s) << s.message();
+  RunOptions opt;
+  opt.outDir = dir / name;
+  opt.backend = Backend::kCpu;
+  opt.pictures = false;
+  opt.plots = false;
+  auto summary = runScenario(*s, opt);
+  ASSERT_TRUE(summary) << summary.message();
+}
+
 TEST(ScenarioOutputs, OutlineHazardAndStylesAreWhatAGisUserOpens) {
   const auto dir = strata::test::tempDir("outputs");
   std::ofstream(dir / "dam.toml") << damBreakText();
@@ -119,20 +133,8 @@ TEST(ScenarioOutputs, OutlineHazardAndStylesAreWhatAGisUserOpens) {
 TEST(ScenarioOutputs, TheReportWarnsOfPondedWaterAndOfInflowSpeeds) {
   const auto dir = strata::test::tempDir("warnings");
   auto run = [&](const std::string& name, const std::string& text) {
-    std::ofstream(dir / (name + ".toml")) << text;
-    auto s = loadScenario(dir / (name + ".toml"));
-    EXPECT_TRUE(s) << s.message();
-    RunOptions opt;
-    opt.outDir = dir / name;
-    opt.backend = Backend::kCpu;
-    opt.pictures = false;
-    opt.plots = false;
-    auto summary = runScenario(*s, opt);
-    EXPECT_TRUE(summary) << summary.message();
-    std::ifstream f(opt.outDir / "report.md");
-    std::stringstream report;
-    report << f.rdbuf();
-    return report.str();
+    cpuRun(dir, name, text);
+    return slurp(dir / name / "report.md");
   };
   const std::string raw = run("raw", scenarioText());
   const size_t at = raw.find("% of the water in the region at the end) stands in closed depressions of the bed");
@@ -176,18 +178,7 @@ TEST(ScenarioOutputs, TheReportWarnsOfPondedWaterAndOfInflowSpeeds) {
 // both runs and the change, and a folder that holds anything, or runs of other grids, are refused.
 TEST(ScenarioOutputs, CompareGivesDifferenceMapsAndTheHeadlineNumbers) {
   const auto dir = strata::test::tempDir("compare");
-  auto run = [&](const std::string& name, const std::string& text) {
-    std::ofstream(dir / (name + ".toml")) << text;
-    auto s = loadScenario(dir / (name + ".toml"));
-    ASSERT_TRUE(s) << s.message();
-    RunOptions opt;
-    opt.outDir = dir / name;
-    opt.backend = Backend::kCpu;
-    opt.pictures = false;
-    opt.plots = false;
-    auto summary = runScenario(*s, opt);
-    ASSERT_TRUE(summary) << summary.message();
-  };
+  auto run = [&](const std::string& name, const std::string& text) { cpuRun(dir, name, text); };
   std::string rough = scenarioText();
   rough.replace(rough.find("manning_n = 0.04"), 16, "manning_n = 0.08");
   run("smooth", scenarioText());
@@ -212,11 +203,9 @@ TEST(ScenarioOutputs, CompareGivesDifferenceMapsAndTheHeadlineNumbers) {
     changed += y != x;
   }
   EXPECT_GT(changed, 10) << "a rougher bed changes the depths";
-  std::ifstream f(o.outDir / "compare.md");
-  std::stringstream md;
-  md << f.rdbuf();
-  EXPECT_NE(md.str().find("| largest flooded area | "), std::string::npos) << md.str();
-  EXPECT_NE(md.str().find("![max_depth_difference](plots/max_depth_difference.png)"), std::string::npos);
+  const std::string md = slurp(o.outDir / "compare.md");
+  EXPECT_NE(md.find("| largest flooded area | "), std::string::npos) << md;
+  EXPECT_NE(md.find("![max_depth_difference](plots/max_depth_difference.png)"), std::string::npos);
 
   // Refusals: the output folder holds something; a run of other cells.
   auto again = compareRuns(o);

@@ -20,13 +20,6 @@ namespace {
 
 using namespace test_support;
 
-std::string slurp(const std::filesystem::path& p) {
-  std::ifstream f(p);
-  std::stringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
-
 // On the fixture's dam break (damBreakText): the section runs from the north edge to the south
 // edge at -112.1 (heading south, so positive is from its left, east, to its right, west); the
 // gauge stands in the canyon below it.

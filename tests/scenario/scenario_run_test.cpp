@@ -21,13 +21,6 @@ namespace {
 
 using namespace test_support;
 
-std::string slurp(const std::filesystem::path& p) {
-  std::ifstream f(p);
-  std::stringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
-
 TEST(ScenarioRun, FloodRunsOnTheCpuWithoutGl) {
   const auto dir = strata::test::tempDir("cpu-run");
   const auto scenario = writeScenario(dir);
