@@ -501,6 +501,33 @@ Status writeGeoTiff(const std::string& path, const Raster& raster, const WriteOp
   return {};
 }
 
+Status rewriteAsCog(const std::string& path, int blockSize) {
+  detail::ensureGdal();
+  GdalErrorCapture errors;
+  DatasetPtr src(GDALDataset::FromHandle(GDALOpen(path.c_str(), GA_ReadOnly)));
+  if (!src) return fail(path + ": cannot open: " + errors.last());
+  GDALDriver* driver = GetGDALDriverManager()->GetDriverByName("COG");
+  if (!driver) return fail(path + ": GDAL has no COG driver");
+  WriteOptions options;
+  options.cog = true;
+  options.blockSize = blockSize;
+  STRATA_TRY_STATUS(checkBlockSize(path, options));
+  const CPLStringList co = geoTiffOptions(options);
+  const std::string tmp = path + ".tmp" + std::to_string(::getpid());
+  DatasetPtr written(driver->CreateCopy(tmp.c_str(), src.get(), FALSE, co.List(), nullptr, nullptr));
+  src.reset();
+  if (!written) {
+    VSIUnlink(tmp.c_str());
+    return fail(path + ": cannot write a COG: " + errors.last());
+  }
+  written.reset();
+  if (CPLGetLastErrorType() >= CE_Failure || VSIRename(tmp.c_str(), path.c_str()) != 0) {
+    VSIUnlink(tmp.c_str());
+    return fail(path + ": cannot write a COG: " + errors.last("cannot rename the temporary into place"));
+  }
+  return {};
+}
+
 namespace {
 // The numeric value of PARAMETER["name", value, ...] in a WKT2 string.
 std::optional<double> wktParameter(const std::string& wkt, const std::string& name) {

@@ -1183,7 +1183,11 @@ class Session {
     if (!ranks_.lead()) return summary_;  // the lead writes the styles, plots and the report
     std::vector<std::string> written;
     for (const auto& f : summary_.files) {
-      if (f.starts_with("maps/")) written.push_back(f);
+      if (!f.starts_with("maps/")) continue;
+      written.push_back(f);
+      // The run's maps as Cloud Optimized GeoTIFFs (overviews: a GIS pans a large one quickly);
+      // written window by window during the run, rewritten once here.
+      if (f.ends_with(".tif")) STRATA_TRY_STATUS(gis::rewriteAsCog((opt_.outDir / f).string()));
     }
     STRATA_TRY(auto styles, detail::writeMapStyles(opt_.outDir, written, s_.outputs.wetThresholdM));
     summary_.files.insert(summary_.files.end(), styles.begin(), styles.end());

@@ -68,6 +68,9 @@ TEST(ScenarioRun, FloodRunsOnTheCpuWithoutGl) {
     GDALRasterBandH band = GDALGetRasterBand(ds, 1);
     EXPECT_STREQ(GDALGetDescription(band), b.description) << b.file;
     EXPECT_STREQ(GDALGetRasterUnitType(band), b.units) << b.file;
+    // Issue 31: Cloud Optimized GeoTIFFs (rewritten once the run ends, keeping all of the above).
+    const char* layout = GDALGetMetadataItem(ds, "LAYOUT", "IMAGE_STRUCTURE");
+    EXPECT_STREQ(layout ? layout : "", "COG") << b.file;
     GDALClose(ds);
   }
 }

@@ -125,6 +125,11 @@ struct WriteOptions {
 /// With `overwrite` false the temporary is linked into place (fails if `path` exists) instead.
 Status writeGeoTiff(const std::string& path, const Raster& raster, const WriteOptions& options = {});
 
+/// Rewrites the GeoTIFF at `path` as a Cloud Optimized GeoTIFF (GDAL's COG driver: tiles of
+/// `blockSize`, DEFLATE with a predictor, overviews by averaging), keeping its values, nodata,
+/// CRS, geotransform, band description, unit and metadata; through a temporary renamed into place.
+Status rewriteAsCog(const std::string& path, int blockSize = 256);
+
 /// A float32 GeoTIFF written window by window, by one process or by several in turn (each rank of
 /// a run over MPI writes its own blocks; docs/distributed.md): createGeoTiff makes `path` (a
 /// temporary, committed by the caller) with `georef`'s size, CRS and geotransform and no cells
