@@ -991,6 +991,11 @@ Result<Scenario> readScenario(const toml::table& root, const std::filesystem::pa
     return fail(s.at("time.spin_up_tolerance") +
                 "is a fraction of the base flow (the inflows at t = 0), and [water] has no inflow");
   }
+  // Rows land on steps (the step before each row is shortened to reach it): a million at most.
+  if ((!s.outputs.gauges.empty() || !s.outputs.sections.empty()) && s.durationS / s.outputs.probeIntervalS > 1e6) {
+    return fail(s.at("outputs.probe_interval") + "more than a million rows over the duration (" +
+                std::to_string(s.durationS / s.outputs.probeIntervalS) + "): choose a longer interval");
+  }
   if (!s.outputs.sections.empty() && s.model.kind == sim::WaterModel::kVirtualPipes) {
     return fail(s.at("outputs.section") +
                 "sections need the flood model's face fluxes; the pipe model has none (set [model] kind = \"flood\")");

@@ -170,6 +170,11 @@ TEST(ScenarioProbes, BadProbesAreRefusedNamingTheKey) {
             file + ":20: key 'outputs.gauge[0].at_lonlat': the gauge \"gauge 1\" is outside the region");
   EXPECT_EQ(refused(damBreakText("[[outputs.gauge]]\nat_lonlat = [-112.1, 36.1]\nheight = 3\n")),
             file + ":21: key 'outputs.gauge[0].height': unknown key (expected one of: name, at_lonlat, at_xy)");
+  std::string fine = damBreakText(kProbes);
+  fine.replace(fine.find("probe_interval = \"1 min\""), 24, "probe_interval = 0.001");
+  EXPECT_NE(refused(fine).find("key 'outputs.probe_interval': more than a million rows over the duration (1200000"),
+            std::string::npos)
+      << refused(fine);
   std::string pipe = damBreakText(kProbes);
   pipe.replace(pipe.find("kind = \"flood\""), 14, "kind = \"pipe\"");
   EXPECT_NE(refused(pipe).find("key 'outputs.section': sections need the flood model's face fluxes"), std::string::npos)
