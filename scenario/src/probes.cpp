@@ -136,33 +136,36 @@ std::string number(double v, const char* format) {
 
 }  // namespace
 
-// Long format (one line per probe and time): a name is data, not a column header.
-std::string Probes::gaugesCsv() const {
-  if (gauges_.empty()) return {};
-  std::string out = "time_s,gauge,depth_m,level_m,speed_m_s,toward_deg\n";
+// Long format (one line per probe and time): a name is data, not a column header. Each row holds
+// the probes' values from `offset` on, `formats.size()` per probe.
+std::string Probes::longCsv(const char* header, const std::vector<std::string>& names, size_t offset,
+                            const std::vector<const char*>& formats) const {
+  if (names.empty()) return {};
+  std::string out = header;
   const size_t perRow = 1 + 4 * gauges_.size() + 3 * sections_.size();
   for (size_t r = 0; r + perRow <= rows_.size(); r += perRow) {
-    for (size_t k = 0; k < gauges_.size(); ++k) {
-      const double* v = &rows_[r + 1 + 4 * k];
-      out += number(rows_[r], "%.3f") + "," + quoted(gauges_[k].name) + "," + number(v[0], "%.4f") + "," +
-             number(v[1], "%.4f") + "," + number(v[2], "%.4f") + "," + number(v[3], "%.1f") + "\n";
+    for (size_t k = 0; k < names.size(); ++k) {
+      out += number(rows_[r], "%.3f") + "," + quoted(names[k]);
+      for (size_t j = 0; j < formats.size(); ++j) {
+        out += "," + number(rows_[r + offset + formats.size() * k + j], formats[j]);
+      }
+      out += "\n";
     }
   }
   return out;
 }
 
+std::string Probes::gaugesCsv() const {
+  std::vector<std::string> names;
+  for (const auto& g : gauges_) names.push_back(g.name);
+  return longCsv("time_s,gauge,depth_m,level_m,speed_m_s,toward_deg\n", names, 1, {"%.4f", "%.4f", "%.4f", "%.1f"});
+}
+
 std::string Probes::sectionsCsv() const {
-  if (sections_.empty()) return {};
-  std::string out = "time_s,section,discharge_m3_s,volume_m3,mean_level_m\n";
-  const size_t perRow = 1 + 4 * gauges_.size() + 3 * sections_.size();
-  for (size_t r = 0; r + perRow <= rows_.size(); r += perRow) {
-    for (size_t k = 0; k < sections_.size(); ++k) {
-      const double* v = &rows_[r + 1 + 4 * gauges_.size() + 3 * k];
-      out += number(rows_[r], "%.3f") + "," + quoted(sections_[k].name) + "," + number(v[0], "%.6g") + "," +
-             number(v[1], "%.9g") + "," + number(v[2], "%.4f") + "\n";
-    }
-  }
-  return out;
+  std::vector<std::string> names;
+  for (const auto& s : sections_) names.push_back(s.name);
+  return longCsv("time_s,section,discharge_m3_s,volume_m3,mean_level_m\n", names, 1 + 4 * gauges_.size(),
+                 {"%.6g", "%.9g", "%.4f"});
 }
 
 std::vector<ProbeSummary> Probes::gaugeSummaries() const {

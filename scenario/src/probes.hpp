@@ -42,6 +42,8 @@ class Probes {
   };
   GaugeNow readGauge(const sim::Solver& solver, size_t k) const;
   double meanLevel(const sim::Solver& solver, size_t k) const;
+  std::string longCsv(const char* header, const std::vector<std::string>& names, size_t offset,
+                      const std::vector<const char*>& formats) const;
 
   std::vector<ScenarioDomain::GaugeCell> gauges_;
   std::vector<ScenarioDomain::SectionFaces> sections_;

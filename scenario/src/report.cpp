@@ -30,12 +30,38 @@ std::string fmt(const char* f, double v) {
 // User text (a scenario's name and description, inflow and material names) as report.md shows
 // it: control characters written as visible \uXXXX escapes, so that none reaches a terminal or
 // a viewer raw; in a table cell ('cell'), '|' escaped and line breaks as spaces too.
-std::string userText(const std::string& text, bool cell = false);
-std::string fmt(const char* f, double v);
-std::string hours(double s);
-// An area in the unit that fits: m² below a hectare's tenth... km² from 0.1 km².
+std::string userText(const std::string& text, bool cell = false) {
+  std::string out;
+  for (const char c : text) {
+    const auto u = static_cast<unsigned char>(c);
+    if (cell && (c == '\n' || c == '\t')) {
+      out += ' ';
+    } else if (cell && c == '|') {
+      out += "\\|";
+    } else if ((u < 0x20 && c != '\n' && c != '\t') || u == 0x7F) {
+      char code[8];
+      std::snprintf(code, sizeof code, "\\u%04X", unsigned(u));
+      out += code;
+    } else {
+      out += c;
+    }
+  }
+  return out;
+}
+
+std::string hours(double s) { return fmt("%.2f h", s / 3600.0); }
+
+// "36.0586 N, 112.0030 W" for a cell centre.
+std::string where(const gis::Georef& g, int x, int y) {
+  auto ll = gis::pixelToLonLat(g, x + 0.5, y + 0.5);
+  if (!ll) return "cell (" + std::to_string(x) + ", " + std::to_string(y) + ")";
+  const double lon = ll->lonDeg > 180 ? ll->lonDeg - 360 : ll->lonDeg;
+  return fmt("%.4f", std::abs(ll->latDeg)) + (ll->latDeg >= 0 ? " N, " : " S, ") + fmt("%.4f", std::abs(lon)) +
+         (lon >= 0 ? " E" : " W");
+}
+
+// An area in the unit that fits: m² below 0.1 km², km² from there.
 std::string areaText(double m2) { return m2 < 1e5 ? fmt("%.0f", m2) + " m²" : fmt("%.2f", m2 / 1e6) + " km²"; }
-std::string where(const gis::Georef& g, int x, int y);
 
 // The roughness: one n, or a map (a raster of n, or land-cover classes and their n).
 std::string manningText(const Scenario& s) {
@@ -88,36 +114,6 @@ std::string probesSection(const RunSummary& sum, const ScenarioDomain& d, const 
       md += "![" + std::string(p) + "](plots/" + p + ".png)\n";
   }
   return md + "\n";
-}
-
-std::string userText(const std::string& text, bool cell) {
-  std::string out;
-  for (const char c : text) {
-    const auto u = static_cast<unsigned char>(c);
-    if (cell && (c == '\n' || c == '\t')) {
-      out += ' ';
-    } else if (cell && c == '|') {
-      out += "\\|";
-    } else if ((u < 0x20 && c != '\n' && c != '\t') || u == 0x7F) {
-      char code[8];
-      std::snprintf(code, sizeof code, "\\u%04X", unsigned(u));
-      out += code;
-    } else {
-      out += c;
-    }
-  }
-  return out;
-}
-
-std::string hours(double s) { return fmt("%.2f h", s / 3600.0); }
-
-// "36.0586 N, 112.0030 W" for a cell centre.
-std::string where(const gis::Georef& g, int x, int y) {
-  auto ll = gis::pixelToLonLat(g, x + 0.5, y + 0.5);
-  if (!ll) return "cell (" + std::to_string(x) + ", " + std::to_string(y) + ")";
-  const double lon = ll->lonDeg > 180 ? ll->lonDeg - 360 : ll->lonDeg;
-  return fmt("%.4f", std::abs(ll->latDeg)) + (ll->latDeg >= 0 ? " N, " : " S, ") + fmt("%.4f", std::abs(lon)) +
-         (lon >= 0 ? " E" : " W");
 }
 
 // Runs an embedded plotting script with Debian's Python (where python3-matplotlib is): the

@@ -1094,8 +1094,9 @@ bool erase(toml::table& root, const std::vector<std::string>& parts) {
 }
 
 // Values that stand in for a required key once its own is refused, so that the rest of its
-// table is read too (each is valid wherever the key occurs).
-bool placeholder(toml::table& root, const std::vector<std::string>& parts) {
+// table is read too (each is valid wherever the key occurs). Only `strata check` reads with
+// them: its scenario is never run.
+bool standIn(toml::table& root, const std::vector<std::string>& parts) {
   toml::node* parent = parentOf(root, parts);
   auto* t = parent ? parent->as_table() : nullptr;
   if (!t || parts.empty()) return false;
@@ -1161,7 +1162,7 @@ ScenarioCheck checkScenarioText(std::string_view text, const std::filesystem::pa
     return check;
   }
   toml::table root = std::move(parsed).value();
-  std::set<std::string> replaced;  // keys given a placeholder (a problem of theirs again is a cascade)
+  std::set<std::string> replaced;  // keys given a stand-in value (a problem of theirs again is a cascade)
   // Each pass reads the file up to its first problem; the key it names is then set aside (a
   // near-miss name renamed, a refused required value replaced by a valid one, anything else
   // removed) and the next pass reads on. A problem on a key already reported is its cascade.
@@ -1183,7 +1184,7 @@ ScenarioCheck checkScenarioText(std::string_view text, const std::filesystem::pa
     bool moved = false;
     if (!cascade && message.find("unknown key") != std::string::npos) moved = renameNearMiss(root, parts, message);
     if (!moved && !replaced.count(at.key)) {
-      moved = placeholder(root, parts);
+      moved = standIn(root, parts);
       if (moved) replaced.insert(at.key);
     }
     if (!moved) moved = erase(root, parts);

@@ -100,8 +100,8 @@ TEST(ScenarioProbes, SectionVolumeIsTheWaterThatCrossedAndGaugePeakIsTheMap) {
   }
   EXPECT_EQ(initialWest, 0.0);
   EXPECT_GT(west, 1e7) << "the flood crossed the section";
+  // 1e-5 of the lake: the final depths come from a float32 map (the run's own balance is ~1e-7).
   EXPECT_NEAR(section.volumeM3, west, 1e-5 * d->damBreakVolumeM3);
-  EXPECT_NEAR(section.forwardM3 - section.backM3, section.volumeM3, 1e-9 * section.forwardM3);
   EXPECT_GT(section.peak, 0.0);  // east to west
   EXPECT_GT(section.peakTimeS, 0.0);
 
@@ -117,6 +117,12 @@ TEST(ScenarioProbes, SectionVolumeIsTheWaterThatCrossedAndGaugePeakIsTheMap) {
             0u)
       << sections;
   EXPECT_EQ(std::count(sections.begin(), sections.end(), '\n'), 1 + 21);
+  // The last row's volume is the summary's (written with 9 digits).
+  const size_t lastRow = sections.rfind('\n', sections.size() - 2) + 1;
+  std::stringstream last(sections.substr(lastRow));
+  std::string field;
+  for (int k = 0; k < 4; ++k) std::getline(last, field, ',');
+  EXPECT_NEAR(std::stod(field), section.volumeM3, 1e-8 * section.volumeM3) << sections.substr(lastRow);
   const std::string gauges = slurp(dir / "run" / "gauges.csv");
   EXPECT_EQ(std::count(gauges.begin(), gauges.end(), '\n'), 1 + 21);
   for (const char* f : {"plots/gauges.png", "plots/sections.png"}) {
