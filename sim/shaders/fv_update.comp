@@ -107,8 +107,8 @@ void main() {
       const float moved = denI > 0.0 ? s * A * volOut / denI : 0.0;
       sNew -= moved / A;
       if (edge[d]) {
-        kahanAdd(8 * i, volOut);
-        kahanAdd(8 * i + 4, moved);
+        kahanAdd(ACCUM_PER_CELL * i + ACCUM_OUTFLOW, volOut);
+        kahanAdd(ACCUM_PER_CELL * i + ACCUM_SEDIMENT_OUT, moved);
       }
     } else if (volOut < 0.0 && !edge[d]) {
       const ivec2 q = p + kDir[d];

@@ -22,5 +22,5 @@ void main() {
   const float h1 = max(0.0, e.stageM - bed[i]);
   const float keep = s.x > P.dryDepthM ? h1 / s.x : 0.0;
   state[i] = vec4(h1, s.y, s.z * keep, s.w * keep);
-  kahanAdd(8 * i + 6, (h1 - s.x) * cellArea(y));
+  kahanAdd(ACCUM_PER_CELL * i + ACCUM_LEVEL, (h1 - s.x) * cellArea(y));
 }

@@ -88,3 +88,30 @@ float faceWidthY(int yFace) {
   return 0.5 * (rowDx[yFace - 1] + rowDx[yFace]);
 }
 float velocityOf(float h, float q) { return h > P.dryDepthM ? q / h : 0.0; }
+
+// W11b: u - ln(1 + u) for u >= 0, a series below 0.1 (sim/src/cpu_kernels.hpp's uMinusLog1p).
+float uMinusLog1p(float u) {
+  if (u >= 0.1) return u - log(1.0 + u);
+  float p = 1.0 / 9.0;
+  p = 1.0 / 8.0 - u * p;
+  p = 1.0 / 7.0 - u * p;
+  p = 1.0 / 6.0 - u * p;
+  p = 1.0 / 5.0 - u * p;
+  p = 1.0 / 4.0 - u * p;
+  p = 1.0 / 3.0 - u * p;
+  p = 0.5 - u * p;
+  return u * u * p;
+}
+// W11b: the depth the soil can take in over a step under ponding from cumulative infiltration f:
+// Green-Ampt integrated over the step, four Newton steps; g = 0: a constant loss ksDt
+// (sim/src/cpu_kernels.hpp's infiltrationCapacity, which gives the derivation and accuracy).
+float infiltrationCapacity(float ksDt, float g, float f) {
+  if (!(g > 0.0) || !(ksDt > 0.0)) return ksDt;
+  const float a = f + g;
+  float d = ksDt + sqrt(2.0 * g * ksDt);
+  for (int k = 0; k < 4; ++k) {
+    const float r = d * f / a + g * uMinusLog1p(d / a) - ksDt;
+    d = max(ksDt, d - r * (a + d) / (f + d));
+  }
+  return d;
+}

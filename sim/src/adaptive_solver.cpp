@@ -42,6 +42,10 @@ Result<AdaptiveSolver> AdaptiveSolver::create(const SimInput& input, const SimPa
   if (params.waterModel != WaterModel::kFiniteVolume || params.erosionEnabled || params.thermalEnabled) {
     return fail("adaptive tiles: flood mode (waterModel = finite volume) without erosion or thermal weathering only");
   }
+  if (input.infiltrationMmPerHour.size() > 0) {
+    // A level's cells would start with a dry soil where a finer or coarser one had taken water in.
+    return fail("adaptive tiles: no infiltration (the soil's state does not pass between levels)");
+  }
   const int T = options.tileSize, f = 1 << std::max(0, options.maxLevel);
   if (options.maxLevel < 0 || options.maxLevel > 6 || T < 2 || T % f != 0 || options.halo < 1 ||
       options.regridEvery < 1 || !(options.coarsenBelow <= options.refineAbove)) {
@@ -581,8 +585,8 @@ SimStats AdaptiveSolver::stats() const {
       for (int y = 0; y < iw; ++y) {
         for (int x = 0; x < iw; ++x) {
           const size_t i = size_t(y) * size_t(iw) + size_t(x);
-          out.outflowM3 += double(b.accum[8 * i]);
-          out.evaporatedM3 += double(b.accum[8 * i + 2]);
+          out.outflowM3 += double(b.accum[kAccumPerCell * i + kAccumOutflow]);
+          out.evaporatedM3 += double(b.accum[kAccumPerCell * i + kAccumEvaporated]);
           if (L == t.level) {
             out.storedWaterM3 += double(b.state[4 * i]) * dx[size_t(iy0 + y)] * dyL;
             out.suspendedM3 += double(b.state[4 * i + 1]) * dx[size_t(iy0 + y)] * dyL;

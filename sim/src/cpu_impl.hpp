@@ -18,6 +18,7 @@
 
 #include <strata/sim/bookkeeping.hpp>
 #include <strata/sim/params.hpp>
+#include <strata/sim/solver.hpp>
 
 #include "cpu_kernels.hpp"
 
@@ -103,10 +104,11 @@ struct Impl {
   size_t layerStride = 0;  // floats from one layer to the next
   Plane rain;              // raster rain (mm/h); empty when there is none
   Plane manningN2;         // n^2 per cell (W19, E1) of SimInput::manningN; empty: SimParams::manningN everywhere
+  Plane infilKs, infilG;   // W11b per cell: Ks (m/s) and psi * dtheta (m); empty: no infiltration
   Water state[2];          // ping-pong: state[cur] is the current state
   int cur = 0;
   Plane flux[4], fluxDiag[4];  // pipes: outflows W, E, N, S and NW, NE, SW, SE (m^3/s)
-  Plane accum[8];              // (sum, error) of water out, evaporated, sediment out, level exchange (m^3)
+  Plane accum[kAccumPerCell];  // (sum, error) pairs in AccumOffset order (m^3)
   Plane tilt;                  // sin(bed tilt), for erosion (E0)
   Plane thermal[4];            // material shed W, E, N, S (m over this cell) (E7)
   Plane scour;                 // what the flow took off each cell this step (m), the toe a bank may fall into (E8)
@@ -167,6 +169,7 @@ struct Impl {
   bool blockEvapResidual(int bx, int by) const;
   void markAll();  // state replaced: all flags recomputed, every block runs for two steps
   void allocateFor(const SimParams& params);
+  void setRain(const gis::Grid<float>& mmPerHour);
 
   // ---- passes (cpu_water.cpp) ----
   void sourcesPass(const std::vector<SourceEntry>& entries);

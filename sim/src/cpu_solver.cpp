@@ -97,11 +97,14 @@ Impl::Impl(const SimInput& input, const SimParams& params, int threadCount, bool
       for (int x = 0; x < w; ++x) manningN2.at(x, y) = input.manningN.at(x, y) * input.manningN.at(x, y);
     }
   }
-  if (input.rainMmPerHour.size() > 0 && std::any_of(input.rainMmPerHour.data.begin(), input.rainMmPerHour.data.end(),
-                                                    [](float r) { return r != 0.0f; })) {
-    rain = Plane(w, h);
+  if (input.infiltrationMmPerHour.size() > 0) {
+    infilKs = Plane(w, h);
+    infilG = Plane(w, h);
     for (int y = 0; y < h; ++y) {
-      for (int x = 0; x < w; ++x) rain.at(x, y) = input.rainMmPerHour.at(x, y);
+      for (int x = 0; x < w; ++x) {
+        infilKs.at(x, y) = input.infiltrationMmPerHour.at(x, y) * kMmPerHourToMS;
+        if (input.infiltrationSuctionM.size() > 0) infilG.at(x, y) = input.infiltrationSuctionM.at(x, y);
+      }
     }
   }
   for (auto& a : accum) a = Plane(w, h);
@@ -127,17 +130,27 @@ Impl::Impl(const SimInput& input, const SimParams& params, int threadCount, bool
     set->on.assign(blocks, 0);
     set->runs.reserve(blocks);
   }
-  for (int by = 0; by < bh; ++by) {
-    for (int bx = 0; bx < bw; ++bx) {
-      bool any = false;
-      for (int y = by * kBlock; y < std::min(h, (by + 1) * kBlock) && !rain.empty(); ++y) {
-        for (int x = bx * kBlock; x < std::min(w, (bx + 1) * kBlock); ++x) any = any || rain.at(x, y) != 0.0f;
-      }
-      rainBlock[size_t(by * bw + bx)] = any;
-    }
-  }
+  setRain(input.rainMmPerHour);
   allocateFor(p);
   markAll();
+}
+
+// The rain raster (mm/h; empty or all 0: none) and which blocks it falls on.
+void Impl::setRain(const gis::Grid<float>& mmPerHour) {
+  const bool any = std::any_of(mmPerHour.data.begin(), mmPerHour.data.end(), [](float r) { return r != 0.0f; });
+  rain = any ? Plane(w, h) : Plane();
+  for (int y = 0; y < h && any; ++y) {
+    for (int x = 0; x < w; ++x) rain.at(x, y) = mmPerHour.at(x, y);
+  }
+  for (int by = 0; by < bh; ++by) {
+    for (int bx = 0; bx < bw; ++bx) {
+      bool wet = false;
+      for (int y = by * kBlock; y < std::min(h, (by + 1) * kBlock) && any; ++y) {
+        for (int x = bx * kBlock; x < std::min(w, (bx + 1) * kBlock); ++x) wet = wet || rain.at(x, y) != 0.0f;
+      }
+      rainBlock[size_t(by * bw + bx)] = wet;
+    }
+  }
 }
 
 // Planes that depend on the run-time parameters (erosion and thermal weathering may be switched
@@ -203,7 +216,7 @@ bool Impl::blockQuiet(int bx, int by) const {
 // pass keeps running where a cell's evaporation sum has one.
 bool Impl::blockEvapResidual(int bx, int by) const {
   const int x0 = bx * kBlock, y0 = by * kBlock;
-  return anyBits(accum[3], x0, std::min(w, x0 + kBlock), y0, std::min(h, y0 + kBlock));
+  return anyBits(accum[kAccumEvaporated + 1], x0, std::min(w, x0 + kBlock), y0, std::min(h, y0 + kBlock));
 }
 
 void Impl::dilate(std::vector<uint8_t>& on) {
@@ -391,6 +404,11 @@ void CpuSolver::runStep(const StepInputs& step) {
   m.step(step.sources, step.levels, step.dtS, step.startS + double(step.dtS));
 }
 
+Status CpuSolver::onRainRasterChanged(const gis::Grid<float>& mmPerHour) {
+  impl_->setRain(mmPerHour);
+  return {};
+}
+
 void CpuSolver::onParamsChanged() {
   Impl& m = *impl_;
   const SimParams& next = params();
@@ -460,10 +478,11 @@ Solver::Totals CpuSolver::totals() const {
       t.depth[i] = u.h.at(x, y);
       t.suspended[i] = u.s.at(x, y);
       for (int l = 0; l < m.L; ++l) t.layers[size_t(l) * m.cells() + i] = m.layers.at(x, l * m.h + y);
-      t.outflowM3 += double(m.accum[0].at(x, y));
-      t.evaporatedM3 += double(m.accum[2].at(x, y));
-      t.sedimentOutflowM3 += double(m.accum[4].at(x, y));
-      const float level = m.accum[6].at(x, y);
+      t.outflowM3 += double(m.accum[kAccumOutflow].at(x, y));
+      t.evaporatedM3 += double(m.accum[kAccumEvaporated].at(x, y));
+      t.infiltratedM3 += double(m.accum[kAccumInfiltrated].at(x, y));
+      t.sedimentOutflowM3 += double(m.accum[kAccumSedimentOut].at(x, y));
+      const float level = m.accum[kAccumLevel].at(x, y);
       (level > 0 ? t.levelInM3 : t.levelOutM3) += double(level);
     }
   }
@@ -504,9 +523,9 @@ void CpuSolver::setFloodStatsCells(const std::vector<float>& cells) {
 }
 
 namespace {
-// Copies 4 (or 8) planes at cells [x0, x0 + width) x [y0, y0 + height) to / from per-cell groups.
+// Copies N planes at cells [x0, x0 + width) x [y0, y0 + height) to / from per-cell groups.
 template <size_t N>
-void planesToCells(const cpu::Plane* const (&planes)[N], int x0, int y0, int width, int height, float* out) {
+void planesToCells(const std::array<const cpu::Plane*, N>& planes, int x0, int y0, int width, int height, float* out) {
   for (int y = 0; y < height; ++y) {
     for (int x = 0; x < width; ++x) {
       for (size_t k = 0; k < N; ++k) *out++ = planes[k]->empty() ? 0.0f : planes[k]->at(x0 + x, y0 + y);
@@ -514,7 +533,7 @@ void planesToCells(const cpu::Plane* const (&planes)[N], int x0, int y0, int wid
   }
 }
 template <size_t N>
-void cellsToPlanes(const float* in, int x0, int y0, int width, int height, cpu::Plane* const (&planes)[N]) {
+void cellsToPlanes(const float* in, int x0, int y0, int width, int height, const std::array<cpu::Plane*, N>& planes) {
   for (int y = 0; y < height; ++y) {
     for (int x = 0; x < width; ++x) {
       for (size_t k = 0; k < N; ++k, ++in) {
@@ -523,21 +542,32 @@ void cellsToPlanes(const float* in, int x0, int y0, int width, int height, cpu::
     }
   }
 }
+// A group's planes: the water state, the pipes, the diagonal pipes, the accumulators (AccumOffset order).
+template <class P, size_t N>
+std::array<P*, N> planesOf(P (&planes)[N]) {
+  std::array<P*, N> out;
+  for (size_t k = 0; k < N; ++k) out[k] = &planes[k];
+  return out;
+}
+template <class W>
+auto statePlanesOf(W& u) {
+  using P = std::remove_reference_t<decltype((u.h))>;
+  return std::array<P*, 4>{&u.h, &u.s, &u.hu, &u.hv};
+}
 }  // namespace
 
 void CpuSolver::saveCells(SolverState& out) const {
   const Impl& m = *impl_;
   const auto& u = m.now();
   const size_t n = m.cells();
-  const cpu::Plane* const statePlanes[4] = {&u.h, &u.s, &u.hu, &u.hv};
-  const cpu::Plane* const fluxPlanes[4] = {&m.flux[0], &m.flux[1], &m.flux[2], &m.flux[3]};
-  const cpu::Plane* const diagPlanes[4] = {&m.fluxDiag[0], &m.fluxDiag[1], &m.fluxDiag[2], &m.fluxDiag[3]};
-  const cpu::Plane* const accumPlanes[8] = {&m.accum[0], &m.accum[1], &m.accum[2], &m.accum[3],
-                                            &m.accum[4], &m.accum[5], &m.accum[6], &m.accum[7]};
+  const auto statePlanes = statePlanesOf(u);
+  const auto fluxPlanes = planesOf(m.flux);
+  const auto diagPlanes = planesOf(m.fluxDiag);
+  const auto accumPlanes = planesOf(m.accum);
   out.state.resize(4 * n);
   out.flux.resize(4 * n);
   out.fluxDiag.resize(4 * n);
-  out.accum.resize(8 * n);
+  out.accum.resize(kAccumPerCell * n);
   planesToCells(statePlanes, 0, 0, m.w, m.h, out.state.data());
   planesToCells(fluxPlanes, 0, 0, m.w, m.h, out.flux.data());
   planesToCells(diagPlanes, 0, 0, m.w, m.h, out.fluxDiag.data());
@@ -549,7 +579,7 @@ Status CpuSolver::restoreCells(const SolverState& in) {
   Impl& m = *impl_;
   const size_t n = m.cells();
   if (in.state.size() != 4 * n || in.flux.size() != 4 * n || in.fluxDiag.size() != 4 * n ||
-      in.layers.size() != size_t(m.L) * n || in.accum.size() != 8 * n) {
+      in.layers.size() != size_t(m.L) * n || in.accum.size() != kAccumPerCell * n) {
     return fail("sim: the saved state is of a different grid (" + std::to_string(in.state.size() / 4) +
                 " cells, this simulation has " + std::to_string(n) + ")");
   }
@@ -566,11 +596,10 @@ CellBlock CpuSolver::readBlock(int x0, int y0, int width, int height, unsigned p
                                             << " outside the " << m.w << "x" << m.h << " grid";
   const auto& u = m.now();
   const size_t cells = b.cells();
-  const cpu::Plane* const statePlanes[4] = {&u.h, &u.s, &u.hu, &u.hv};
-  const cpu::Plane* const fluxPlanes[4] = {&m.flux[0], &m.flux[1], &m.flux[2], &m.flux[3]};
-  const cpu::Plane* const diagPlanes[4] = {&m.fluxDiag[0], &m.fluxDiag[1], &m.fluxDiag[2], &m.fluxDiag[3]};
-  const cpu::Plane* const accumPlanes[8] = {&m.accum[0], &m.accum[1], &m.accum[2], &m.accum[3],
-                                            &m.accum[4], &m.accum[5], &m.accum[6], &m.accum[7]};
+  const auto statePlanes = statePlanesOf(u);
+  const auto fluxPlanes = planesOf(m.flux);
+  const auto diagPlanes = planesOf(m.fluxDiag);
+  const auto accumPlanes = planesOf(m.accum);
   if (parts & kBlockState) {
     b.state.resize(4 * cells);
     planesToCells(statePlanes, x0, y0, width, height, b.state.data());
@@ -594,7 +623,7 @@ CellBlock CpuSolver::readBlock(int x0, int y0, int width, int height, unsigned p
     }
   }
   if (parts & kBlockAccum) {
-    b.accum.resize(8 * cells);
+    b.accum.resize(kAccumPerCell * cells);
     planesToCells(accumPlanes, x0, y0, width, height, b.accum.data());
   }
   return b;
@@ -605,11 +634,10 @@ void CpuSolver::writeBlock(const CellBlock& b) {
   STRATA_CHECK(blockFits(b, m.w, m.h, m.L)) << "writeBlock: sizes do not match the block or the grid";
   auto& u = m.now();
   const size_t cells = b.cells();
-  cpu::Plane* const statePlanes[4] = {&u.h, &u.s, &u.hu, &u.hv};
-  cpu::Plane* const fluxPlanes[4] = {&m.flux[0], &m.flux[1], &m.flux[2], &m.flux[3]};
-  cpu::Plane* const diagPlanes[4] = {&m.fluxDiag[0], &m.fluxDiag[1], &m.fluxDiag[2], &m.fluxDiag[3]};
-  cpu::Plane* const accumPlanes[8] = {&m.accum[0], &m.accum[1], &m.accum[2], &m.accum[3],
-                                      &m.accum[4], &m.accum[5], &m.accum[6], &m.accum[7]};
+  const auto statePlanes = statePlanesOf(u);
+  const auto fluxPlanes = planesOf(m.flux);
+  const auto diagPlanes = planesOf(m.fluxDiag);
+  const auto accumPlanes = planesOf(m.accum);
   if (!b.state.empty()) cellsToPlanes(b.state.data(), b.rect.x, b.rect.y, b.rect.width, b.rect.height, statePlanes);
   if (!b.flux.empty()) cellsToPlanes(b.flux.data(), b.rect.x, b.rect.y, b.rect.width, b.rect.height, fluxPlanes);
   if (!b.fluxDiag.empty())

@@ -44,13 +44,32 @@ STRATA_ROW_KERNEL void sourcesRow(float* h, float* sum, float* err, const float*
   rain ? cells(std::true_type{}) : cells(std::false_type{});
 }
 
-// sim/shaders/sources.comp: rain (W11), evaporation (W11), then point_sources.comp (W12).
+// sim/shaders/sources.comp for a row, after rain and evaporation: each cell loses to the soil
+// what its infiltration capacity over the step allows of its water (W11b), the infiltrated
+// volume summed with compensation; that sum over the cell's area is the capacity's F.
+STRATA_ROW_KERNEL void infiltrationRow(float* h, float* sum, float* err, const float* ks, const float* g, float area,
+                                       int x0, int x1, float dtS) {
+  for (int x = x0; x < x1; ++x) {
+    const float f = minOf(h[x], infiltrationCapacity(ks[x] * dtS, g[x], sum[x] / area));
+    if (f > 0.0f) {
+      h[x] -= f;
+      kahanAdd(sum[x], err[x], f * area);
+    }
+  }
+}
+
+// sim/shaders/sources.comp: rain (W11), evaporation (W11), infiltration (W11b), then
+// point_sources.comp (W12).
 void Impl::sourcesPass(const std::vector<SourceEntry>& entries) {
   forRuns(sources, [&](const Run& r, int) {
     const float evapMax = p.evaporationMmPerHour * kMmPerHourToMS * dt;
     for (int y = r.y0; y < r.y1; ++y) {
-      sourcesRow(now().h.row(y), accum[2].row(y), accum[3].row(y), rain.empty() ? nullptr : rain.row(y),
-                 rowArea[size_t(y)], r.x0, r.x1, p.rainMmPerHour, dt, evapMax);
+      sourcesRow(now().h.row(y), accum[kAccumEvaporated].row(y), accum[kAccumEvaporated + 1].row(y),
+                 rain.empty() ? nullptr : rain.row(y), rowArea[size_t(y)], r.x0, r.x1, p.rainMmPerHour, dt, evapMax);
+      if (!infilKs.empty()) {
+        infiltrationRow(now().h.row(y), accum[kAccumInfiltrated].row(y), accum[kAccumInfiltrated + 1].row(y),
+                        infilKs.row(y), infilG.row(y), rowArea[size_t(y)], r.x0, r.x1, dt);
+      }
     }
   });
   for (const auto& e : entries) {
@@ -308,8 +327,14 @@ void Impl::pipeUpdatePass() {
     const PipeConst c = pipeConst(*this);
     for (int y = run.y0; y < run.y1; ++y) {
       Water& nx = next();
-      const PipeOut o{nx.h.row(y),     nx.s.row(y),     nx.hu.row(y),    nx.hv.row(y),
-                      accum[0].row(y), accum[1].row(y), accum[4].row(y), accum[5].row(y)};
+      const PipeOut o{nx.h.row(y),
+                      nx.s.row(y),
+                      nx.hu.row(y),
+                      nx.hv.row(y),
+                      accum[kAccumOutflow].row(y),
+                      accum[kAccumOutflow + 1].row(y),
+                      accum[kAccumSedimentOut].row(y),
+                      accum[kAccumSedimentOut + 1].row(y)};
       pipeUpdateRow(c, pipeRow(*this, y), o, run.x0, run.x1, p.diagonalPipes, anySuspended);
       if (p.erosionEnabled) tiltRows(y, run.x0, run.x1);
     }
@@ -780,8 +805,8 @@ float Impl::fvSedimentEdge(int x, int y, const FaceFlux limited[4]) {
       const float moved = denI > 0.0f ? s * A * volOut / denI : 0.0f;
       sNew -= moved / A;
       if (boundary) {
-        kahanAdd(accum[0].at(x, y), accum[1].at(x, y), volOut);
-        kahanAdd(accum[4].at(x, y), accum[5].at(x, y), moved);
+        kahanAdd(accum[kAccumOutflow].at(x, y), accum[kAccumOutflow + 1].at(x, y), volOut);
+        kahanAdd(accum[kAccumSedimentOut].at(x, y), accum[kAccumSedimentOut + 1].at(x, y), moved);
       }
     } else if (volOut < 0.0f && !boundary) {
       const float Aj = rowArea[size_t(ny)];
@@ -812,7 +837,7 @@ void Impl::levelPass(const std::vector<LevelEntry>& entries) {
     u.h.at(x, y) = h1;
     u.hu.at(x, y) *= keep;
     u.hv.at(x, y) *= keep;
-    kahanAdd(accum[6].at(x, y), accum[7].at(x, y), (h1 - h0) * rowArea[size_t(y)]);
+    kahanAdd(accum[kAccumLevel].at(x, y), accum[kAccumLevel + 1].at(x, y), (h1 - h0) * rowArea[size_t(y)]);
   }
 }
 

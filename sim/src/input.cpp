@@ -59,6 +59,13 @@ Status validate(const SimInput& input, const SimParams& params) {
   if (input.waterDepthM.size() > 0) STRATA_TRY_STATUS(checkGrid(input.waterDepthM, w, h, "waterDepthM", true));
   if (input.rainMmPerHour.size() > 0) STRATA_TRY_STATUS(checkGrid(input.rainMmPerHour, w, h, "rainMmPerHour", true));
   if (input.manningN.size() > 0) STRATA_TRY_STATUS(checkGrid(input.manningN, w, h, "manningN", true));
+  if (input.infiltrationMmPerHour.size() > 0) {
+    STRATA_TRY_STATUS(checkGrid(input.infiltrationMmPerHour, w, h, "infiltrationMmPerHour", true));
+  }
+  if (input.infiltrationSuctionM.size() > 0) {
+    if (input.infiltrationMmPerHour.size() == 0) return fail("sim input: infiltrationSuctionM without a rate");
+    STRATA_TRY_STATUS(checkGrid(input.infiltrationSuctionM, w, h, "infiltrationSuctionM", true));
+  }
   if (input.rowDxM.size() != 1 && input.rowDxM.size() != size_t(h)) {
     return fail("sim input: rowDxM has " + std::to_string(input.rowDxM.size()) + " values, expected 1 or " +
                 std::to_string(h) + " (one per row)");

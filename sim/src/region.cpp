@@ -41,6 +41,8 @@ Result<SimInput> cutRegion(const SimInput& full, const CellRect& rect) {
   out.waterDepthM = crop(full.waterDepthM, rect);
   out.rainMmPerHour = crop(full.rainMmPerHour, rect);
   out.manningN = crop(full.manningN, rect);
+  out.infiltrationMmPerHour = crop(full.infiltrationMmPerHour, rect);
+  out.infiltrationSuctionM = crop(full.infiltrationSuctionM, rect);
   if (full.rowDxM.size() == 1) {
     out.rowDxM = full.rowDxM;
   } else if (full.rowDxM.size() == size_t(full.baseM.height)) {
@@ -112,8 +114,8 @@ Result<SimInput> readWindow(const RegionSource& region, const CellRect& window) 
     return (optional && g.size() == 0) || (g.width == window.width && g.height == window.height);
   };
   bool ok = sized(s.baseM, false) && sized(s.waterDepthM, true) && sized(s.rainMmPerHour, true) &&
-            sized(s.manningN, true) && s.layersM.size() == region.materials.size() &&
-            s.materials.size() == region.materials.size() &&
+            sized(s.manningN, true) && sized(s.infiltrationMmPerHour, true) && sized(s.infiltrationSuctionM, true) &&
+            s.layersM.size() == region.materials.size() && s.materials.size() == region.materials.size() &&
             (s.rowDxM.size() == 1 || s.rowDxM.size() == size_t(window.height)) && s.dyM == region.dyM &&
             s.datumM == region.datumM;
   for (const auto& l : s.layersM) ok = ok && sized(l, false);

@@ -58,6 +58,30 @@ Status Solver::setParams(const SimParams& params) {
   return {};
 }
 
+Status Solver::setRainRaster(const gis::Grid<float>& mmPerHour) {
+  if (mmPerHour.size() > 0) {
+    if (mmPerHour.width != grid_.width || mmPerHour.height != grid_.height) {
+      return fail("sim: a rain raster of " + std::to_string(mmPerHour.width) + "x" + std::to_string(mmPerHour.height) +
+                  " cells for a grid of " + std::to_string(grid_.width) + "x" + std::to_string(grid_.height));
+    }
+    for (size_t i = 0; i < mmPerHour.size(); ++i) {
+      const float v = mmPerHour.data[i];
+      if (!(v >= 0.0f) || !std::isfinite(v)) {
+        return fail("sim: rain raster value " + std::to_string(v) + " mm/h at cell (" +
+                    std::to_string(i % size_t(grid_.width)) + ", " + std::to_string(i / size_t(grid_.width)) + ")");
+      }
+    }
+  }
+  STRATA_TRY_STATUS(onRainRasterChanged(mmPerHour));
+  rainRaster_ = mmPerHour.data;
+  updateRainTotals();
+  return {};
+}
+
+Status Solver::onRainRasterChanged(const gis::Grid<float>& /*mmPerHour*/) {
+  return fail("sim: the " + backendName() + " cannot change its rain raster during a run");
+}
+
 double Solver::nextDt() {
   if (params_.cflAlpha <= 0) return params_.maxDtS;  // no wave speed needed (a GPU read-back saved)
   return stepDtWithSources(params_, maxWaveSpeedMS(), maxRainRasterMmH_, sources_, grid_, c_.timeS);
@@ -141,10 +165,12 @@ Solver::Totals Solver::totals() const {
   for (size_t i = 0; i < n; ++i) {
     t.depth[i] = b.state[4 * i];
     t.suspended[i] = b.state[4 * i + 1];
-    t.outflowM3 += double(b.accum[8 * i]);
-    t.evaporatedM3 += double(b.accum[8 * i + 2]);
-    t.sedimentOutflowM3 += double(b.accum[8 * i + 4]);
-    (b.accum[8 * i + 6] > 0 ? t.levelInM3 : t.levelOutM3) += double(b.accum[8 * i + 6]);
+    const float* a = &b.accum[kAccumPerCell * i];
+    t.outflowM3 += double(a[kAccumOutflow]);
+    t.evaporatedM3 += double(a[kAccumEvaporated]);
+    t.infiltratedM3 += double(a[kAccumInfiltrated]);
+    t.sedimentOutflowM3 += double(a[kAccumSedimentOut]);
+    (a[kAccumLevel] > 0 ? t.levelInM3 : t.levelOutM3) += double(a[kAccumLevel]);
   }
   t.layers = std::move(b.layers);
   return t;
@@ -176,7 +202,7 @@ Status Solver::restoreCells(const SolverState& in) {
   const size_t n = grid_.cells();
   const size_t diag = params_.diagonalPipes ? 4 * n : 0;
   if (in.state.size() != 4 * n || in.flux.size() != 4 * n || in.fluxDiag.size() != diag ||
-      in.layers.size() != size_t(grid_.layers) * n || in.accum.size() != 8 * n) {
+      in.layers.size() != size_t(grid_.layers) * n || in.accum.size() != kAccumPerCell * n) {
     return fail("sim: the saved state is of a different grid or model (" + std::to_string(in.state.size() / 4) +
                 " cells, this simulation has " + std::to_string(n) + ")");
   }
@@ -198,6 +224,7 @@ SimStats Solver::counterStats() const {
   s.rainM3 = c_.rainM3;
   s.inflowM3 = c_.inflowM3;
   s.initialMaterialM3 = c_.initialMaterialM3;
+  s.infiltratedM3 = -c_.infiltratedBeforeM3;  // stats() adds the cells' sums
   return s;
 }
 
@@ -208,6 +235,7 @@ SimStats Solver::stats() const {
   s.inflowM3 = c_.inflowM3 + t.levelInM3;    // W26: level cells that gained water on balance
   s.outflowM3 = t.outflowM3 - t.levelOutM3;  // and those that lost (levelOut <= 0)
   s.evaporatedM3 = t.evaporatedM3;
+  s.infiltratedM3 += t.infiltratedM3;
   s.sedimentOutflowM3 = t.sedimentOutflowM3;
   s.suspendedM3 = integrate(t.suspended, grid_);
   s.materialM3 = s.suspendedM3 + integrate(t.layers, grid_);
@@ -283,6 +311,7 @@ void Solver::setClock(double timeS) {
 void Solver::restartAt(double timeS) {
   STRATA_CHECK(std::isfinite(timeS)) << "restart at " << timeS;
   setClock(timeS);
+  c_.infiltratedBeforeM3 += stats().infiltratedM3;
   clearAccumulators();
   c_.inflowM3 = 0;
   c_.rainM3 = 0;
@@ -290,8 +319,11 @@ void Solver::restartAt(double timeS) {
 }
 
 void Solver::clearAccumulators() {
+  static_assert(kAccumInfiltrated + 2 == kAccumPerCell, "the infiltration pair is a cell's last");
   CellBlock b = readBlock(0, 0, grid_.width, grid_.height, kBlockAccum);
-  std::fill(b.accum.begin(), b.accum.end(), 0.0f);
+  for (size_t i = 0; i < b.accum.size(); i += kAccumPerCell) {
+    std::fill_n(&b.accum[i], kAccumInfiltrated, 0.0f);  // the sums before the infiltration pair
+  }
   writeBlock(b);
 }
 

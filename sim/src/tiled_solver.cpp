@@ -35,6 +35,8 @@ Result<TiledSolver> TiledSolver::create(const SimInput& input, const SimParams& 
       sub.waterDepthM = crop(input.waterDepthM, ex0, ey0, ex1, ey1);
       sub.rainMmPerHour = crop(input.rainMmPerHour, ex0, ey0, ex1, ey1);
       sub.manningN = crop(input.manningN, ex0, ey0, ex1, ey1);
+      sub.infiltrationMmPerHour = crop(input.infiltrationMmPerHour, ex0, ey0, ex1, ey1);
+      sub.infiltrationSuctionM = crop(input.infiltrationSuctionM, ex0, ey0, ex1, ey1);
       sub.rowDxM.assign(t.grid().rowDxM.begin() + ey0, t.grid().rowDxM.begin() + ey1);
       sub.dyM = input.dyM;
       sub.datumM = input.datumM;
@@ -83,6 +85,13 @@ Status TiledSolver::onLevelAdded(const LevelBoundary& level) {
         sub.cells.push_back({x - tile.ex0, y - tile.ey0});
     }
     if (!sub.cells.empty()) STRATA_TRY_STATUS(tile.solver->addLevel(sub));
+  }
+  return {};
+}
+
+Status TiledSolver::onRainRasterChanged(const gis::Grid<float>& mmPerHour) {
+  for (auto& tile : tiles_) {
+    STRATA_TRY_STATUS(tile.solver->setRainRaster(crop(mmPerHour, tile.ex0, tile.ey0, tile.ex1, tile.ey1)));
   }
   return {};
 }

@@ -12,6 +12,7 @@
 #include <strata/sim/tiled_solver.hpp>
 
 #include "gl_fixture.hpp"
+#include "infiltration_cases.hpp"
 #include "runoff_scenes.hpp"
 #include "sim_scenes.hpp"
 #include "strata_test.hpp"
@@ -45,7 +46,8 @@ TEST_F(GlTest, SimKernelsUseTheSlotsDeclaredInCpp) {
         "erode", "thermal_flux", "thermal_apply", "flood_stats", "level_boundary", "copy_rect", "bed_rect"}) {
     programs.push_back({{std::string("sim/shaders/") + k + ".comp"}});
   }
-  test::expectProgramsMatchSlots("sim/shaders/", strata::sim::slots::kAll, programs);
+  test::expectProgramsMatchSlots("sim/shaders/", strata::sim::slots::kAll, programs,
+                                 strata::sim::slots::kernelDefines());
 }
 
 TEST_F(GlTest, SimLakeAtRestStaysFlat) {
@@ -130,6 +132,59 @@ TEST_F(GlTest, SimRainAndSourcesBalance) {
   EXPECT_GT(st.evaporatedM3, 0.1);
   // Float32 depth updates of ~2e4 m3 over 2000 steps; same bound as the CPU reference (1e-5).
   EXPECT_LT(std::abs(st.waterBalanceM3()), 1e-5 * moved);
+}
+
+// W11b on the GL backend and on tiles of 4 x 3 cells: Green-Ampt under ponding on the flat basin
+// (tests/sim/sim_infiltration_test.cpp) follows its analytic curve at any step, as on the CPU,
+// and each cell's soil state is its own (tiles take the same answer).
+TEST_F(GlTest, SimInfiltrationFollowsGreenAmptOnTheGpuAndOnTiles) {
+  const double area = test::basinAreaM2();
+  const double expected = test::greenAmptDepthM(3600.0) * area;
+  for (const float maxStep : {15.0f, 0.5f}) {
+    auto gpu = GlSolver::create(test::infiltrationBasin(0.2), test::basinParams(0.0f, maxStep));
+    ASSERT_TRUE(gpu) << gpu.message();
+    gpu->advance(3600.0);
+    const auto st = gpu->stats();
+    std::printf("GPU step cap %.1f s: F(1 h) %.6f m (Green-Ampt %.6f m)\n", maxStep, st.infiltratedM3 / area,
+                expected / area);
+    EXPECT_NEAR(st.infiltratedM3, expected, 2e-4 * expected) << "step cap " << maxStep;
+    EXPECT_NEAR(st.waterBalanceM3(), 0.0, 1e-5 * st.initialWaterM3) << "step cap " << maxStep;
+  }
+  auto tiled = TiledSolver::create(test::infiltrationBasin(0.2), test::basinParams(0.0f, 15.0f), TileOptions{4, 3, 8},
+                                   cpuSolverFactory());
+  ASSERT_TRUE(tiled) << tiled.message();
+  tiled->advance(3600.0);
+  EXPECT_NEAR(tiled->stats().infiltratedM3, expected, 2e-4 * expected);
+  EXPECT_NEAR(tiled->stats().waterBalanceM3(), 0.0, 1e-5 * tiled->stats().initialWaterM3);
+}
+
+// Rain frames (setRainRaster) on the GL backend and on tiles: the CPU test's two frames
+// (tests/sim/sim_runoff_test.cpp) rain their own volumes, and the basin holds them.
+TEST_F(GlTest, SimRainFramesOnTheGpuAndOnTiles) {
+  SimInput in = test::infiltrationBasin(0.0);
+  in.infiltrationMmPerHour = {};
+  in.infiltrationSuctionM = {};
+  const int w = in.baseM.width, h = in.baseM.height;
+  gis::Grid<float> west(w, h, 0.0f), east(w, h, 0.0f);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) (x < w / 2 ? west : east).at(x, y) = x < w / 2 ? 10.0f : 30.0f;
+  }
+  const double both = (10e-3 + 30e-3) * test::basinAreaM2() / 2 / 6;
+  auto gpu = GlSolver::create(in, test::basinParams(0.0f, 15.0f));
+  ASSERT_TRUE(gpu) << gpu.message();
+  auto tiled = TiledSolver::create(in, test::basinParams(0.0f, 15.0f), TileOptions{4, 3, 8}, cpuSolverFactory());
+  ASSERT_TRUE(tiled) << tiled.message();
+  for (Solver* sim : {static_cast<Solver*>(&*gpu), static_cast<Solver*>(&*tiled)}) {
+    ASSERT_TRUE(sim->setRainRaster(west));
+    sim->advance(600.0);
+    ASSERT_TRUE(sim->setRainRaster(east));
+    sim->advance(600.0);
+    ASSERT_TRUE(sim->setRainRaster({}));
+    sim->advance(600.0);
+    const auto st = sim->stats();
+    EXPECT_NEAR(st.rainM3, both, 1e-9 * both) << sim->backendName();
+    EXPECT_NEAR(st.storedWaterM3, both, 1e-5 * both) << sim->backendName();
+  }
 }
 
 // GPU and CPU run the same passes in float32; they differ only where the GPU compiler fuses a

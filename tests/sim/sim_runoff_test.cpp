@@ -9,6 +9,7 @@
 
 #include <strata/sim/cpu_solver.hpp>
 
+#include "infiltration_cases.hpp"
 #include "runoff_scenes.hpp"
 
 namespace strata::sim {
@@ -171,6 +172,53 @@ TEST(SimRunoffCpu, VCatchmentHydrographFollowsTheKinematicWave) {
     EXPECT_GT(nse, 0.98) << cell;
     EXPECT_LT(r.balance, 1e-4) << cell;
   }
+}
+
+}  // namespace
+}  // namespace strata::sim
+
+namespace strata::sim {
+namespace {
+
+// Issue 31: rain from a raster series (radar frames). On the closed flat basin of the infiltration
+// tests without its soil: 10 mm/h on the west half for 10 min, then 30 mm/h on the east half for
+// 10 min, then none. The rain each frame put down is its rate x its area x its time, and the basin
+// holds it all; a raster of the wrong size or with a negative value is refused and changes nothing.
+TEST(SimRainFramesCpu, EachFrameRainsItsOwnVolume) {
+  SimInput in = test::infiltrationBasin(0.0);
+  in.infiltrationMmPerHour = {};
+  in.infiltrationSuctionM = {};
+  const int w = in.baseM.width, h = in.baseM.height;
+  gis::Grid<float> west(w, h, 0.0f), east(w, h, 0.0f);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) (x < w / 2 ? west : east).at(x, y) = x < w / 2 ? 10.0f : 30.0f;
+  }
+  const double half = test::basinAreaM2() / 2;
+  auto sim = CpuSolver::create(in, test::basinParams(0.0f, 15.0f));
+  ASSERT_TRUE(sim) << sim.message();
+  ASSERT_TRUE(sim->setRainRaster(west));
+  sim->advance(600.0);
+  EXPECT_NEAR(sim->stats().rainM3, 10e-3 * half / 6, 1e-9 * half);
+  ASSERT_TRUE(sim->setRainRaster(east));
+  sim->advance(600.0);
+  const double both = (10e-3 + 30e-3) * half / 6;
+  EXPECT_NEAR(sim->stats().rainM3, both, 1e-9 * half);
+  ASSERT_TRUE(sim->setRainRaster({}));
+  sim->advance(600.0);
+  const auto st = sim->stats();
+  EXPECT_NEAR(st.rainM3, both, 1e-9 * half);
+  EXPECT_NEAR(st.storedWaterM3, both, 1e-5 * both);
+
+  gis::Grid<float> bad = west;
+  bad.at(2, 1) = -1.0f;
+  auto refused = sim->setRainRaster(bad);
+  ASSERT_FALSE(refused);
+  EXPECT_EQ(refused.message(), "sim: rain raster value -1.000000 mm/h at cell (2, 1)");
+  refused = sim->setRainRaster(gis::Grid<float>(3, 3, 1.0f));
+  ASSERT_FALSE(refused);
+  EXPECT_EQ(refused.message(), "sim: a rain raster of 3x3 cells for a grid of 10x8");
+  sim->advance(600.0);
+  EXPECT_NEAR(sim->stats().rainM3, both, 1e-9 * half);  // still none
 }
 
 }  // namespace

@@ -48,7 +48,7 @@ TEST(SimState, EncodedStateRestoresBitForBit) {
   EXPECT_FALSE(decodeState("not a state"));
   std::string huge = bytes;
   const uint64_t n = ~0ull;
-  std::memcpy(&huge[8 + 6 * 8 + 8 + 4], &n, 8);  // the length of `state`: beyond what is left
+  std::memcpy(&huge[8 + sizeof(SolverCounters) + 4], &n, 8);  // the length of `state`: beyond what is left
   EXPECT_FALSE(decodeState(huge));
 }
 

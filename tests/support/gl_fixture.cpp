@@ -72,8 +72,8 @@ gl::HeadlessContext& GlTest::context() {
 }
 
 void expectProgramsMatchSlots(const std::string& folder, std::span<const gl::Binding> slots,
-                              const std::vector<SlotProgram>& programs) {
-  const auto defines = gl::definesFor(slots);
+                              const std::vector<SlotProgram>& programs, std::vector<gl::ShaderDefine> defines) {
+  if (defines.empty()) defines = gl::definesFor(slots);
   std::set<std::string> files, usedSlots;
   for (const auto& p : programs) {
     std::string label;

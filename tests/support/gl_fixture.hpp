@@ -43,7 +43,8 @@ struct SlotProgram {
 /// compiles with the table's #defines, every block, sampler and image it has is declared in the
 /// table with the binding the program got (gl::checkBindings), every table entry is used by some
 /// program, and every program file under `folder` (e.g. "render/shaders/") is in some program.
+/// `defines`: what the library compiles its programs with, when more than the table's slots.
 void expectProgramsMatchSlots(const std::string& folder, std::span<const gl::Binding> slots,
-                              const std::vector<SlotProgram>& programs);
+                              const std::vector<SlotProgram>& programs, std::vector<gl::ShaderDefine> defines = {});
 
 }  // namespace strata::test

@@ -25,13 +25,24 @@ void barrier() { gl::memoryBarrier(gl::Barrier::kStorage); }
 void readBarrier() { gl::memoryBarrier(gl::Barrier::kBufferUpdate); }
 }  // namespace
 
+std::vector<gl::ShaderDefine> slots::kernelDefines() {
+  auto d = gl::definesFor(kAll);
+  d.insert(d.end(), {{"ACCUM_PER_CELL", kAccumPerCell},
+                     {"ACCUM_OUTFLOW", kAccumOutflow},
+                     {"ACCUM_EVAPORATED", kAccumEvaporated},
+                     {"ACCUM_SEDIMENT_OUT", kAccumSedimentOut},
+                     {"ACCUM_LEVEL", kAccumLevel},
+                     {"ACCUM_INFILTRATED", kAccumInfiltrated}});
+  return d;
+}
+
 struct GlSolver::Impl {
   GpuSimParams p{};  // the block the kernels read (gpuParams)
   size_t n = 0;
   int layers = 0;
 
   gl::Buffer params, materials, rowDx, base, bed, layerBuf, stateA, stateB, stage, flux, fluxDiag, faceX, faceY, tilt,
-      accum, rain, manning, thermal, scour, sourceEntries, maxSpeed, floodStats, fvLimit, levelEntries;
+      accum, rain, manning, infiltration, thermal, scour, sourceEntries, maxSpeed, floodStats, fvLimit, levelEntries;
   bool aIsCurrent = true;
   gl::Program pSources, pPointSources, pWaveSpeed, pPipeFlux, pPipeUpdate, pFvFace, pFvLimit, pFvUpdate, pErode,
       pThermalFlux, pThermalApply, pFloodStats, pLevel, pCopyRect, pBedRect;
@@ -60,6 +71,7 @@ struct GlSolver::Impl {
     accum.bind(slots::kAccum);
     rain.bind(slots::kRain);
     manning.bind(slots::kManning);
+    infiltration.bind(slots::kInfiltration);
     thermal.bind(slots::kThermal);
     scour.bind(slots::kScour);
     sourceEntries.bind(slots::kSources);
@@ -253,7 +265,7 @@ Result<GlSolver> GlSolver::create(const SimInput& input, const SimParams& params
         Kernel{&s.pThermalApply, "sim/shaders/thermal_apply.comp"},
         Kernel{&s.pFloodStats, "sim/shaders/flood_stats.comp"}, Kernel{&s.pLevel, "sim/shaders/level_boundary.comp"},
         Kernel{&s.pCopyRect, "sim/shaders/copy_rect.comp"}, Kernel{&s.pBedRect, "sim/shaders/bed_rect.comp"}}) {
-    auto prog = gl::Program::compute(name, gl::definesFor(slots::kAll));
+    auto prog = gl::Program::compute(name, slots::kernelDefines());
     if (!prog) return fail("sim: " + prog.message());
     *program = std::move(prog).value();
   }
@@ -299,13 +311,20 @@ Result<GlSolver> GlSolver::create(const SimInput& input, const SimParams& params
   s.fvLimit.fill(0u);
   s.tilt = gl::Buffer(4 * n);
   s.tilt.fill(0u);
-  s.accum = gl::Buffer(32 * n);
+  s.accum = gl::Buffer(sizeof(float) * kAccumPerCell * n);
   s.accum.fill(0u);
   s.rain = gl::Buffer::from(std::span<const float>(rain));
   // n^2 per cell of a roughness map; -1 (the uniform P.manningN, which setParams may change) without.
   std::vector<float> manningN2(n, -1.0f);
   for (size_t i = 0; i < input.manningN.size(); ++i) manningN2[i] = input.manningN.data[i] * input.manningN.data[i];
   s.manning = gl::Buffer::from(std::span<const float>(manningN2));
+  // W11b: (Ks m/s, psi * dtheta m) per cell; one (0, 0), which every cell reads, without.
+  std::vector<float> infiltration(input.infiltrationMmPerHour.size() > 0 ? 2 * n : 2, 0.0f);
+  for (size_t i = 0; i < input.infiltrationMmPerHour.size(); ++i) {
+    infiltration[2 * i] = input.infiltrationMmPerHour.data[i] * (1.0f / 3.6e6f);  // as the CPU backend
+    if (input.infiltrationSuctionM.size() > 0) infiltration[2 * i + 1] = input.infiltrationSuctionM.data[i];
+  }
+  s.infiltration = gl::Buffer::from(std::span<const float>(infiltration));
   s.thermal = gl::Buffer(16 * n);
   s.thermal.fill(0u);
   s.scour = gl::Buffer(4 * n);
@@ -326,6 +345,16 @@ std::string GlSolver::backendName() const {
 }
 
 void GlSolver::runStep(const StepInputs& step) { impl_->takeStep(step, !levels().empty(), floodThresholdM()); }
+
+Status GlSolver::onRainRasterChanged(const gis::Grid<float>& mmPerHour) {
+  Impl& s = *impl_;
+  if (mmPerHour.size() > 0) {
+    s.rain.upload(0, s.rain.size(), mmPerHour.data.data());
+  } else {
+    s.rain.fill(0u);
+  }
+  return {};
+}
 
 void GlSolver::onParamsChanged() {
   Impl& s = *impl_;
@@ -350,9 +379,9 @@ size_t GlSolver::gpuBytes() const {
   const Impl& s = *impl_;
   size_t total = 0;
   for (const gl::Buffer* b :
-       {&s.params,  &s.materials, &s.rowDx,    &s.base,          &s.bed,      &s.layerBuf,   &s.stateA, &s.stateB,
-        &s.stage,   &s.flux,      &s.fluxDiag, &s.faceX,         &s.faceY,    &s.tilt,       &s.accum,  &s.rain,
-        &s.manning, &s.thermal,   &s.scour,    &s.sourceEntries, &s.maxSpeed, &s.floodStats, &s.fvLimit}) {
+       {&s.params,  &s.materials,    &s.rowDx,    &s.base,  &s.bed,           &s.layerBuf, &s.stateA,     &s.stateB,
+        &s.stage,   &s.flux,         &s.fluxDiag, &s.faceX, &s.faceY,         &s.tilt,     &s.accum,      &s.rain,
+        &s.manning, &s.infiltration, &s.thermal,  &s.scour, &s.sourceEntries, &s.maxSpeed, &s.floodStats, &s.fvLimit}) {
     total += b->size();
   }
   return total;

@@ -277,8 +277,8 @@ struct DistributedSolver::Impl {
     const CellRect li = b.local(b.interior);
     const CellBlock a = b.solver->readBlock(li.x, li.y, li.width, li.height, kBlockAccum);
     for (size_t i = 0; i < a.cells(); ++i) {
-      for (int k = 1; k < 8; k += 2) {
-        if (!allZeroBits(&a.accum[8 * i + size_t(k)], 1)) return false;
+      for (int k = 1; k < kAccumPerCell; k += 2) {
+        if (!allZeroBits(&a.accum[kAccumPerCell * i + size_t(k)], 1)) return false;
       }
     }
     return true;
@@ -398,7 +398,7 @@ struct DistributedSolver::Impl {
     if (parts & kBlockFlux) out.flux.resize(4 * cells);
     if ((parts & kBlockFlux) && diag(params)) out.fluxDiag.resize(4 * cells);
     if (parts & kBlockLayers) out.layers.resize(size_t(layers()) * cells);
-    if (parts & kBlockAccum) out.accum.resize(8 * cells);
+    if (parts & kBlockAccum) out.accum.resize(kAccumPerCell * cells);
     for (size_t at = 0; at < all.size();) {
       const CellRect r{int(all[at]), int(all[at + 1]), int(all[at + 2]), int(all[at + 3])};
       CellBlock piece;
@@ -756,8 +756,8 @@ Result<RebalanceReport> DistributedSolver::rebalance() {
 
 SimStats DistributedSolver::stats() const {
   const Impl& m = *impl_;
-  // stored, suspended, layers, outflow, evaporated, sediment out, level in, level out
-  ExactSum sums[8];
+  // stored, suspended, layers, outflow, evaporated, sediment out, level in, level out, infiltrated
+  ExactSum sums[9];
   float maxDepth = 0;
   const CellGrid& g = grid();
   const int L = g.layers;
@@ -768,18 +768,19 @@ SimStats DistributedSolver::stats() const {
     for (size_t i = 0; i < cells; ++i) {
       const double area = g.area(b.interior.y + int(i / size_t(l.width)));
       const float* st = &c.state[4 * i];
-      const float* ac = &c.accum[8 * i];
+      const float* ac = &c.accum[kAccumPerCell * i];
       sums[0].add(double(st[0]) * area);
       sums[1].add(double(st[1]) * area);
       for (int k = 0; k < L; ++k) sums[2].add(double(c.layers[size_t(k) * cells + i]) * area);
-      sums[3].add(double(ac[0]));
-      sums[4].add(double(ac[2]));
-      sums[5].add(double(ac[4]));
-      sums[ac[6] > 0 ? 6 : 7].add(double(ac[6]));
+      sums[3].add(double(ac[kAccumOutflow]));
+      sums[4].add(double(ac[kAccumEvaporated]));
+      sums[5].add(double(ac[kAccumSedimentOut]));
+      sums[ac[kAccumLevel] > 0 ? 6 : 7].add(double(ac[kAccumLevel]));
+      sums[8].add(double(ac[kAccumInfiltrated]));
       maxDepth = std::max(maxDepth, st[0]);
     }
   }
-  allreduceExact(sums, 8, m.comm);
+  allreduceExact(sums, 9, m.comm);
   float globalMax = 0;
   MPI_Allreduce(&maxDepth, &globalMax, 1, MPI_FLOAT, MPI_MAX, m.comm);
   SimStats s = counterStats();
@@ -791,6 +792,7 @@ SimStats DistributedSolver::stats() const {
   s.inflowM3 += sums[6].value();                    // W26: level cells that gained water on balance
   s.outflowM3 = sums[3].value() - sums[7].value();  // and those that lost (<= 0)
   s.evaporatedM3 = sums[4].value();
+  s.infiltratedM3 += sums[8].value();
   s.sedimentOutflowM3 = sums[5].value();
   s.maxDepthM = globalMax;
   return s;

@@ -55,6 +55,7 @@ class CpuSolver final : public Solver {
   void runStep(const StepInputs& step) override;
   void onParamsChanged() override;
   Totals totals() const override;
+  Status onRainRasterChanged(const gis::Grid<float>& mmPerHour) override;
   bool keepsFloodStats() const override { return true; }
   void resetFloodStats() override;
   std::vector<float> floodStatsCells() const override;

@@ -25,6 +25,12 @@ struct SimInput {
   /// Manning's n per cell (s m^-1/3, >= 0; W19, E1): a roughness map; empty = SimParams::manningN
   /// everywhere (and then a setParams changes it).
   gis::Grid<float> manningN;
+  /// Infiltration per cell (W11b): the loss rate, or with a suction Green-Ampt's saturated
+  /// hydraulic conductivity Ks (mm/h, >= 0); empty = no infiltration.
+  gis::Grid<float> infiltrationMmPerHour;
+  /// Green-Ampt's wetting-front suction head times the soil's moisture deficit, psi * dtheta (m,
+  /// >= 0) per cell; 0 or empty (with a rate) = a constant loss at the rate.
+  gis::Grid<float> infiltrationSuctionM;
   std::vector<double> rowDxM;  ///< cell size east-west per row (m): one value, or one per row (geographic grids)
   double dyM = 1.0;            ///< cell size north-south (m)
   double datumM = 0.0;         ///< elevations are stored relative to this (m)

@@ -47,15 +47,28 @@ struct SimStats {
   double inflowM3 = 0;           ///< added by sources (and fixed levels that gained on balance)
   double outflowM3 = 0;          ///< left through open edges (and fixed levels that lost on balance)
   double evaporatedM3 = 0;       ///< evaporated
+  double infiltratedM3 = 0;      ///< lost to the soil
   double materialM3 = 0;         ///< all layers + suspended sediment now
   double suspendedM3 = 0;        ///< suspended sediment now
   double initialMaterialM3 = 0;  ///< all layers + suspended at the start
   double sedimentOutflowM3 = 0;  ///< suspended sediment carried out through open edges
   double maxDepthM = 0;          ///< deepest water now
-  /// stored - (initial + rain + inflow - outflow - evaporated): 0 up to rounding.
+  /// stored - (initial + rain + inflow - outflow - evaporated - infiltrated): 0 up to rounding.
   double waterBalanceM3() const {
-    return storedWaterM3 - (initialWaterM3 + rainM3 + inflowM3 - outflowM3 - evaporatedM3);
+    return storedWaterM3 - (initialWaterM3 + rainM3 + inflowM3 - outflowM3 - evaporatedM3 - infiltratedM3);
   }
+};
+
+/// Each cell's compensated (Kahan) sums (W20), a (sum, error) pair of floats each, m^3: the
+/// offsets into a cell's kAccumPerCell floats of CellBlock::accum and SolverState::accum. The GL
+/// kernels get the same numbers as #defines (ACCUM_PER_CELL, ACCUM_OUTFLOW, ...).
+enum AccumOffset : int {
+  kAccumOutflow = 0,      ///< water out through open edges
+  kAccumEvaporated = 2,   ///< evaporated (W11)
+  kAccumSedimentOut = 4,  ///< suspended sediment out through open edges
+  kAccumLevel = 6,        ///< gained (> 0) or lost at a fixed level (W26)
+  kAccumInfiltrated = 8,  ///< lost to the soil (W11b)
+  kAccumPerCell = 10,
 };
 
 /// Which parts of a rectangle of cells readBlock() reads (bits).
@@ -76,7 +89,7 @@ struct CellBlock {
   std::vector<float> flux;      ///< 4 per cell: pipe outflows W, E, N, S (m^3/s)
   std::vector<float> fluxDiag;  ///< 4 per cell: diagonal pipes NW, NE, SW, SE (with them)
   std::vector<float> layers;    ///< layer-major: layers[l * cells + cell] (m)
-  std::vector<float> accum;     ///< 8 per cell: compensated sums (SolverState::accum)
+  std::vector<float> accum;     ///< kAccumPerCell per cell: compensated sums (AccumOffset)
   size_t cells() const { return size_t(rect.width) * size_t(rect.height); }
 
   /// The one list of a block's parts: f(part's BlockParts bit, its values, floats per cell of a
@@ -89,7 +102,7 @@ struct CellBlock {
     f(kBlockFlux, b.flux, size_t(4), size_t(1));
     f(kBlockFlux, b.fluxDiag, size_t(4), size_t(1));
     f(kBlockLayers, b.layers, size_t(1), size_t(layers));
-    f(kBlockAccum, b.accum, size_t(8), size_t(1));
+    f(kBlockAccum, b.accum, size_t(kAccumPerCell), size_t(1));
   }
 };
 
@@ -101,6 +114,9 @@ void copyOverlap(const CellBlock& src, CellBlock& dst, int layers);
 /// A solver's own counters: time, steps and the budgets of what it added.
 struct SolverCounters {
   double timeS = 0, lastDtS = 0, rainM3 = 0, inflowM3 = 0, initialWaterM3 = 0, initialMaterialM3 = 0;
+  /// What the cells' infiltration sums held at the last restartAt(): they are the soil's state
+  /// (W11b's cumulative infiltration), kept through a restart, so the budget subtracts them.
+  double infiltratedBeforeM3 = 0;
   int64_t steps = 0;
 };
 
@@ -109,16 +125,16 @@ struct SolverCounters {
 /// solver it holds.
 struct SolverState {
   SolverCounters counters;
-  float wetThresholdM = -1;     ///< flood statistics threshold (< 0: off)
-  std::vector<float> state;     ///< 4 per cell: h, s, hu, hv
-  std::vector<float> flux;      ///< 4 per cell: pipe outflows
-  std::vector<float> fluxDiag;  ///< 4 per cell with diagonal pipes
-  std::vector<float> layers;    ///< layer-major thicknesses
-  std::vector<float> accum;     ///< 8 per cell: compensated sums of outflow, evaporation, sediment out, level exchange
-  std::vector<float> flood;     ///< 4 per cell: max depth, max speed, arrival, wet duration
-  std::vector<float> extra;     ///< a runner's own per-cell data
-  std::vector<double> numbers;  ///< a runner's own counters
-  std::vector<int32_t> tags;    ///< a runner's own integers (e.g. tile levels)
+  float wetThresholdM = -1;        ///< flood statistics threshold (< 0: off)
+  std::vector<float> state;        ///< 4 per cell: h, s, hu, hv
+  std::vector<float> flux;         ///< 4 per cell: pipe outflows
+  std::vector<float> fluxDiag;     ///< 4 per cell with diagonal pipes
+  std::vector<float> layers;       ///< layer-major thicknesses
+  std::vector<float> accum;        ///< kAccumPerCell per cell: compensated sums (AccumOffset)
+  std::vector<float> flood;        ///< 4 per cell: max depth, max speed, arrival, wet duration
+  std::vector<float> extra;        ///< a runner's own per-cell data
+  std::vector<double> numbers;     ///< a runner's own counters
+  std::vector<int32_t> tags;       ///< a runner's own integers (e.g. tile levels)
   std::vector<SolverState> parts;  ///< the states of the solvers a runner holds
 
   /// Calls f(name, field) for every field in one fixed order: the one list that checkpoint
@@ -158,6 +174,10 @@ class Solver {
   /// Changes the run-time parameters (rain, evaporation, friction, erosion constants, edges, time
   /// step rule) from the next step on; the water model and diagonal pipes stay as created.
   Status setParams(const SimParams& params);
+  /// Replaces the rain raster (mm/h per cell, >= 0; empty = none) from the next step on: the
+  /// frames of a radar rain series. The CPU and GL backends and tiles take it; a runner whose
+  /// cells are elsewhere (MPI ranks, adaptive levels) refuses.
+  Status setRainRaster(const gis::Grid<float>& mmPerHour);
 
   /// Takes `n` steps, each of the W10 length.
   void step(int n = 1);
@@ -269,6 +289,8 @@ class Solver {
   virtual void runStep(const StepInputs& step) = 0;
   /// params() changed (setParams).
   virtual void onParamsChanged() {}
+  /// The rain raster is to change (setRainRaster, the grid checked); by default refused.
+  virtual Status onRainRasterChanged(const gis::Grid<float>& mmPerHour);
   /// The rain raster's largest value (mm/h, W10's bound) and the rain falling on the whole grid
   /// under params() (m^3/s, rainVolumeRate): from the input's raster by default; a runner whose
   /// cells are elsewhere sums its parts'.
@@ -283,7 +305,8 @@ class Solver {
   /// The solvers a runner steps (tiles, blocks), each once: they follow the run's clock (a
   /// part's sources and levels follow its own clock). None for a backend.
   virtual void forEachPart(const std::function<void(Solver&)>& /*f*/) {}
-  /// restartAt(): every cell's accumulators (outflow, evaporation, level exchanges) back to 0.
+  /// restartAt(): every cell's accumulators (outflow, evaporation, level exchanges) back to 0;
+  /// the infiltration sums stay (they are the soil's state).
   virtual void clearAccumulators();
   virtual Status onLevelAdded(const LevelBoundary& /*level*/) { return {}; }
 
@@ -291,7 +314,7 @@ class Solver {
   /// their compensated accumulators. By default from readBlock() over the whole grid.
   struct Totals {
     std::vector<float> depth, suspended, layers;  ///< per cell (layers layer-major)
-    double outflowM3 = 0, evaporatedM3 = 0, sedimentOutflowM3 = 0;
+    double outflowM3 = 0, evaporatedM3 = 0, infiltratedM3 = 0, sedimentOutflowM3 = 0;
     double levelInM3 = 0, levelOutM3 = 0;  ///< W26: cells that gained / lost on balance
   };
   virtual Totals totals() const;

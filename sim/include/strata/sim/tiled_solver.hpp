@@ -46,6 +46,7 @@ class TiledSolver final : public Solver {
   TiledSolver(const SimInput& input, const SimParams& params, const TileOptions& options);
   void runStep(const StepInputs& step) override;
   void onParamsChanged() override;
+  Status onRainRasterChanged(const gis::Grid<float>& mmPerHour) override;
   Status onSourceAdded(const Source& source) override;
   void forEachPart(const std::function<void(Solver&)>& f) override;
   Status onLevelAdded(const LevelBoundary& level) override;

@@ -41,6 +41,7 @@ class GlSolver final : public Solver {
   GlSolver(const SimInput& input, const SimParams& params, std::unique_ptr<Impl> impl);
   void runStep(const StepInputs& step) override;
   void onParamsChanged() override;
+  Status onRainRasterChanged(const gis::Grid<float>& mmPerHour) override;
   bool keepsFloodStats() const override { return true; }
   void resetFloodStats() override;
   std::vector<float> floodStatsCells() const override;

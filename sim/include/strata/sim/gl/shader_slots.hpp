@@ -4,6 +4,8 @@
 // through it; a GPU test checks every kernel's blocks against it (docs/architecture.md, "The GL
 // layer"). Which buffer is which is in sim/src/gl/gl_solver.cpp.
 
+#include <vector>
+
 #include <strata/gl/bindings.hpp>
 
 namespace strata::sim::slots {
@@ -37,10 +39,16 @@ inline constexpr gl::Binding kCopyGrid{"SLOT_COPY_GRID", kBuf, 22, "Grid"};     
 inline constexpr gl::Binding kCopyPacked{"SLOT_COPY_PACKED", kBuf, 23, "Rect"};  ///< copy_rect: the packed rectangle
 inline constexpr gl::Binding kScour{"SLOT_SCOUR", kBuf, 24, "Scour"};            ///< the step's toe scour (E8)
 inline constexpr gl::Binding kManning{"SLOT_MANNING", kBuf, 25, "Manning"};      ///< n^2 per cell; < 0: P.manningN
+inline constexpr gl::Binding kInfiltration{"SLOT_INFILTRATION", kBuf, 26,
+                                           "Infiltration"};  ///< (Ks, psi dtheta) per cell
 
-inline constexpr gl::Binding kAll[] = {kParams,   kMaterials, kRowDx,      kBase,     kBed,      kLayers,     kStateIn,
-                                       kStateOut, kStage,     kFlux,       kFaceX,    kFaceY,    kTilt,       kAccum,
-                                       kRain,     kThermal,   kSources,    kMaxSpeed, kFluxDiag, kFloodStats, kFvLimit,
-                                       kLevels,   kCopyGrid,  kCopyPacked, kScour,    kManning};
+inline constexpr gl::Binding kAll[] = {kParams,   kMaterials, kRowDx,      kBase,     kBed,      kLayers,      kStateIn,
+                                       kStateOut, kStage,     kFlux,       kFaceX,    kFaceY,    kTilt,        kAccum,
+                                       kRain,     kThermal,   kSources,    kMaxSpeed, kFluxDiag, kFloodStats,  kFvLimit,
+                                       kLevels,   kCopyGrid,  kCopyPacked, kScour,    kManning,  kInfiltration};
+
+/// What the kernels compile with: this table's slots and the accumulators' layout as
+/// ACCUM_PER_CELL, ACCUM_OUTFLOW, ... (sim::AccumOffset).
+std::vector<gl::ShaderDefine> kernelDefines();
 
 }  // namespace strata::sim::slots
