@@ -50,7 +50,8 @@ def main():
     fig, ax = plt.subplots(figsize=(7, 4))
     ax.plot(t, [v / 1e6 for v in cols["water_volume_m3"]], label="stored", lw=2)
     for key, label in (("inflow_m3", "inflow (cumulative)"), ("rain_m3", "rain (cumulative)"),
-                       ("outflow_m3", "outflow (cumulative)"), ("evaporation_m3", "evaporated (cumulative)")):
+                       ("outflow_m3", "outflow (cumulative)"), ("evaporation_m3", "evaporated (cumulative)"),
+                       ("infiltration_m3", "infiltrated (cumulative)")):
         if key in cols and max(cols[key]) > 0:
             ax.plot(t, [v / 1e6 for v in cols[key]], label=label, ls="--")
     ax.set_xlabel("time (h)")

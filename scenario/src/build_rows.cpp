@@ -56,13 +56,15 @@ Result<gis::Grid<float>> readInputWindow(const fs::path& file, const gis::CellRe
 }  // namespace
 
 std::vector<std::string> modelInputFiles(int layers) {
-  std::vector<std::string> files{"input/base.tif", "input/water.tif", "input/rain.tif", "input/manning.tif"};
+  std::vector<std::string> files{"input/base.tif"};
+  for (const auto& o : kOptionalInputs) files.push_back(o.file);
   for (int k = 1; k <= layers; ++k) files.push_back("input/layer_" + std::to_string(k) + ".tif");
   return files;
 }
 
 Status writeModelInput(const Ranks& ranks, const fs::path& runDir, const gis::Georef& georef, const ScenarioDomain& d,
-                       int layers, bool water, bool rain, bool manning) {
+                       const ScenarioDomain& shape) {
+  const int layers = int(shape.input.materials.size());
   if (layers > kMaxInputLayers) {
     return fail(std::to_string(layers) + " layers: a run over MPI ranks takes at most " +
                 std::to_string(kMaxInputLayers));
@@ -80,9 +82,9 @@ Status writeModelInput(const Ranks& ranks, const fs::path& runDir, const gis::Ge
     return writeRaster(ranks, runDir / file, georef, o, windows);
   };
   STRATA_TRY_STATUS(write("input/base.tif", &d.input.baseM, "base elevation (m), conditioned, walls included"));
-  if (water) STRATA_TRY_STATUS(write("input/water.tif", &d.input.waterDepthM, "initial depth (m)"));
-  if (rain) STRATA_TRY_STATUS(write("input/rain.tif", &d.input.rainMmPerHour, "rain (mm/h)"));
-  if (manning) STRATA_TRY_STATUS(write("input/manning.tif", &d.input.manningN, "Manning's n (s/m^(1/3))"));
+  for (const auto& o : kOptionalInputs) {
+    if ((shape.input.*o.grid).size() > 0) STRATA_TRY_STATUS(write(o.file, &(d.input.*o.grid), o.what));
+  }
   for (int k = 0; k < layers; ++k) {
     const std::string material = d.input.materials.empty() ? std::string() : d.input.materials[size_t(k)].name;
     STRATA_TRY_STATUS(write("input/layer_" + std::to_string(k + 1) + ".tif",
@@ -108,9 +110,7 @@ void keepRows(ScenarioDomain& d, int rows) {
   crop(d.cellAreaM2);
   crop(d.input.baseM);
   for (auto& l : d.input.layersM) crop(l);
-  crop(d.input.rainMmPerHour);
-  crop(d.input.manningN);
-  crop(d.input.waterDepthM);
+  for (const auto& o : kOptionalInputs) crop(d.input.*o.grid);
   d.input.rowDxM.resize(std::min(d.input.rowDxM.size(), size_t(rows)));
 }
 
@@ -279,9 +279,7 @@ Result<RowsBuilt> buildByRows(const RowBuilder& b, const Scenario& s, const Rank
 Status writeRows(const Ranks& ranks, const fs::path& runDir, const RowsBuilt& built) {
   const auto& shape = built.shape;
   const auto& d = built.rows;
-  STRATA_TRY_STATUS(writeModelInput(ranks, runDir, shape.bed.georef, d, int(shape.input.materials.size()),
-                                    shape.input.waterDepthM.size() > 0, shape.input.rainMmPerHour.size() > 0,
-                                    shape.input.manningN.size() > 0));
+  STRATA_TRY_STATUS(writeModelInput(ranks, runDir, shape.bed.georef, d, shape));
   STRATA_TRY_STATUS(writeRaster(ranks, runDir / "maps" / "elevation.tif", shape.bed.georef, elevationMapOptions(),
                                 {{0, d.firstRow, d.bed.values}}));
   if (d.conditioningM.size() == 0) return {};
@@ -296,26 +294,21 @@ sim::RegionSource modelInputSource(const fs::path& runDir, const ScenarioDomain&
   region.rowDxM = shape.input.rowDxM;
   region.dyM = shape.input.dyM;
   region.datumM = shape.input.datumM;
-  const bool water = shape.input.waterDepthM.size() > 0, rain = shape.input.rainMmPerHour.size() > 0,
-             manning = shape.input.manningN.size() > 0;
+  std::vector<OptionalInput> optional;
+  for (const auto& o : kOptionalInputs) {
+    if ((shape.input.*o.grid).size() > 0) optional.push_back(o);
+  }
   const int layers = int(shape.input.materials.size());
   region.read = [runDir, rowDxM = shape.input.rowDxM, materials = shape.input.materials, dy = shape.input.dyM,
-                 datum = shape.input.datumM, water, rain, manning,
-                 layers](const gis::CellRect& w) -> Result<sim::SimInput> {
+                 datum = shape.input.datumM, optional, layers](const gis::CellRect& w) -> Result<sim::SimInput> {
     sim::SimInput in;
     STRATA_TRY(in.baseM, readInputWindow(runDir / "input/base.tif", w));
     for (int k = 1; k <= layers; ++k) {
       STRATA_TRY(auto l, readInputWindow(runDir / ("input/layer_" + std::to_string(k) + ".tif"), w));
       in.layersM.push_back(std::move(l));
     }
-    if (water) {
-      STRATA_TRY(in.waterDepthM, readInputWindow(runDir / "input/water.tif", w));
-    }
-    if (rain) {
-      STRATA_TRY(in.rainMmPerHour, readInputWindow(runDir / "input/rain.tif", w));
-    }
-    if (manning) {
-      STRATA_TRY(in.manningN, readInputWindow(runDir / "input/manning.tif", w));
+    for (const auto& o : optional) {
+      STRATA_TRY(in.*o.grid, readInputWindow(runDir / o.file, w));
     }
     in.materials = materials;
     if (rowDxM.size() == 1) {

@@ -21,17 +21,31 @@ namespace strata::scenario::detail {
 using sim::Ranks;
 
 /// The run folder's model input files for `layers` layers (relative paths): input/base.tif,
-/// input/layer_K.tif (K = 1 the bottom layer), input/water.tif, input/rain.tif.
+/// input/layer_K.tif (K = 1 the bottom layer) and those of kOptionalInputs.
 std::vector<std::string> modelInputFiles(int layers);
+/// The per-cell inputs a region may have, each a file of input/ when it does (a shape marks the
+/// ones its rows have with a 1 x 1 grid).
+struct OptionalInput {
+  const char* file;
+  gis::Grid<float> sim::SimInput::*grid;
+  const char* what;  ///< the file's STRATA_MODEL_INPUT metadata
+};
+inline constexpr OptionalInput kOptionalInputs[] = {
+    {"input/water.tif", &sim::SimInput::waterDepthM, "initial depth (m)"},
+    {"input/rain.tif", &sim::SimInput::rainMmPerHour, "rain (mm/h)"},
+    {"input/manning.tif", &sim::SimInput::manningN, "Manning's n (s/m^(1/3))"},
+    {"input/infiltration_rate.tif", &sim::SimInput::infiltrationMmPerHour, "infiltration rate or Ks (mm/h)"},
+    {"input/infiltration_suction.tif", &sim::SimInput::infiltrationSuctionM,
+     "Green-Ampt suction head x moisture deficit (m)"},
+};
 /// Layers a distributed run can have (one model input file each).
 inline constexpr int kMaxInputLayers = 64;
 
-/// Collective: writes the model input (base, layers, initial water, rain raster and roughness map
-/// when present) as float32 GeoTIFFs in the region's CRS (`georef`, the whole region's) into
-/// `runDir`/input: each rank its rows of the region, `d` (its grids' rows from d.firstRow).
-/// `layers`, `water`, `rain` and `manning`: which files the region has (the same on every rank).
+/// Collective: writes the model input (base, layers and the optional inputs `shape` marks) as
+/// float32 GeoTIFFs in the region's CRS (`georef`, the whole region's) into `runDir`/input: each
+/// rank its rows of the region, `d` (its grids' rows from d.firstRow).
 Status writeModelInput(const Ranks& ranks, const std::filesystem::path& runDir, const gis::Georef& georef,
-                       const ScenarioDomain& d, int layers, bool water, bool rain, bool manning);
+                       const ScenarioDomain& d, const ScenarioDomain& shape);
 
 class RowBuilder;
 /// A domain built by the ranks: its shape (the same on every rank, with the report's numbers of

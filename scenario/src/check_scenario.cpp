@@ -35,8 +35,14 @@ std::vector<std::string> checkScenarioFile(const std::filesystem::path& file) {
       }
     }
     if (s->water.rain && !s->water.rain->raster.empty()) raster("water.rain.raster", s->water.rain->raster);
+    if (s->water.rain) {
+      for (const auto& f : s->water.rain->frames) raster("water.rain.frames", f.raster);
+    }
     if (!s->model.manningRaster.empty()) raster("model.manning_raster", s->model.manningRaster);
     if (!s->model.landCoverRaster.empty()) raster("model.land_cover.raster", s->model.landCoverRaster);
+    if (s->water.infiltration && !s->water.infiltration->raster.empty()) {
+      raster("water.infiltration.raster", s->water.infiltration->raster);
+    }
     if (!s->terrain.store.empty() && !check.hasProblem("terrain.store")) {
       std::error_code ec;
       if (!std::filesystem::is_regular_file(std::filesystem::path(s->terrain.store) / "manifest.toml", ec)) {

@@ -933,10 +933,42 @@ void addVoidHoles(std::vector<std::pair<int, int>> cells, ScenarioDomain& d) {
   d.levelNames.push_back("voids (holes)");
 }
 
+// Step 10, a rain series: each frame's raster read for these rows (bilinear; no data is no rain);
+// a negative or non-finite value is refused naming the frame, its file and a cell.
+Status placeRainFrames(const Scenario& s, const Plan& plan, ScenarioDomain& d) {
+  const auto& rain = *s.water.rain;
+  d.rainFramesEndS = rain.endS < 0 ? s.durationS : rain.endS;
+  const int h = d.bed.values.height;
+  if (h == 0) return {};  // a shape: no rows
+  for (size_t k = 0; k < rain.frames.size(); ++k) {
+    const auto& f = rain.frames[k];
+    const std::string key = "water.rain.frames[" + std::to_string(k) + "]";
+    auto read = readRows(f.raster, plan.grid, d.firstRow, h);
+    if (!read) return fail(s.at("water.rain.frames") + oneLine(read.message()));
+    ScenarioDomain::RainFrame frame{f.timeS, gis::Grid<float>(plan.grid.width, h, 0.0f)};
+    for (int y = 0; y < h; ++y) {
+      for (int x = 0; x < plan.grid.width; ++x) {
+        const float v = read->at(x, y);
+        if (gis::isNoData(v)) continue;
+        if (!(v >= 0.0f && v <= 10000.0f)) {
+          char where[96];
+          std::snprintf(where, sizeof where, " at column %d, row %d of the region", x, d.firstRow + y);
+          return fail(s.at("water.rain.frames") + key + " " + oneLine(f.raster) + ": rain " + std::to_string(v) +
+                      " mm/h" + where + " (0 to 10000 mm/h)");
+        }
+        frame.mmPerHour.at(x, y) = v;
+      }
+    }
+    d.rainFrames.push_back(std::move(frame));
+  }
+  return {};
+}
+
 // Step 10: rain, uniform for a span of time or as a raster of multipliers for the whole run (the
 // raster's rows of `d`).
 Status placeRain(const Scenario& s, const Plan& plan, ScenarioDomain& d) {
   if (!s.water.rain) return {};
+  if (!s.water.rain->frames.empty()) return placeRainFrames(s, plan, d);
   const double rate = s.water.rain->rateMPerS * 3.6e6;
   d.rainMmPerHour = rate;
   d.rainStartS = s.water.rain->startS;
@@ -993,6 +1025,39 @@ Status placeManning(const Scenario& s, const Plan& plan, ScenarioDomain& d) {
         }
         d.input.manningN.at(x, y) = v;
       }
+    }
+  }
+  return {};
+}
+
+// Step 10c: infiltration ([water.infiltration]): the rate (or Green-Ampt's Ks) per cell of these
+// rows in mm/h, from its raster where it has one (no data takes the uniform value; a negative or
+// non-finite value is refused naming the key, the value and a cell), and Green-Ampt's suction head
+// x moisture deficit.
+Status placeInfiltration(const Scenario& s, const Plan& plan, ScenarioDomain& d) {
+  if (!s.water.infiltration) return {};
+  const auto& f = *s.water.infiltration;
+  const int h = d.bed.values.height;
+  if (h == 0) return {};  // a shape: no rows
+  const float uniform = float(f.rateMPerS * 3.6e6);
+  d.input.infiltrationMmPerHour = gis::Grid<float>(plan.grid.width, h, uniform);
+  if (f.greenAmpt)
+    d.input.infiltrationSuctionM = gis::Grid<float>(plan.grid.width, h, float(f.suctionM * f.moistureDeficit));
+  if (f.raster.empty()) return {};
+  const std::string key = "water.infiltration.raster";
+  auto read = readRows(f.raster, plan.grid, d.firstRow, h, gis::Resampling::Bilinear);
+  if (!read) return fail(s.at(key) + oneLine(read.message()));
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < plan.grid.width; ++x) {
+      const float v = read->at(x, y);
+      if (gis::isNoData(v)) continue;
+      if (!(v >= 0.0f && v <= 1000.0f)) {
+        char where[96];
+        std::snprintf(where, sizeof where, " at column %d, row %d of the region", x, d.firstRow + y);
+        return fail(s.at(key) + oneLine(f.raster) + ": " + (f.greenAmpt ? "Ks " : "loss rate ") + std::to_string(v) +
+                    " mm/h" + where + " (0 to 1000 mm/h)");
+      }
+      d.input.infiltrationMmPerHour.at(x, y) = v;
     }
   }
   return {};
@@ -1255,10 +1320,15 @@ Result<RowBuilder> RowBuilder::plan(const Scenario& s, uint64_t memoryBudgetByte
   STRATA_TRY_STATUS(placeProbes(s, plan, region, shape));
   STRATA_TRY_STATUS(placeRain(s, plan, shape));
   STRATA_TRY(auto dams, damBreakCells(s, plan, region));
-  // One-cell markers (modelInputSource reads them): the rows have a rain raster, initial water.
+  // One-cell markers (modelInputSource reads them): the rows have a rain raster, a roughness map,
+  // infiltration, initial water.
   if (s.water.rain && !s.water.rain->raster.empty()) shape.input.rainMmPerHour = gis::Grid<float>(1, 1, 0.0f);
   if (!s.model.manningRaster.empty() || !s.model.landCoverRaster.empty()) {
     shape.input.manningN = gis::Grid<float>(1, 1, 0.0f);
+  }
+  if (s.water.infiltration) {
+    shape.input.infiltrationMmPerHour = gis::Grid<float>(1, 1, 0.0f);
+    if (s.water.infiltration->greenAmpt) shape.input.infiltrationSuctionM = gis::Grid<float>(1, 1, 0.0f);
   }
   if (!dams.empty()) shape.input.waterDepthM = gis::Grid<float>(1, 1, 0.0f);
   return RowBuilder(std::make_unique<Impl>(Impl{s, std::move(plan), std::move(shape), std::move(dams)}));
@@ -1279,6 +1349,7 @@ Result<ScenarioDomain> RowBuilder::rows(int y0, int y1) const {
   STRATA_TRY_STATUS(statusOf(stackLayers(s, plan, storeLayers, d)));  // (the caller finds the lowest bed of its rows)
   STRATA_TRY_STATUS(placeRain(s, plan, d));
   STRATA_TRY_STATUS(placeManning(s, plan, d));
+  STRATA_TRY_STATUS(placeInfiltration(s, plan, d));
   return d;
 }
 

@@ -64,6 +64,19 @@ std::string where(const gis::Georef& g, int x, int y) {
 std::string areaText(double m2) { return m2 < 1e5 ? fmt("%.0f", m2) + " m²" : fmt("%.2f", m2 / 1e6) + " km²"; }
 
 // The roughness: one n, or a map (a raster of n, or land-cover classes and their n).
+// The model row's infiltration, as given (docs/sim-water.md, W11b).
+std::string infiltrationText(const Scenario& s) {
+  if (!s.water.infiltration) return "";
+  const auto& f = *s.water.infiltration;
+  const std::string rate = fmt("%.3g", f.rateMPerS * 3.6e6) + " mm/h";
+  const std::string map = f.raster.empty()
+                              ? std::string()
+                              : " per cell from `" + userText(f.raster, true) + "` (" + rate + " where it has no data)";
+  if (!f.greenAmpt) return ", infiltration at a constant loss of " + (map.empty() ? rate : "the rate" + map);
+  return ", infiltration by Green-Ampt (Ks " + (map.empty() ? rate : map.substr(1)) + ", suction head " +
+         fmt("%.3g", f.suctionM * 1e3) + " mm, moisture deficit " + fmt("%.3g", f.moistureDeficit) + ")";
+}
+
 std::string manningText(const Scenario& s) {
   const std::string n = fmt("%.3f", s.model.manningN) + " s/m^(1/3)";
   if (!s.model.manningRaster.empty()) {
@@ -262,7 +275,7 @@ Status writeReport(const fs::path& runDir, const ReportInput& in) {
              : "virtual pipes: an interactive authoring model without friction, whose depths and speeds depend on "
                "the pipe area and the time step and are not physical (kind = \"flood\" for analysis, "
                "docs/sim-water.md)") +
-        ", " + manningText(s) + ", CFL " + fmt("%.2f", s.model.cfl) +
+        ", " + manningText(s) + infiltrationText(s) + ", CFL " + fmt("%.2f", s.model.cfl) +
         (s.model.kind == sim::WaterModel::kFiniteVolume ? (s.model.sharpSlopes ? ", MC slopes" : ", minmod slopes")
                                                         : "") +
         " |\n";
@@ -333,7 +346,16 @@ Status writeReport(const fs::path& runDir, const ReportInput& in) {
           " m³/s. Every result below is of the run from t = 0: the river's water at t = 0 is the initial water, and "
           "cells wet at t = 0 count as flooded from the start |\n";
   }
-  if (s.water.rain) md += "| rain | " + fmt("%.1f", s.water.rain->rateMPerS * 3.6e6) + " mm/h |\n";
+  if (s.water.rain && s.water.rain->frames.empty()) {
+    md += "| rain | " + fmt("%.1f", s.water.rain->rateMPerS * 3.6e6) + " mm/h |\n";
+  } else if (s.water.rain) {
+    const auto& fr = s.water.rain->frames;
+    md +=
+        "| rain | " + std::to_string(fr.size()) + " raster frame" + (fr.size() > 1 ? "s" : "") + " (mm/h), `" +
+        userText(fr.front().raster, true) + "` at " + formatDuration(fr.front().timeS) +
+        (fr.size() > 1 ? " to `" + userText(fr.back().raster, true) + "` at " + formatDuration(fr.back().timeS) : "") +
+        ", falling until " + formatDuration(d.rainFramesEndS) + " |\n";
+  }
   if (d.damBreakVolumeM3 > 0) md += "| dam break | " + volumeText(d.damBreakVolumeM3) + " released at t = 0 |\n";
   md += "| duration | " + formatDuration(s.durationS) + ", outputs every " + formatDuration(s.outputIntervalS) + " |\n";
   md += "| wet threshold | " + fmt("%.2f", s.outputs.wetThresholdM) + " m |\n\n";
@@ -383,6 +405,11 @@ Status writeReport(const fs::path& runDir, const ReportInput& in) {
                               (sum.spinUp.seconds > 0 ? " or was there at t = 0)" : ")")
                         : "") +
           " |\n";
+    if (s.water.infiltration) {
+      md += "| water that soaked into the ground | " + volumeText(last.infiltrationM3) +
+            (supplied > 0 ? " (" + fmt("%.0f", 100 * last.infiltrationM3 / supplied) + "% of what entered)" : "") +
+            " |\n";
+    }
     md += "| water in the region at the end | " + volumeText(last.waterM3) + ", " + fmt("%.1f", last.floodedAreaKm2) +
           " km² flooded |\n";
     md += "| volume balance error at the end | " + fmt("%.2e", last.balanceErrorRel) +
@@ -433,6 +460,15 @@ std::vector<std::string> runWarnings(const ReportInput& in) {
                   ". Where they are artefacts of the DEM (SRTM has them in narrow valleys and under voids), "
                   "`[terrain] fill_depressions = true` raises them to their spill level and `breach_inflows = true` "
                   "carves each inflow's path out (docs/scenario.md, \"Conditioning the DEM\").");
+  }
+  if (f.wetVoidCells > 0) {
+    out.push_back("The flood reached " + std::to_string(f.wetVoidCells) + " of the " +
+                  std::to_string(in.domain.voidCells) + " cells the DEM had no data for (" + areaText(f.wetVoidM2) +
+                  "), whose ground was filled from the cells around them (`[terrain] voids = \"fill\"`): the water "
+                  "there, up to " +
+                  fmt("%.1f", f.deepestVoid.value) + " m deep at " + where(g, f.deepestVoid.x, f.deepestVoid.y) +
+                  ", stands on ground the DEM does not have. Check those places against another source (a "
+                  "void-filled DEM, a survey) before using depths, speeds or hazard there.");
   }
   if (f.fastest.value > 10.0) {
     // Next to an inflow (within 2 cells of one of its cells) the speed is the inflow line's doing.

@@ -386,7 +386,23 @@ class Run {
   // Uniform rain while it falls, [start, end).
   double rainAt(double t) const { return t >= d_.rainStartS && t < d_.rainEndS ? d_.rainMmPerHour : 0.0; }
 
+  // The rain frame falling at t ([water.rain] frames): -1 before the first and from the end on.
+  int frameAt(double t) const {
+    int k = -1;
+    for (size_t i = 0; i < d_.rainFrames.size(); ++i) {
+      if (t >= d_.rainFrames[i].startS) k = int(i);
+    }
+    return t < d_.rainFramesEndS ? k : -1;
+  }
+
   Status setRain(double t) {
+    if (!d_.rainFrames.empty()) {
+      const int k = frameAt(t);
+      if (k == frame_) return {};
+      STRATA_TRY_STATUS(solver().setRainRaster(k < 0 ? gis::Grid<float>() : d_.rainFrames[size_t(k)].mmPerHour));
+      frame_ = k;
+      return {};
+    }
     if (float(rainAt(t)) == solver().params().rainMmPerHour) return {};
     auto p = solver().params();
     p.rainMmPerHour = float(rainAt(t));
@@ -408,6 +424,12 @@ class Run {
       double next = endS;
       for (double edge : {d_.rainStartS, d_.rainEndS, probes_ ? probes_->nextRowS() : endS}) {
         if (before(sv.timeS(), edge) && edge < next) next = edge;
+      }
+      for (const auto& f : d_.rainFrames) {
+        if (before(sv.timeS(), f.startS) && f.startS < next) next = f.startS;
+      }
+      if (!d_.rainFrames.empty() && before(sv.timeS(), d_.rainFramesEndS) && d_.rainFramesEndS < next) {
+        next = d_.rainFramesEndS;
       }
       STRATA_TRY_STATUS(setRain(sv.timeS()));
       while (before(sv.timeS(), next)) {
@@ -508,6 +530,7 @@ class Run {
     r.rainM3 = st.rainM3;
     r.outflowM3 = st.outflowM3;
     r.evaporationM3 = st.evaporatedM3;
+    r.infiltrationM3 = st.infiltratedM3;
     const double supplied = st.initialWaterM3 + st.rainM3 + st.inflowM3;
     r.balanceErrorRel = supplied > 0 ? st.waterBalanceM3() / supplied : 0.0;
     r.maxDepthM = st.maxDepthM;
@@ -737,6 +760,12 @@ class Run {
     const auto& g = d_.bed.georef;
     detail::Extreme deep, fast, far;
     std::vector<sim::ExactSum> everWet(5);  // all, then per hazard class
+    sim::ExactSum wetVoid;
+    detail::Extreme deepVoid;
+    int wetVoidCells = 0;
+    // The void mask of the whole region (one process; a rank holds no mask of its own).
+    const bool voidsHere = s_.terrain.voids == decltype(s_.terrain)::Voids::kFill && d_.voidCells > 0 &&
+                           d_.voids.width == e_.solver->grid().width && d_.voids.height == e_.solver->grid().height;
     std::optional<std::pair<int, int>> c0;
     std::optional<gis::LonLat> from;
     if (!d_.sources.empty()) {
@@ -756,6 +785,11 @@ class Run {
       if (p.inside.data[i]) {
         everWet[0].add(area);
         everWet[1 + size_t(hazardClass(hazardRating(depth, speed, s_.outputs.hazardLandUse)))].add(area);
+        if (voidsHere && d_.voids.at(x, y)) {
+          wetVoid.add(area);
+          ++wetVoidCells;
+          if (detail::beats({depth, x, y, 0}, deepVoid)) deepVoid = {depth, x, y, 0};
+        }
       }
       if (!from) return;
       auto to = gis::pixelToLonLat(g, x + 0.5, y + 0.5);
@@ -773,6 +807,9 @@ class Run {
     f.farthestArrivalS = far.with;
     f.everWetM2 = everWet[0].value();
     for (size_t k = 0; k < f.hazardClassM2.size(); ++k) f.hazardClassM2[k] = everWet[1 + k].value();
+    f.wetVoidM2 = wetVoid.value();
+    f.wetVoidCells = wetVoidCells;
+    f.deepestVoid = {deepVoid.value, deepVoid.x, deepVoid.y};
     return f;
   }
 
@@ -849,6 +886,7 @@ class Run {
   detail::InputWindow input_;  // the model input of a window: what the solver started from
   std::optional<detail::Probes> probes_;
   double chosenDtS_ = 0, minChosenDtS_ = 1e300;
+  int frame_ = -2;  // the rain frame the solver has (setRain); -2: none set yet (a new or resumed run)
 };
 
 }  // namespace
@@ -895,12 +933,13 @@ std::vector<std::string> runFolderTemporaries(const fs::path& runDir) {
 std::string seriesCsv(const std::vector<SeriesRow>& rows) {
   std::string out =
       "time_s,steps,dt_s,water_volume_m3,flooded_area_km2,inflow_m3,rain_m3,outflow_m3,evaporation_m3,"
-      "balance_error_rel,max_depth_m,sediment_m3,eroded_m3,deposited_m3\n";
+      "infiltration_m3,balance_error_rel,max_depth_m,sediment_m3,eroded_m3,deposited_m3\n";
   char buf[512];
   for (const auto& r : rows) {
-    std::snprintf(buf, sizeof buf, "%.3f,%lld,%.6g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.6g,%.6g,%.9g,%.9g,%.9g\n", r.timeS,
-                  r.steps, r.dtS, r.waterM3, r.floodedAreaKm2, r.inflowM3, r.rainM3, r.outflowM3, r.evaporationM3,
-                  r.balanceErrorRel, r.maxDepthM, r.sedimentM3, r.erodedM3, r.depositedM3);
+    std::snprintf(buf, sizeof buf, "%.3f,%lld,%.6g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.6g,%.6g,%.9g,%.9g,%.9g\n",
+                  r.timeS, r.steps, r.dtS, r.waterM3, r.floodedAreaKm2, r.inflowM3, r.rainM3, r.outflowM3,
+                  r.evaporationM3, r.infiltrationM3, r.balanceErrorRel, r.maxDepthM, r.sedimentM3, r.erodedM3,
+                  r.depositedM3);
     out += buf;
   }
   return out;
@@ -953,6 +992,11 @@ class Session {
     if (ranks_.distributed() && (!s_.outputs.gauges.empty() || !s_.outputs.sections.empty())) {
       return fail(s_.at(s_.outputs.gauges.empty() ? "outputs.section" : "outputs.gauge") +
                   "gauges and sections are not recorded over MPI ranks yet: run this scenario in one process");
+    }
+    if (ranks_.distributed() && s_.water.rain && !s_.water.rain->frames.empty()) {
+      return fail(s_.at("water.rain.frames") +
+                  "rain frames do not reach MPI ranks yet (each rank's blocks would need their windows of every "
+                  "frame): run this scenario in one process");
     }
     STRATA_TRY(engine_, startContext(opt_.backend.value_or(s_.model.backend), opt_.pictures, ranks_));
     std::optional<detail::RowsBuilt> rows;

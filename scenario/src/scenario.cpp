@@ -655,10 +655,79 @@ Status readMaterials(const Reader& r, const toml::table& root, Scenario& s) {
   return {};
 }
 
+// [water.infiltration]: model = "constant" with rate, or "green_ampt" with conductivity, suction
+// and moisture_deficit; raster (mm/h) optional for either.
+Result<Scenario::Infiltration> readInfiltration(const Reader& r, const toml::node& node) {
+  const std::string key = "water.infiltration";
+  const auto* t = node.as_table();
+  if (!t) return r.error(node, key, "expected a table (model = \"constant\", rate = \"5 mm/h\")");
+  const auto* model = t->get("model");
+  if (!model) return r.errorAt(int(t->source().begin.line), key + ".model", "missing: \"constant\" or \"green_ampt\"");
+  STRATA_TRY(const std::string name, r.string(*model, key + ".model"));
+  Scenario::Infiltration f;
+  if (name == "constant") {
+    STRATA_TRY_STATUS(r.onlyKeys(*t, key, {"model", "rate", "raster"}));
+  } else if (name == "green_ampt") {
+    f.greenAmpt = true;
+    STRATA_TRY_STATUS(r.onlyKeys(*t, key, {"model", "conductivity", "suction", "moisture_deficit", "raster"}));
+  } else {
+    return r.error(*model, key + ".model", "\"" + name + "\": expected \"constant\" or \"green_ampt\"");
+  }
+  // A soil's Ks is under ~1 m/h (gravel); suction heads under ~10 m (clay's are ~0.3 m).
+  constexpr Range kSoilRate{0, 1.0 / 3600, false, "1 m/h"};
+  constexpr Range kSuction{0, 10, false, "10 m"};
+  constexpr Range kDeficit{0, 1, false, "1"};
+  auto need = [&](const char* k, const char* what) -> Result<const toml::node*> {
+    if (const auto* n = t->get(k)) return n;
+    return r.errorAt(int(t->source().begin.line), key + "." + k, std::string("missing: ") + what);
+  };
+  if (!f.greenAmpt) {
+    STRATA_TRY(const auto* n, need("rate", "the loss rate, e.g. \"5 mm/h\""));
+    STRATA_TRY(f.rateMPerS, r.quantity(*n, key + ".rate", "rate", kSoilRate));
+  } else {
+    STRATA_TRY(const auto* k, need("conductivity", "the saturated hydraulic conductivity Ks, e.g. \"10.9 mm/h\""));
+    STRATA_TRY(f.rateMPerS, r.quantity(*k, key + ".conductivity", "rate", kSoilRate));
+    STRATA_TRY(const auto* p, need("suction", "the wetting-front suction head, e.g. \"110 mm\""));
+    STRATA_TRY(f.suctionM, r.quantity(*p, key + ".suction", "length", kSuction));
+    STRATA_TRY(const auto* d, need("moisture_deficit", "porosity minus the initial water content, e.g. 0.3"));
+    STRATA_TRY(f.moistureDeficit, r.number(*d, key + ".moisture_deficit", kDeficit));
+  }
+  if (const auto* ra = t->get("raster")) {
+    STRATA_TRY(auto p, r.string(*ra, key + ".raster"));
+    f.raster = r.path(p);
+  }
+  return f;
+}
+
+// [water.rain] frames = [["0 min", "radar_0000.tif"], ...]: times from 0, increasing, within the run.
+Result<std::vector<Rain::Frame>> readRainFrames(const Reader& r, const toml::node& node, double durationS) {
+  const std::string key = "water.rain.frames";
+  r.note(node, key);
+  const auto* arr = node.as_array();
+  if (!arr || arr->empty()) return r.error(node, key, "expected [[time, \"raster.tif\"], ...] (rain in mm/h)");
+  std::vector<Rain::Frame> out;
+  for (size_t i = 0; i < arr->size(); ++i) {
+    const std::string k = key + "[" + std::to_string(i) + "]";
+    const auto* pair = (*arr)[i].as_array();
+    if (!pair || pair->size() != 2) return r.error((*arr)[i], k, "expected [time, \"raster.tif\"]");
+    Rain::Frame f;
+    STRATA_TRY(f.timeS, r.quantity(*pair->get(0), k, "time"));
+    STRATA_TRY(const std::string path, r.string(*pair->get(1), k));
+    f.raster = r.path(path);
+    if (f.timeS < 0) return r.error(*pair->get(0), k, "negative time");
+    if (!out.empty() && f.timeS <= out.back().timeS) return r.error(*pair->get(0), k, "not after the frame before it");
+    if (f.timeS >= durationS) {
+      return r.error(*pair->get(0), k, "after the run ends (time.duration is " + formatDuration(durationS) + ")");
+    }
+    out.push_back(std::move(f));
+  }
+  return out;
+}
+
 Status readWater(const Reader& r, const toml::table& root, Scenario& s) {
   const auto* t = root["water"].as_table();
   if (!t) return {};
-  STRATA_TRY_STATUS(r.onlyKeys(*t, "water", {"inflow", "rain", "dam_break", "level", "evaporation"}));
+  STRATA_TRY_STATUS(r.onlyKeys(*t, "water", {"inflow", "rain", "dam_break", "level", "evaporation", "infiltration"}));
   if (const auto* e = t->get("evaporation")) {
     STRATA_TRY(s.water.evaporationMPerS, r.quantity(*e, "water.evaporation", "rate", kRate));
   }
@@ -690,10 +759,21 @@ Status readWater(const Reader& r, const toml::table& root, Scenario& s) {
   if (const auto* rn = t->get("rain")) {
     const auto* rt = rn->as_table();
     if (!rt) return r.error(*rn, "water.rain", "expected a table");
-    STRATA_TRY_STATUS(r.onlyKeys(*rt, "water.rain", {"rate", "raster", "start", "end"}));
+    STRATA_TRY_STATUS(r.onlyKeys(*rt, "water.rain", {"rate", "raster", "start", "end", "frames"}));
     Rain rain;
-    if (!rt->get("rate")) return r.errorAt(int(rt->source().begin.line), "water.rain.rate", "missing");
-    STRATA_TRY(rain.rateMPerS, r.quantity(*rt->get("rate"), "water.rain.rate", "rate", kRate));
+    if (const auto* fr = rt->get("frames")) {
+      STRATA_TRY(rain.frames, readRainFrames(r, *fr, s.durationS));
+      for (const char* k : {"rate", "raster", "start"}) {
+        if (const auto* n = rt->get(k)) {
+          return r.error(*n, std::string("water.rain.") + k,
+                         "the frames carry the rain: no rate, raster or start beside them");
+        }
+      }
+    } else if (!rt->get("rate")) {
+      return r.errorAt(int(rt->source().begin.line), "water.rain.rate", "missing (or give frames)");
+    } else {
+      STRATA_TRY(rain.rateMPerS, r.quantity(*rt->get("rate"), "water.rain.rate", "rate", kRate));
+    }
     if (const auto* ra = rt->get("raster")) {
       STRATA_TRY(auto p, r.string(*ra, "water.rain.raster"));
       rain.raster = r.path(p);
@@ -711,7 +791,12 @@ Status readWater(const Reader& r, const toml::table& root, Scenario& s) {
     }
     if (rt->get("end") && rain.endS <= rain.startS)
       return r.error(*rt->get("end"), "water.rain.end", "must be after start");
+    if (rt->get("end") && !rain.frames.empty() && rain.endS <= rain.frames.back().timeS)
+      return r.error(*rt->get("end"), "water.rain.end", "must be after the last frame's time");
     s.water.rain = rain;
+  }
+  if (const auto* in = t->get("infiltration")) {
+    STRATA_TRY(s.water.infiltration, readInfiltration(r, *in));
   }
   if (const auto* db = t->get("dam_break")) {
     const auto* arr = db->as_array();

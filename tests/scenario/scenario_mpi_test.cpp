@@ -43,13 +43,18 @@ using test::worldSize;
 fs::path sharedDir(const std::string& name) { return test::sharedTempDir("strata-scenario-mpi-" + name); }
 
 // The shared fixture flood (a 20,000 m3/s river in a piece of the canyon at 600 m cells) with a
-// spin-up of its first flow, rain over the whole run, the DEM conditioned, three open edges.
+// spin-up of its first flow, rain over the whole run on a Green-Ampt soil (the ranks' model input
+// carries its two maps; the river's bed keeps what it took in during the spin-up), the DEM
+// conditioned, three open edges.
 std::string floodText() {
   std::string text = scenarioText();
   text.replace(text.find("[region]"), 8, "breach_inflows = true\nfill_depressions = true\n[region]");
   text.replace(text.find("hydrograph = [[0, 0]"), 20, "hydrograph = [[0, 400]");
   text.replace(text.find("output_interval = \"5 min\""), 25, "output_interval = \"5 min\"\nspin_up = \"10 min\"");
   text += "[water.rain]\nrate = \"30 mm/h\"\nstart = \"0 min\"\nend = \"20 min\"\n";
+  text +=
+      "[water.infiltration]\nmodel = \"green_ampt\"\nconductivity = \"10 mm/h\"\nsuction = \"110 mm\"\n"
+      "moisture_deficit = 0.3\n";
   return text;
 }
 
@@ -127,7 +132,11 @@ TEST(ScenarioMpi, AFloodOverTheRanksEqualsOneProcess) {
   MPI_Barrier(MPI_COMM_WORLD);
   if (worldRank() != 0) return;
   EXPECT_TRUE(fs::exists(dir / "ranks" / "input" / "base.tif"));
+  EXPECT_TRUE(fs::exists(dir / "ranks" / "input" / "infiltration_suction.tif"));
   EXPECT_FALSE(fs::exists(dir / "ranks" / "checkpoint.bin"));
+  const auto series = readCsv(dir / "ranks" / "series.csv");
+  ASSERT_FALSE(series.empty());
+  EXPECT_GT(series.back()[9], 0.0) << "infiltration_m3: the soil took nothing in";
   expectSameRun(dir / "one", dir / "ranks",
                 {"max_depth", "max_speed", "arrival_time", "inundation_duration", "final_depth"},
                 "flood on " + std::to_string(worldSize()) + " ranks");

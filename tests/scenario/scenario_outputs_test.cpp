@@ -171,6 +171,32 @@ TEST(ScenarioOutputs, TheReportWarnsOfPondedWaterAndOfInflowSpeeds) {
 // Issue 31: strata compare. The fixture's flood with Manning n 0.04 against 0.08: every map's
 // difference is B - A cell by cell (never-wet cells count as 0 depth), the headline table has
 // both runs and the change, and a folder that holds anything, or runs of other grids, are refused.
+// Issue 31: "voids filled under the flood". Rainier's SRTM has 1,501 void cells in this region
+// (ScenarioDomain.VoidsAreRefusedFilledWallsOrHoles); filled, and rained on, some of them get wet:
+// the report says how many, where the deepest is, and that the ground there is made up. Without
+// voids (a region of the same DEM that has none) it says nothing.
+TEST(ScenarioOutputs, TheReportWarnsOfWaterOverFilledVoids) {
+  const auto dir = strata::test::tempDir("voids_warning");
+  auto text = [](const std::string& bbox) {
+    return "[terrain]\ndem = \"" + strata::test::dataPath("rainier/mt_rainier_90m.tif") +
+           "\"\nvoids = \"fill\"\n[region]\nbbox_lonlat = " + bbox +
+           "\n[model]\nkind = \"flood\"\nboundary = \"open\"\n[water.rain]\nrate = \"100 mm/h\"\n"
+           "[time]\nduration = \"10 min\"\n[outputs]\nwet_threshold = \"0.005 m\"\nmaps = [\"max_depth\"]\n";
+  };
+  cpuRun(dir, "voids", text("[-121.82, 46.82, -121.70, 46.89]"));
+  const std::string report = slurp(dir / "voids" / "report.md");
+  const size_t at = report.find(" of the 1501 cells the DEM had no data for (");
+  ASSERT_NE(at, std::string::npos) << report;
+  const int wet = std::stoi(report.substr(report.rfind("reached ", at) + 8));
+  EXPECT_GT(wet, 0);
+  EXPECT_LE(wet, 1501);
+  EXPECT_NE(report.find("stands on ground the DEM does not have"), std::string::npos) << report;
+  cpuRun(dir, "none", text("[-121.39, 46.77, -121.31, 46.83]"));
+  const std::string clean = slurp(dir / "none" / "report.md");
+  EXPECT_EQ(clean.find("| voids |"), std::string::npos) << "this region has voids: pick one without";
+  EXPECT_EQ(clean.find("the DEM had no data for"), std::string::npos) << clean;
+}
+
 TEST(ScenarioOutputs, CompareGivesDifferenceMapsAndTheHeadlineNumbers) {
   const auto dir = strata::test::tempDir("compare");
   auto run = [&](const std::string& name, const std::string& text) { cpuRun(dir, name, text); };

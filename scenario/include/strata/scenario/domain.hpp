@@ -51,8 +51,16 @@ struct ScenarioDomain {
     std::vector<std::pair<int, int>> cells;  ///< the cells the line passes through (its mean level)
   };
   std::vector<SectionFaces> sections;
-  double rainMmPerHour = 0;              ///< uniform rain rate while it falls
-  double rainStartS = 0, rainEndS = 0;   ///< rain falls in [start, end)
+  double rainMmPerHour = 0;             ///< uniform rain rate while it falls
+  double rainStartS = 0, rainEndS = 0;  ///< rain falls in [start, end)
+  /// [water.rain] frames: each frame's rain (mm/h per cell of these rows, no data as 0) from its
+  /// time on; the last one's until rainFramesEndS.
+  struct RainFrame {
+    double startS = 0;
+    gis::Grid<float> mmPerHour;
+  };
+  std::vector<RainFrame> rainFrames;
+  double rainFramesEndS = 0;
   double damBreakVolumeM3 = 0;           ///< initial water from dam breaks
   double totalAreaM2 = 0;                ///< area of the region's cells
   std::array<float, 2> bedRangeM{0, 0};  ///< the lowest and highest bed of the region's cells (m)

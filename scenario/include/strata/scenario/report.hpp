@@ -33,6 +33,12 @@ struct FloodSummary {
   /// level (m^3, the model's cell areas); the deepest such water and its cell; all water at the end.
   double pondedM3 = 0, waterAtEndM3 = 0;
   AtCell deepestPonded;
+  /// [terrain] voids = "fill": the area of filled void cells ever deeper than the wet threshold,
+  /// their number, and the deepest water on one (one process only: a run over MPI ranks does
+  /// not hold the void mask, and leaves these at 0).
+  double wetVoidM2 = 0;
+  int wetVoidCells = 0;
+  AtCell deepestVoid;
 };
 
 struct ReportInput {
@@ -50,7 +56,8 @@ struct ReportInput {
 /// domain is built), with Debian's matplotlib. Returns the files written (relative), the
 /// elevation map first.
 /// What the report warns about (one paragraph each, Markdown): water ending in closed depressions
-/// of the bed (more than a fifth of the water at the end), speeds above 10 m/s. Also logged.
+/// of the bed (more than a fifth of the water at the end), speeds above 10 m/s, water over filled
+/// voids of the DEM. Also logged.
 std::vector<std::string> runWarnings(const ReportInput& in);
 
 /// `haveSeries` false (a run stopped before its first output interval): no series plots.

@@ -54,7 +54,8 @@ struct SeriesRow {
   double timeS = 0;
   long long steps = 0;
   double dtS = 0;
-  double waterM3 = 0, floodedAreaKm2 = 0, inflowM3 = 0, rainM3 = 0, outflowM3 = 0, evaporationM3 = 0;
+  double waterM3 = 0, floodedAreaKm2 = 0, inflowM3 = 0, rainM3 = 0, outflowM3 = 0, evaporationM3 = 0,
+         infiltrationM3 = 0;
   double balanceErrorRel = 0;
   double maxDepthM = 0;
   double sedimentM3 = 0, erodedM3 = 0, depositedM3 = 0;

@@ -42,6 +42,13 @@ struct Rain {
   double rateMPerS = 0;          ///< uniform rate
   std::string raster;            ///< optional raster of rate multipliers (path)
   double startS = 0, endS = -1;  ///< endS < 0: until the end
+  /// A raster series instead (radar frames): each frame's rain (mm/h per cell) falls from its
+  /// time until the next frame's, the last one's until endS (or the run's end).
+  struct Frame {
+    double timeS = 0;
+    std::string raster;  ///< resolved path
+  };
+  std::vector<Frame> frames;
 };
 
 /// A volume of water standing behind a (removed) dam at t = 0.
@@ -156,9 +163,21 @@ struct Scenario {
   };
   std::vector<MaterialChange> materials;
 
+  /// [water.infiltration]: water lost to the soil (W11b): a constant loss at `rateMPerS`, or
+  /// Green-Ampt with Ks = rateMPerS and suction head x moisture deficit; `raster` gives the rate
+  /// or Ks per cell (mm/h; no data takes rateMPerS).
+  struct Infiltration {
+    bool greenAmpt = false;
+    double rateMPerS = 0;        ///< constant: the loss rate; Green-Ampt: Ks (m/s)
+    double suctionM = 0;         ///< Green-Ampt: wetting-front suction head psi (m)
+    double moistureDeficit = 0;  ///< Green-Ampt: porosity - initial water content (0..1)
+    std::string raster;
+  };
+
   struct {
     std::vector<Inflow> inflows;
     std::optional<Rain> rain;
+    std::optional<Infiltration> infiltration;
     std::vector<DamBreak> damBreaks;
     std::vector<Level> levels;
     double evaporationMPerS = 0;
