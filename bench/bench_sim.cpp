@@ -69,6 +69,10 @@ constexpr Work kFlood{24 + 59 + 72 + 99 + 16 + 76 + 12, 8 + 236 + 56 + 246 + 15 
 // passes above, by law.
 constexpr Work kFloodForceBased{kFlood.bytes + 12 + 8 + 68 + 40, kFlood.flops + 40 + 10 + 48 + 120};
 constexpr Work kFloodShear{kFlood.bytes + 12 + 8 + 68 + 40, kFlood.flops + 40 + 10 + 62 + 120};
+// Flood mode on a Green-Ampt soil (W11b, infiltrationRow after the sources): Ks and G in, the
+// infiltration sum and its error in and out: 24 B; the capacity's four Newton steps (a division
+// and the series or a logarithm, counted as 10, each) and the cell's update: 90 flops.
+constexpr Work kFloodInfiltration{kFlood.bytes + 24, kFlood.flops + 90};
 
 // ---------------------------------------------------------------------------------------------
 // The machine's floors (measured once, before the benchmarks)
@@ -206,9 +210,13 @@ std::optional<gl::HeadlessContext> gContext;
 
 // threads 0: the GL backend; else the CPU backend with that many threads, every cell every step
 // unless `skip` (then dry blocks are skipped, and cell updates still count every cell).
-void run(benchmark::State& state, const ts::SimParams& p, Work work, int threads, bool skip) {
+void run(benchmark::State& state, const ts::SimParams& p, Work work, int threads, bool skip, bool soil = false) {
   const int n = int(state.range(0));
-  const auto input = terrainOf(n);
+  auto input = terrainOf(n);
+  if (soil) {  // a sandy loam's Green-Ampt parameters (Rawls et al. 1983) everywhere
+    input.infiltrationMmPerHour = gis::Grid<float>(n, n, 10.9f);
+    input.infiltrationSuctionM = gis::Grid<float>(n, n, 0.110f * 0.3f);
+  }
   std::unique_ptr<ts::Solver> sim;
   if (threads == 0) {
     if (!gContext) {
@@ -283,11 +291,13 @@ void registerAll() {
     const char* name;
     ts::SimParams params;
     Work work;
+    bool soil = false;
   };
   const Model models[] = {
       {"pipes", pipes(), kPipes},
       {"pipes_erosion_thermal_4layers", erosion(), kErosion},
       {"flood", flood(), kFlood},
+      {"flood_green_ampt", flood(), kFloodInfiltration, true},
       {"flood_erosion_forcebased_4layers", floodErosion(ts::ErosionLaw::kForceBased), kFloodForceBased},
       {"flood_erosion_shear_4layers", floodErosion(ts::ErosionLaw::kShearStress), kFloodShear}};
   struct Variant {
@@ -305,7 +315,7 @@ void registerAll() {
     for (const auto& v : variants) {
       const std::string name = std::string(m.name) + "/" + v.name;
       benchmark::RegisterBenchmark(name.c_str(),
-                                   [m, v](benchmark::State& s) { run(s, m.params, m.work, v.threads, v.skip); })
+                                   [m, v](benchmark::State& s) { run(s, m.params, m.work, v.threads, v.skip, m.soil); })
           ->Arg(256)
           ->Arg(512)
           ->Arg(1024)

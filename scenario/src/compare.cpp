@@ -144,6 +144,7 @@ Result<std::vector<std::string>> compareRuns(const CompareOptions& o) {
     const char* what;
     double a, b;
     const char* unit;
+    bool hideZero = false;  // a row of what neither run had (erosion, infiltration)
   };
   const std::vector<Row> rows{
       {"simulated", last(a, "time_s") / 3600, last(b, "time_s") / 3600, "h"},
@@ -152,14 +153,15 @@ Result<std::vector<std::string>> compareRuns(const CompareOptions& o) {
       {"most water in the region", most(a, "water_volume_m3"), most(b, "water_volume_m3"), "m³"},
       {"largest flooded area", most(a, "flooded_area_km2"), most(b, "flooded_area_km2"), "km²"},
       {"water that left through the edges", last(a, "outflow_m3"), last(b, "outflow_m3"), "m³"},
+      {"water that soaked into the ground", last(a, "infiltration_m3"), last(b, "infiltration_m3"), "m³", true},
       {"deepest water", most(a, "max_depth_m"), most(b, "max_depth_m"), "m"},
-      {"ground eroded", last(a, "eroded_m3"), last(b, "eroded_m3"), "m³"},
-      {"ground deposited", last(a, "deposited_m3"), last(b, "deposited_m3"), "m³"},
+      {"ground eroded", last(a, "eroded_m3"), last(b, "eroded_m3"), "m³", true},
+      {"ground deposited", last(a, "deposited_m3"), last(b, "deposited_m3"), "m³", true},
   };
   std::string md = "# What changed: " + o.runB.string() + " against " + o.runA.string() + "\n\n";
   md += "| | A: `" + o.runA.string() + "` | B: `" + o.runB.string() + "` | B − A | change |\n|---|---|---|---|---|\n";
   for (const auto& r : rows) {
-    if (!std::isfinite(r.a) || !std::isfinite(r.b) || (r.a == 0 && r.b == 0 && r.what[0] == 'g')) continue;
+    if (!std::isfinite(r.a) || !std::isfinite(r.b) || (r.a == 0 && r.b == 0 && r.hideZero)) continue;
     const bool volume = std::string(r.unit) == "m³";
     auto text = [&](double v) { return volume ? volumeText(v) : fmt("%.3g", v) + " " + r.unit; };
     md += "| " + std::string(r.what) + " | " + text(r.a) + " | " + text(r.b) + " | " + text(r.b - r.a) + " | " +

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include <strata/gis/dem_io.hpp>
+#include <strata/gis/geodesy.hpp>
 #include <strata/scenario/scenario.hpp>
 
 #include "strata_test.hpp"
@@ -62,6 +63,20 @@ inline std::string slurp(const std::filesystem::path& p) {
   std::stringstream s;
   s << f.rdbuf();
   return s.str();
+}
+
+/// A raster of `width` x `height` cells of `cellM` in UTM zone 12N (EPSG:32612), its north-west
+/// corner at (x0, y0), every cell `fill`: the synthetic DEMs and maps of the spatial-input tests.
+inline gis::Raster utmRaster(int width, int height, double x0, double y0, double cellM, float fill) {
+  auto crs = gis::describeCrs("EPSG:32612");
+  EXPECT_TRUE(crs) << crs.message();
+  gis::Raster r;
+  r.georef = *crs;
+  r.georef.width = width;
+  r.georef.height = height;
+  r.georef.transform = gis::GeoTransform{{x0, cellM, 0, y0, 0, -cellM}};
+  r.values = gis::Grid<float>(width, height, fill);
+  return r;
 }
 
 inline gis::ReadOptions allowEmpty() {

@@ -25,17 +25,7 @@ using namespace test_support;
 constexpr int kW = 60, kH = 40;  // 10 m cells, UTM 12N
 constexpr double kX0 = 400000, kY0 = 4000000;
 
-gis::Raster grid(float fill) {
-  auto crs = gis::describeCrs("EPSG:32612");
-  EXPECT_TRUE(crs) << crs.message();
-  gis::Raster r;
-  r.georef = *crs;
-  r.georef.width = kW;
-  r.georef.height = kH;
-  r.georef.transform = gis::GeoTransform{{kX0, 10, 0, kY0, 0, -10}};
-  r.values = gis::Grid<float>(kW, kH, fill);
-  return r;
-}
+gis::Raster grid(float fill) { return utmRaster(kW, kH, kX0, kY0, 10, fill); }
 
 // A plane falling south at 2 %; the loss rates 5 mm/h west and 15 mm/h east of its middle.
 void writeInputs(const std::filesystem::path& dir) {
@@ -58,6 +48,16 @@ std::string text(const std::string& infiltration) {
          "[time]\nduration = \"30 min\"\noutput_interval = \"10 min\"\n[outputs]\nmaps = [\"max_depth\"]\n";
 }
 
+// The CPU backend, no pictures or plots, into `out`.
+RunOptions cpuOptions(const std::filesystem::path& out) {
+  RunOptions o;
+  o.outDir = out;
+  o.backend = Backend::kCpu;
+  o.pictures = false;
+  o.plots = false;
+  return o;
+}
+
 struct Outcome {
   std::vector<std::vector<double>> series;
   std::string report;
@@ -67,18 +67,9 @@ Result<Outcome> run(const std::filesystem::path& dir, const std::string& name, c
   std::ofstream(dir / (name + ".toml")) << text(infiltration);
   auto s = loadScenario(dir / (name + ".toml"));
   if (!s) return s.error();
-  RunOptions opt;
-  opt.outDir = dir / name;
-  opt.backend = Backend::kCpu;
-  opt.pictures = false;
-  opt.plots = false;
-  auto r = runScenario(*s, opt);
+  auto r = runScenario(*s, cpuOptions(dir / name));
   if (!r) return r.error();
-  Outcome o;
-  o.series = readCsv(dir / name / "series.csv");
-  std::ifstream report(dir / name / "report.md");
-  o.report.assign(std::istreambuf_iterator<char>(report), std::istreambuf_iterator<char>());
-  return o;
+  return Outcome{readCsv(dir / name / "series.csv"), slurp(dir / name / "report.md")};
 }
 
 // series.csv's columns (scenario/src/run.cpp, seriesCsv).
@@ -144,12 +135,7 @@ TEST(ScenarioInfiltration, BadSoilIsRefusedNamingFileLineAndKey) {
     auto s = loadScenario(file);
     Status status = s ? Status{} : Status(s.error());
     if (s) {
-      RunOptions opt;
-      opt.outDir = dir / "out";
-      opt.backend = Backend::kCpu;
-      opt.pictures = false;
-      opt.plots = false;
-      auto r = runScenario(*s, opt);
+      auto r = runScenario(*s, cpuOptions(dir / "out"));
       if (!r) status = r.error();
     }
     ASSERT_FALSE(status) << c.infiltration;
@@ -188,12 +174,7 @@ TEST(ScenarioRainFrames, EachFrameRainsItsRasterForItsTime) {
   std::ofstream(dir / "frames.toml") << t;
   auto s = loadScenario(dir / "frames.toml");
   ASSERT_TRUE(s) << s.message();
-  RunOptions opt;
-  opt.outDir = dir / "frames";
-  opt.backend = Backend::kCpu;
-  opt.pictures = false;
-  opt.plots = false;
-  auto r = runScenario(*s, opt);
+  auto r = runScenario(*s, cpuOptions(dir / "frames"));
   ASSERT_TRUE(r) << r.message();
   const auto series = readCsv(dir / "frames" / "series.csv");
   ASSERT_EQ(series.size(), 3u);
@@ -209,8 +190,7 @@ TEST(ScenarioRainFrames, EachFrameRainsItsRasterForItsTime) {
   // The ratios to rounding (the same cells' areas in each; float32 rates; measured 2.5e-9, 1.4e-8).
   EXPECT_NEAR(series[1][kRain] / series[0][kRain], expected[1] / expected[0], 1e-7);
   EXPECT_NEAR(series[2][kRain] / series[0][kRain], expected[2] / expected[0], 1e-7);
-  std::ifstream in(dir / "frames" / "report.md");
-  const std::string report((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string report = slurp(dir / "frames" / "report.md");
   EXPECT_NE(report.find("| rain | 3 raster frames (mm/h), `"), std::string::npos) << report;
   EXPECT_NE(report.find("f2.tif` at 20 min 00 s, falling until 25 min 00 s |"), std::string::npos) << report;
 
@@ -241,8 +221,7 @@ TEST(ScenarioRainFrames, EachFrameRainsItsRasterForItsTime) {
   std::ofstream(file) << bad;
   auto parsed = loadScenario(file);
   ASSERT_TRUE(parsed) << parsed.message();
-  opt.outDir = dir / "negative";
-  auto refused = runScenario(*parsed, opt);
+  auto refused = runScenario(*parsed, cpuOptions(dir / "negative"));
   ASSERT_FALSE(refused);
   EXPECT_NE(refused.message().find(":8: key 'water.rain.frames': water.rain.frames[1] "), std::string::npos)
       << refused.message();

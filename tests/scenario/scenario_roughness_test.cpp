@@ -25,17 +25,7 @@ using namespace test_support;
 constexpr int kW = 60, kH = 40;  // 10 m cells, UTM 12N
 constexpr double kX0 = 400000, kY0 = 4000000;
 
-gis::Raster grid(float fill) {
-  auto crs = gis::describeCrs("EPSG:32612");
-  EXPECT_TRUE(crs) << crs.message();
-  gis::Raster r;
-  r.georef = *crs;
-  r.georef.width = kW;
-  r.georef.height = kH;
-  r.georef.transform = gis::GeoTransform{{kX0, 10, 0, kY0, 0, -10}};
-  r.values = gis::Grid<float>(kW, kH, fill);
-  return r;
-}
+gis::Raster grid(float fill) { return utmRaster(kW, kH, kX0, kY0, 10, fill); }
 
 // Two V valleys draining south at 2 %, their floors at columns 15 and 45, a 20 m ridge between.
 void writeInputs(const std::filesystem::path& dir) {

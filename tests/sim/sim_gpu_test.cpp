@@ -161,14 +161,7 @@ TEST_F(GlTest, SimInfiltrationFollowsGreenAmptOnTheGpuAndOnTiles) {
 // Rain frames (setRainRaster) on the GL backend and on tiles: the CPU test's two frames
 // (tests/sim/sim_runoff_test.cpp) rain their own volumes, and the basin holds them.
 TEST_F(GlTest, SimRainFramesOnTheGpuAndOnTiles) {
-  SimInput in = test::infiltrationBasin(0.0);
-  in.infiltrationMmPerHour = {};
-  in.infiltrationSuctionM = {};
-  const int w = in.baseM.width, h = in.baseM.height;
-  gis::Grid<float> west(w, h, 0.0f), east(w, h, 0.0f);
-  for (int y = 0; y < h; ++y) {
-    for (int x = 0; x < w; ++x) (x < w / 2 ? west : east).at(x, y) = x < w / 2 ? 10.0f : 30.0f;
-  }
+  const auto [in, west, east] = test::rainFrames();
   const double both = (10e-3 + 30e-3) * test::basinAreaM2() / 2 / 6;
   auto gpu = GlSolver::create(in, test::basinParams(0.0f, 15.0f));
   ASSERT_TRUE(gpu) << gpu.message();

@@ -185,14 +185,7 @@ namespace {
 // 10 min, then none. The rain each frame put down is its rate x its area x its time, and the basin
 // holds it all; a raster of the wrong size or with a negative value is refused and changes nothing.
 TEST(SimRainFramesCpu, EachFrameRainsItsOwnVolume) {
-  SimInput in = test::infiltrationBasin(0.0);
-  in.infiltrationMmPerHour = {};
-  in.infiltrationSuctionM = {};
-  const int w = in.baseM.width, h = in.baseM.height;
-  gis::Grid<float> west(w, h, 0.0f), east(w, h, 0.0f);
-  for (int y = 0; y < h; ++y) {
-    for (int x = 0; x < w; ++x) (x < w / 2 ? west : east).at(x, y) = x < w / 2 ? 10.0f : 30.0f;
-  }
+  const auto [in, west, east] = test::rainFrames();
   const double half = test::basinAreaM2() / 2;
   auto sim = CpuSolver::create(in, test::basinParams(0.0f, 15.0f));
   ASSERT_TRUE(sim) << sim.message();

@@ -45,6 +45,23 @@ inline sim::SimParams basinParams(float rainMmH, float maxStepS) {
   return p;
 }
 
+/// The basin without its soil, and two rain frames on it (mm/h): 10 on its west half, 30 on its
+/// east half (the rain-frame tests).
+struct RainFrames {
+  sim::SimInput basin;
+  gis::Grid<float> west, east;
+};
+inline RainFrames rainFrames() {
+  RainFrames f{infiltrationBasin(0.0), gis::Grid<float>(kBasinW, kBasinH, 0.0f),
+               gis::Grid<float>(kBasinW, kBasinH, 0.0f)};
+  f.basin.infiltrationMmPerHour = {};
+  f.basin.infiltrationSuctionM = {};
+  for (int y = 0; y < kBasinH; ++y) {
+    for (int x = 0; x < kBasinW; ++x) (x < kBasinW / 2 ? f.west : f.east).at(x, y) = x < kBasinW / 2 ? 10.0f : 30.0f;
+  }
+  return f;
+}
+
 /// Green and Ampt (1911) under ponding from a dry start: the cumulative infiltration F (m) at t
 /// (s), F - G ln(1 + F / G) = Ks t, by bisection in double.
 inline double greenAmptDepthM(double tS) {
