@@ -70,7 +70,7 @@ constexpr Work kFlood{24 + 59 + 72 + 99 + 16 + 76 + 12, 8 + 236 + 56 + 246 + 15 
 constexpr Work kFloodForceBased{kFlood.bytes + 12 + 8 + 68 + 40, kFlood.flops + 40 + 10 + 48 + 120};
 constexpr Work kFloodShear{kFlood.bytes + 12 + 8 + 68 + 40, kFlood.flops + 40 + 10 + 62 + 120};
 // Flood mode on a Green-Ampt soil (W11b, infiltrationRow after the sources): Ks and G in, the
-// infiltration sum and its error in and out: 24 B; the capacity's four Newton steps (a division
+// infiltration sum and its error in and out: 24 B; the capacity's three Newton steps (divisions
 // and the series or a logarithm, counted as 10, each) and the cell's update: 90 flops.
 constexpr Work kFloodInfiltration{kFlood.bytes + 24, kFlood.flops + 90};
 

@@ -407,7 +407,9 @@ Status writeReport(const fs::path& runDir, const ReportInput& in) {
           " |\n";
     if (s.water.infiltration) {
       md += "| water that soaked into the ground | " + volumeText(last.infiltrationM3) +
-            (supplied > 0 ? " (" + fmt("%.0f", 100 * last.infiltrationM3 / supplied) + "% of what entered)" : "") +
+            (supplied > 0 ? " (" + fmt("%.0f", 100 * last.infiltrationM3 / supplied) + "% of what entered" +
+                                (sum.spinUp.seconds > 0 ? " or was there at t = 0)" : ")")
+                          : "") +
             " |\n";
     }
     md += "| water in the region at the end | " + volumeText(last.waterM3) + ", " + fmt("%.1f", last.floodedAreaKm2) +

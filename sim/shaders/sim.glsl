@@ -103,13 +103,13 @@ float uMinusLog1p(float u) {
   return u * u * p;
 }
 // W11b: the depth the soil can take in over a step under ponding from cumulative infiltration f:
-// Green-Ampt integrated over the step, four Newton steps; g = 0: a constant loss ksDt
+// Green-Ampt integrated over the step, three Newton steps; g = 0: a constant loss ksDt
 // (sim/src/cpu_kernels.hpp's infiltrationCapacity, which gives the derivation and accuracy).
 float infiltrationCapacity(float ksDt, float g, float f) {
   if (!(g > 0.0) || !(ksDt > 0.0)) return ksDt;
   const float a = f + g;
   float d = ksDt + sqrt(2.0 * g * ksDt);
-  for (int k = 0; k < 4; ++k) {
+  for (int k = 0; k < 3; ++k) {
     const float r = d * f / a + g * uMinusLog1p(d / a) - ksDt;
     d = max(ksDt, d - r * (a + d) / (f + d));
   }

@@ -21,7 +21,8 @@ void main() {
   const vec2 soil = infiltration[min(i, infiltration.length() - 1)];
   const int k = ACCUM_PER_CELL * i + ACCUM_INFILTRATED;
   const float area = cellArea(p.y);
-  const float f = min(h, infiltrationCapacity(soil.x * dt, soil.y, accum[k] / area));
+  const float ksDt = soil.x * dt;  // the capacity is at least this: less water soaks in whole
+  const float f = h <= ksDt ? max(h, 0.0) : min(h, infiltrationCapacity(ksDt, soil.y, accum[k] / area));
   if (f > 0.0) {
     h -= f;
     kahanAdd(k, f * area);

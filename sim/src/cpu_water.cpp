@@ -50,7 +50,11 @@ STRATA_ROW_KERNEL void sourcesRow(float* h, float* sum, float* err, const float*
 STRATA_ROW_KERNEL void infiltrationRow(float* h, float* sum, float* err, const float* ks, const float* g, float area,
                                        int x0, int x1, float dtS) {
   for (int x = x0; x < x1; ++x) {
-    const float f = minOf(h[x], infiltrationCapacity(ks[x] * dtS, g[x], sum[x] / area));
+    const float hx = h[x];
+    if (!(hx > 0.0f)) continue;  // dry: nothing to lose
+    // The capacity is at least Ks dt: water up to that soaks in whole, with nothing to solve.
+    const float ksDt = ks[x] * dtS;
+    const float f = hx <= ksDt ? hx : minOf(hx, infiltrationCapacity(ksDt, g[x], sum[x] / area));
     if (f > 0.0f) {
       h[x] -= f;
       kahanAdd(sum[x], err[x], f * area);
