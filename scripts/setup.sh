@@ -48,6 +48,8 @@ packages=(
   python3-matplotlib python3-numpy python3-gdal
   # a run folder's maps as QGIS shows them (tests load the .qml styles in headless QGIS)
   python3-qgis
+  # the Python module `strata` (python/: pybind11 over the scenario library)
+  pybind11-dev python3-dev
 )
 
 missing=()

@@ -1149,6 +1149,12 @@ class Session {
   // pictures and checkpoint). Stops early when interrupted or asked to.
   Status runIntervals() {
     Progress progress(opt_.command + " " + name_, s_.durationS);
+    // RunOptions::onProgress at most every 0.2 s; a false answer stops the run as a Ctrl-C does.
+    auto nextCallback = std::chrono::steady_clock::now();
+    auto tellProgress = [&] {
+      nextCallback = std::chrono::steady_clock::now() + std::chrono::milliseconds(200);
+      if (!opt_.onProgress(run_->solver().timeS(), s_.durationS)) setInterrupted(true);
+    };
     auto note = [&] { return run_->progressNote("t = " + formatDuration(run_->solver().timeS())); };
     while (interval_ < intervals_) {
       const double t1 = std::min(s_.durationS, (interval_ + 1) * s_.outputIntervalS);
@@ -1156,9 +1162,11 @@ class Session {
       // otherwise), step by step, and at the end of the interval.
       auto tick = [&] {
         if (progress.due()) progress.update(run_->solver().timeS(), note());
+        if (opt_.onProgress && std::chrono::steady_clock::now() >= nextCallback) tellProgress();
       };
       STRATA_TRY(const bool done, run_->advanceTo(t1, tick));
       progress.update(run_->solver().timeS(), note());
+      if (opt_.onProgress && done) tellProgress();
       if (!done) break;
       STRATA_TRY_STATUS(closeInterval());
       if (opt_.stopAfterIntervals >= 0 && interval_ >= opt_.stopAfterIntervals && interval_ < intervals_) break;

@@ -13,6 +13,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -47,6 +48,11 @@ struct RunOptions {
   /// (checkpoint.R-of-N.bin); rank 0 writes the series, pictures, plots and report. A run is
   /// resumed on the same number of ranks. Failures are the same on every rank.
   bool distributed = false;
+  /// Called with the simulated time and the duration (s) during the run (at most ~5 times a
+  /// wall-clock second, and at each output interval's end); returning false stops the run as a
+  /// Ctrl-C does (a resumable folder, RunSummary::completed false). For callers such as the
+  /// Python module; one process only.
+  std::function<bool(double timeS, double durationS)> onProgress;
 };
 
 /// One row of the time series (series.csv).
