@@ -9,9 +9,14 @@
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
+#include <algorithm>
+#include <array>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <fstream>
+#include <memory>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -20,8 +25,12 @@
 
 #include <strata/core/interrupt.hpp>
 #include <strata/gis/dem_io.hpp>
+#include <strata/gl/context.hpp>
+#include <strata/scenario/domain.hpp>
 #include <strata/scenario/run.hpp>
 #include <strata/scenario/scenario.hpp>
+#include <strata/sim/cpu_solver.hpp>
+#include <strata/sim/gl/gl_solver.hpp>
 
 namespace py = pybind11;
 namespace fs = std::filesystem;
@@ -31,6 +40,9 @@ using strata::scenario::RunSummary;
 using strata::scenario::Scenario;
 
 namespace {
+
+namespace gis = strata::gis;
+namespace sim = strata::sim;
 
 // The module's exceptions (created in PYBIND11_MODULE).
 py::object gScenarioError, gCancelled;
@@ -217,6 +229,169 @@ py::dict run(const Scenario& s, const fs::path& outDir, const std::string& backe
   return out;
 }
 
+// A grid as a float32 array (rows north to south) and back.
+py::array_t<float> arrayOf(const gis::Grid<float>& g, float add = 0.0f) {
+  py::array_t<float> a({g.height, g.width});
+  float* out = a.mutable_data();
+  for (size_t i = 0; i < g.size(); ++i) out[i] = g.data[i] + add;
+  return a;
+}
+gis::Grid<float> gridOf(const py::array_t<float, py::array::c_style | py::array::forcecast>& a, int w, int h,
+                        const char* what) {
+  if (a.ndim() != 2 || a.shape(0) != h || a.shape(1) != w) {
+    throw py::value_error(std::string(what) + ": expected an array of " + std::to_string(h) + " rows and " +
+                          std::to_string(w) + " columns");
+  }
+  gis::Grid<float> g(w, h);
+  std::copy(a.data(), a.data() + g.size(), g.data.begin());
+  return g;
+}
+std::vector<std::pair<int, int>> cellsOf(const std::vector<std::pair<int, int>>& cells, const sim::CellGrid& grid) {
+  if (cells.empty()) throw py::value_error("no cells");
+  for (const auto& [x, y] : cells) {
+    if (x < 0 || y < 0 || x >= grid.width || y >= grid.height) {
+      throw py::value_error("cell (" + std::to_string(x) + ", " + std::to_string(y) + ") is outside the " +
+                            std::to_string(grid.width) + " x " + std::to_string(grid.height) + " grid");
+    }
+  }
+  return cells;
+}
+strata::TimeSeries seriesOf(const std::vector<std::array<double, 2>>& samples, const char* what) {
+  auto t = strata::TimeSeries::create(samples);
+  if (!t) throw py::value_error(std::string(what) + ": " + t.message());
+  return std::move(t).value();
+}
+
+// Step-by-step use of one solver over a window of a DEM (flood mode; one layer of rock under the
+// DEM's surface): the scenario's cell sizes (geodesic) and model parameters, the CPU or GL backend.
+class PySolver {
+ public:
+  PySolver(const fs::path& dem, std::optional<std::array<int, 4>> window, const std::string& backend, double manningN,
+           double cfl, double maxStepS, const std::vector<std::string>& openEdges) {
+    gis::ReadOptions ro;
+    auto r = gis::readDem(dem.string(), ro);
+    if (!r) throw std::runtime_error(r.message());
+    georef_ = r->georef;
+    const auto [x0, y0, w, h] = window.value_or(std::array<int, 4>{0, 0, georef_.width, georef_.height});
+    if (w < 2 || h < 2 || x0 < 0 || y0 < 0 || x0 + w > georef_.width || y0 + h > georef_.height) {
+      throw py::value_error("window (" + std::to_string(x0) + ", " + std::to_string(y0) + ", " + std::to_string(w) +
+                            ", " + std::to_string(h) + ") is not inside the " + std::to_string(georef_.width) + " x " +
+                            std::to_string(georef_.height) + " DEM (and at least 2 x 2)");
+    }
+    sim::SimInput in;
+    in.baseM = gis::Grid<float>(w, h);
+    double lo = 1e300;
+    for (int y = 0; y < h; ++y) {
+      for (int x = 0; x < w; ++x) {
+        const float v = r->values.at(x0 + x, y0 + y);
+        if (!std::isfinite(v)) throw py::value_error(dem.string() + ": the window has cells without data");
+        in.baseM.at(x, y) = v;
+        lo = std::min(lo, double(v));
+      }
+    }
+    georef_.transform.c[0] = r->georef.transform.x(x0, y0);
+    georef_.transform.c[3] = r->georef.transform.y(x0, y0);
+    georef_.width = w;
+    georef_.height = h;
+    auto sizes = strata::scenario::measureCells(georef_);
+    if (!sizes) throw std::runtime_error(sizes.message());
+    in.dyM = sizes->dyM;
+    in.rowDxM = sizes->rowDxM;
+    in.datumM = std::floor(lo);
+    in.layersM = {gis::Grid<float>(w, h, 0.0f)};
+    in.materials = {strata::terrain::Material{}};
+    Scenario s;
+    s.model.manningN = manningN;
+    s.model.cfl = cfl;
+    s.model.maxStepS = maxStepS;
+    const char* names[4] = {"west", "east", "south", "north"};
+    for (int e = 0; e < 4; ++e) s.model.boundaries[size_t(e)] = strata::scenario::Boundary::Closed;
+    for (const auto& o : openEdges) {
+      const auto* at = std::find(std::begin(names), std::end(names), o);
+      if (at == std::end(names)) throw py::value_error("open edge \"" + o + "\": expected west, east, south or north");
+      s.model.boundaries[size_t(at - std::begin(names))] = strata::scenario::Boundary::Open;
+    }
+    const sim::SimParams p = strata::scenario::modelParams(s);
+    if (backend == "gpu") {
+      auto ctx = strata::gl::HeadlessContext::create();
+      if (!ctx) throw std::runtime_error("the GPU backend needs a GL 4.5 context: " + ctx.message());
+      context_.emplace(std::move(ctx).value());
+      auto g = sim::GlSolver::create(in, p);
+      if (!g) throw std::runtime_error(g.message());
+      solver_ = std::make_unique<sim::GlSolver>(std::move(g).value());
+    } else if (backend == "cpu") {
+      auto c = sim::CpuSolver::create(in, p);
+      if (!c) throw std::runtime_error(c.message());
+      solver_ = std::make_unique<sim::CpuSolver>(std::move(c).value());
+    } else {
+      throw py::value_error("backend \"" + backend + "\": expected \"cpu\" or \"gpu\"");
+    }
+  }
+
+  void setRain(double mmPerHour) {
+    auto p = solver_->params();
+    p.rainMmPerHour = float(mmPerHour);
+    check(solver_->setParams(p));
+  }
+  void setRainRaster(const std::optional<py::array_t<float, py::array::c_style | py::array::forcecast>>& a) {
+    const auto& g = solver_->grid();
+    check(solver_->setRainRaster(a ? gridOf(*a, g.width, g.height, "rain raster") : gis::Grid<float>()));
+  }
+  void addInflow(const std::vector<std::pair<int, int>>& cells, const std::vector<std::array<double, 2>>& q) {
+    check(solver_->addSource({cellsOf(cells, solver_->grid()), seriesOf(q, "hydrograph")}));
+  }
+  void addLevel(const std::vector<std::pair<int, int>>& cells, const std::vector<std::array<double, 2>>& stage) {
+    check(solver_->addLevel({cellsOf(cells, solver_->grid()), seriesOf(stage, "stage")}));
+  }
+  void step(int n) {
+    if (n < 0) throw py::value_error("a negative number of steps");
+    py::gil_scoped_release release;
+    solver_->step(n);
+  }
+  void advance(double seconds) {
+    if (!(seconds >= 0) || !std::isfinite(seconds)) throw py::value_error("advance: a duration >= 0 in seconds");
+    py::gil_scoped_release release;
+    solver_->advance(seconds);
+  }
+  py::array_t<float> depth() const { return arrayOf(solver_->readWaterDepth()); }
+  py::tuple velocity() const {
+    const auto v = solver_->readVelocity();
+    return py::make_tuple(arrayOf(v.uMS), arrayOf(v.vMS));
+  }
+  py::array_t<float> bed() const { return arrayOf(solver_->readBed(), float(solver_->grid().datumM)); }
+  double timeS() const { return solver_->timeS(); }
+  py::dict stats() const {
+    const auto st = solver_->stats();
+    py::dict d;
+    d["time_s"] = st.timeS;
+    d["steps"] = st.steps;
+    d["stored_water_m3"] = st.storedWaterM3;
+    d["initial_water_m3"] = st.initialWaterM3;
+    d["rain_m3"] = st.rainM3;
+    d["inflow_m3"] = st.inflowM3;
+    d["outflow_m3"] = st.outflowM3;
+    d["evaporated_m3"] = st.evaporatedM3;
+    d["infiltrated_m3"] = st.infiltratedM3;
+    d["balance_m3"] = st.waterBalanceM3();
+    d["max_depth_m"] = st.maxDepthM;
+    return d;
+  }
+  py::tuple geotransform() const {
+    const auto& c = georef_.transform.c;
+    return py::make_tuple(c[0], c[1], c[2], c[3], c[4], c[5]);
+  }
+  std::string crsWkt() const { return georef_.crsWkt; }
+  std::string backendName() const { return solver_->backendName(); }
+
+ private:
+  static void check(const strata::Status& s) {
+    if (!s) throw py::value_error(s.message());
+  }
+  std::optional<strata::gl::HeadlessContext> context_;  // before the solver: destroyed after it
+  std::unique_ptr<sim::Solver> solver_;
+  gis::Georef georef_;
+};
+
 }  // namespace
 
 PYBIND11_MODULE(_strata, m) {
@@ -256,6 +431,30 @@ PYBIND11_MODULE(_strata, m) {
   m.def("run", &run, py::arg("scenario"), py::arg("out_dir"), py::arg("backend") = "cpu", py::arg("pictures") = false,
         py::arg("plots") = false, py::arg("resume") = false, py::arg("overwrite") = false,
         py::arg("progress") = std::function<py::object(double, double)>(), "Runs a scenario into out_dir.");
+  py::class_<PySolver>(m, "Solver",
+                       "One flood-mode solver over a window of a DEM, stepped from Python (docs/python.md).")
+      .def(py::init<const fs::path&, std::optional<std::array<int, 4>>, const std::string&, double, double, double,
+                    const std::vector<std::string>&>(),
+           py::arg("dem"), py::arg("window") = std::nullopt, py::arg("backend") = "cpu", py::arg("manning_n") = 0.035,
+           py::arg("cfl") = 0.45, py::arg("max_step_s") = 30.0,
+           py::arg("open_edges") = std::vector<std::string>{"west", "east", "south", "north"})
+      .def("set_rain", &PySolver::setRain, py::arg("mm_per_hour"), "Uniform rain from the next step on.")
+      .def("set_rain_raster", &PySolver::setRainRaster, py::arg("mm_per_hour"),
+           "Rain per cell (an array of the grid's shape, mm/h) from the next step on; None: none.")
+      .def("add_inflow", &PySolver::addInflow, py::arg("cells"), py::arg("hydrograph"),
+           "Inflow over cells [(x, y), ...] with a hydrograph [(time s, m3/s), ...].")
+      .def("add_level", &PySolver::addLevel, py::arg("cells"), py::arg("stage"),
+           "A fixed water level on cells with a stage [(time s, water surface m), ...].")
+      .def("step", &PySolver::step, py::arg("n") = 1, "Takes n steps of the CFL length.")
+      .def("advance", &PySolver::advance, py::arg("seconds"), "Steps until that much more time has passed.")
+      .def_property_readonly("depth", &PySolver::depth, "Water depth (m), rows north to south.")
+      .def_property_readonly("velocity", &PySolver::velocity, "(u east, v south) in m/s.")
+      .def_property_readonly("bed", &PySolver::bed, "Bed elevation (m).")
+      .def_property_readonly("time_s", &PySolver::timeS)
+      .def_property_readonly("stats", &PySolver::stats, "The water budget since the start (m3).")
+      .def_property_readonly("geotransform", &PySolver::geotransform)
+      .def_property_readonly("crs_wkt", &PySolver::crsWkt)
+      .def_property_readonly("backend", &PySolver::backendName);
   m.def("read_map", &readMap, py::arg("path"), "A GeoTIFF map or DEM: values, geotransform, crs_wkt.");
   m.def("read_series", &readSeries, py::arg("path"), "A run's series.csv as arrays by column.");
 }

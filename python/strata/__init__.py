@@ -6,18 +6,22 @@
     depth = r.map("max_depth")                        # values (numpy, NaN = no data), geotransform, crs_wkt
     r.series["water_volume_m3"]                       # series.csv's columns as numpy arrays
 
+For step-by-step work, strata.Solver("dem.tif", window=(x, y, w, h), backend="cpu") steps one
+flood-mode solver over a window of a DEM: add_inflow, add_level, set_rain, advance, then depth,
+velocity, bed and stats.
+
 A refused scenario raises ScenarioError with the command line's message (file, line, key); a
 progress callback that returns False stops the run and raises Cancelled, leaving a folder that
 strata.run(..., resume=True) continues.
 """
 import os
 
-from ._strata import (Cancelled, Scenario, ScenarioError, load_scenario, read_map, read_series,
+from ._strata import (Cancelled, Scenario, ScenarioError, Solver, load_scenario, read_map, read_series,
                       scenario_from_dict, scenario_toml)
 from . import _strata
 
-__all__ = ["Cancelled", "Run", "Scenario", "ScenarioError", "load_scenario", "read_map", "read_series", "run",
-           "scenario_from_dict", "scenario_toml"]
+__all__ = ["Cancelled", "Run", "Scenario", "ScenarioError", "Solver", "load_scenario", "read_map", "read_series",
+           "run", "scenario_from_dict", "scenario_toml"]
 
 
 class Run:
