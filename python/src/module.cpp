@@ -17,6 +17,7 @@
 #include <fstream>
 #include <memory>
 #include <optional>
+#include <regex>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -49,6 +50,24 @@ py::object gScenarioError, gCancelled;
 
 [[noreturn]] void raise(const py::object& type, const std::string& message) {
   PyErr_SetString(type.ptr(), message.c_str());
+  throw py::error_already_set();
+}
+
+// A ScenarioError whose message starts "FILE:LINE: key 'KEY': " (the scenario parser's form)
+// carries them as attributes too (file, line, key; None where the message has none).
+[[noreturn]] void raiseScenario(const std::string& message) {
+  py::object e = gScenarioError(message);
+  py::object file = py::none(), line = py::none(), key = py::none();
+  static const std::regex form(R"(^(.*?):(\d+): key '([^']*)': )");
+  if (std::smatch m; std::regex_search(message, m, form)) {
+    file = py::str(m[1].str());
+    line = py::int_(std::stoi(m[2].str()));
+    key = py::str(m[3].str());
+  }
+  e.attr("file") = file;
+  e.attr("line") = line;
+  e.attr("key") = key;
+  PyErr_SetObject(gScenarioError.ptr(), e.ptr());
   throw py::error_already_set();
 }
 
@@ -107,7 +126,7 @@ void append(toml::array& a, const py::handle& v, const std::string& where) {
 
 Scenario loadFile(const fs::path& path) {
   auto s = strata::scenario::loadScenario(path);
-  if (!s) raise(gScenarioError, s.message());
+  if (!s) raiseScenario(s.message());
   return std::move(s).value();
 }
 
@@ -117,7 +136,7 @@ std::pair<Scenario, std::string> loadDict(const py::dict& d, const fs::path& bas
   std::ostringstream text;
   text << tableOf(d, "");
   auto s = strata::scenario::parseScenario(text.str(), baseDir / name);
-  if (!s) raise(gScenarioError, s.message() + "\n(the dict as TOML:\n" + text.str() + ")");
+  if (!s) raiseScenario(s.message() + "\n(the dict as TOML:\n" + text.str() + ")");
   return {std::move(s).value(), text.str()};
 }
 
@@ -208,7 +227,7 @@ py::dict run(const Scenario& s, const fs::path& outDir, const std::string& backe
   sigaction(SIGTERM, &oldTerm, nullptr);
   const bool interrupted = strata::interrupted();
   strata::setInterrupted(false);
-  if (!r) raise(gScenarioError, r.message());
+  if (!r) raiseScenario(r.message());
   if (!callbackError.empty()) throw std::runtime_error("the progress callback raised: " + callbackError);
   if (!r->completed && cancelled) {
     char at[64];
@@ -399,7 +418,8 @@ PYBIND11_MODULE(_strata, m) {
   gScenarioError = py::reinterpret_borrow<py::object>(
       PyErr_NewExceptionWithDoc("strata.ScenarioError",
                                 "A scenario refused: the message names the file, the line and the key, as the "
-                                "command line's.",
+                                "command line's; the attributes file, line and key hold them (None where the "
+                                "message has none).",
                                 PyExc_ValueError, nullptr));
   gCancelled = py::reinterpret_borrow<py::object>(PyErr_NewExceptionWithDoc(
       "strata.Cancelled", "A run stopped by its progress callback; its folder can be resumed.", PyExc_RuntimeError,

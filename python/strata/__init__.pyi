@@ -5,7 +5,10 @@ import numpy as np
 
 Path = Union[str, PathLike]
 
-class ScenarioError(ValueError): ...
+class ScenarioError(ValueError):
+    file: Optional[str]
+    line: Optional[int]
+    key: Optional[str]
 class Cancelled(RuntimeError): ...
 
 class Scenario:

@@ -62,6 +62,9 @@ def check_solver(source):
 
 def main():
     cli, source, work = sys.argv[1:4]
+    prefix = os.environ.get("STRATA_EXPECT_PREFIX")  # the install test: the module must come from there
+    if prefix:
+        check(strata.__file__.startswith(prefix), f"strata imported from {os.path.dirname(strata.__file__)}")
     shutil.rmtree(work, ignore_errors=True)
     os.makedirs(work)
     scenarios = os.path.join(source, "scenarios")
@@ -113,6 +116,8 @@ def main():
     except strata.ScenarioError as e:
         check("bad.toml:" in str(e) and "key 'time.duraton': unknown key" in str(e),
               f"ScenarioError: {str(e).splitlines()[0]}")
+        check(e.file.endswith("bad.toml") and isinstance(e.line, int) and e.key == "time.duraton",
+              f"its file, line and key: {os.path.basename(e.file)}, {e.line}, {e.key}")
     try:
         strata.run(s, os.path.join(work, "module"))
         check(False, "an existing run folder is not overwritten")
