@@ -86,6 +86,7 @@ Result<std::vector<std::string>> compareRuns(const CompareOptions& o) {
   if (names.empty()) return fail(o.runA.string() + " and " + o.runB.string() + ": no map in common");
   gis::ReadOptions read;
   read.allowAllNoData = true;
+  std::vector<std::string> differ, identical;  // maps with a difference somewhere, and without any
   for (const auto& name : names) {
     const fs::path pa = o.runA / "maps" / (name + ".tif"), pb = o.runB / "maps" / (name + ".tif");
     STRATA_TRY(auto ra, gis::readDem(pa.string(), read));
@@ -115,6 +116,15 @@ Result<std::vector<std::string>> compareRuns(const CompareOptions& o) {
       }
       d.values.data[i] = std::isfinite(x) && std::isfinite(y) ? y - x : gis::kNoData;
     }
+    double big = 0;
+    for (float v : d.values.data) {
+      if (std::isfinite(v)) big = std::max(big, double(std::abs(v)));
+    }
+    if (big == 0) {  // the same in both runs (e.g. the bed of a what-if that changes the water)
+      identical.push_back(name);
+      continue;
+    }
+    differ.push_back(name);
     gis::WriteOptions w;
     w.description = "difference of " + name + ": run B less run A";
     w.units = ra.georef.verticalUnit == "m" && (name.ends_with("depth") || name == "elevation" ||
@@ -126,10 +136,6 @@ Result<std::vector<std::string>> compareRuns(const CompareOptions& o) {
     STRATA_TRY_STATUS(gis::writeGeoTiff((o.outDir / file).string(), d, w));
     written.push_back(file);
     // A diverging style, symmetric about 0.
-    double big = 0;
-    for (float v : d.values.data) {
-      if (std::isfinite(v)) big = std::max(big, double(std::abs(v)));
-    }
     STRATA_TRY_STATUS(writeFileAtomic(o.outDir / ("maps/" + name + "_difference.qml"),
                                       detail::rasterStyle("terrain_change", -big, big, 0)));
     written.push_back("maps/" + name + "_difference.qml");
@@ -177,7 +183,12 @@ Result<std::vector<std::string>> compareRuns(const CompareOptions& o) {
       }
     }
   } else {
-    for (const auto& n : names) md += "- `maps/" + n + "_difference.tif`\n";
+    for (const auto& n : differ) md += "- `maps/" + n + "_difference.tif`\n";
+  }
+  if (!identical.empty()) {
+    md += "\nThe same in both runs, cell for cell (no difference map):";
+    for (size_t i = 0; i < identical.size(); ++i) md += std::string(i ? "," : "") + " `" + identical[i] + "`";
+    md += ".\n";
   }
   STRATA_TRY_STATUS(writeFileAtomic(o.outDir / "compare.md", md));
   written.push_back("compare.md");

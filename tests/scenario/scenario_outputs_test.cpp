@@ -227,6 +227,9 @@ TEST(ScenarioOutputs, CompareGivesDifferenceMapsAndTheHeadlineNumbers) {
   const std::string md = slurp(o.outDir / "compare.md");
   EXPECT_NE(md.find("| largest flooded area | "), std::string::npos) << md;
   EXPECT_NE(md.find("![max_depth_difference](plots/max_depth_difference.png)"), std::string::npos);
+  // Friction changes the water, not the bed: no map of zeros, said instead.
+  EXPECT_FALSE(std::filesystem::exists(o.outDir / "maps" / "elevation_difference.tif"));
+  EXPECT_NE(md.find("The same in both runs, cell for cell (no difference map): `elevation`"), std::string::npos) << md;
 
   // Refusals: the output folder holds something; a run of other cells.
   auto again = compareRuns(o);
