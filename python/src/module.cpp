@@ -14,7 +14,6 @@
 #include <cmath>
 #include <csignal>
 #include <cstdio>
-#include <fstream>
 #include <memory>
 #include <optional>
 #include <regex>
@@ -158,24 +157,12 @@ py::dict readMap(const fs::path& path) {
   return out;
 }
 
-// series.csv as a dict of float64 arrays by column name.
+// series.csv as a dict of float64 arrays by column name (scenario::readSeriesCsv).
 py::dict readSeries(const fs::path& path) {
-  std::ifstream f(path);
-  if (!f) throw std::runtime_error(path.string() + ": cannot read the series");
-  std::string line;
-  std::getline(f, line);
-  std::vector<std::string> names;
-  std::stringstream header(line);
-  for (std::string n; std::getline(header, n, ',');) names.push_back(n);
-  std::vector<std::vector<double>> cols(names.size());
-  while (std::getline(f, line)) {
-    std::stringstream row(line);
-    size_t k = 0;
-    for (std::string v; std::getline(row, v, ',') && k < cols.size(); ++k) cols[k].push_back(std::stod(v));
-  }
+  auto cols = strata::scenario::readSeriesCsv(path);
+  if (!cols) throw std::runtime_error(cols.message());
   py::dict out;
-  for (size_t k = 0; k < names.size(); ++k)
-    out[py::str(names[k])] = py::array_t<double>(cols[k].size(), cols[k].data());
+  for (const auto& [name, values] : *cols) out[py::str(name)] = py::array_t<double>(values.size(), values.data());
   return out;
 }
 

@@ -5,7 +5,6 @@
 #include <cstdio>
 #include <fstream>
 #include <map>
-#include <sstream>
 
 #include <strata/core/files.hpp>
 #include <strata/gis/dem_io.hpp>
@@ -25,34 +24,6 @@ bool noDataIsZero(const std::string& name) {
          name == "terrain_change" || name == "suspended_sediment";
 }
 
-// A run's series.csv as columns by header name.
-Result<std::map<std::string, std::vector<double>>> readSeries(const fs::path& run) {
-  const fs::path file = run / "series.csv";
-  STRATA_TRY_STATUS(requireRegularFile(file, "a run's series"));
-  std::ifstream in(file);
-  std::string line;
-  std::vector<std::string> header;
-  if (!std::getline(in, line)) return fail(file.string() + ": empty");
-  std::stringstream hs(line);
-  for (std::string h; std::getline(hs, h, ',');) header.push_back(h);
-  std::map<std::string, std::vector<double>> cols;
-  int row = 1;
-  while (std::getline(in, line)) {
-    ++row;
-    std::stringstream ls(line);
-    size_t k = 0;
-    for (std::string v; std::getline(ls, v, ',') && k < header.size(); ++k) {
-      char* end = nullptr;
-      const double x = std::strtod(v.c_str(), &end);
-      if (end == v.c_str()) return fail(file.string() + ":" + std::to_string(row) + ": not a number: " + v);
-      cols[header[k]].push_back(x);
-    }
-  }
-  if (cols.empty() || cols.begin()->second.empty())
-    return fail(file.string() + ": no rows (the run has no output yet)");
-  return cols;
-}
-
 std::string fmt(const char* f, double v) {
   char buf[64];
   std::snprintf(buf, sizeof buf, f, v);
@@ -69,8 +40,8 @@ Result<std::vector<std::string>> compareRuns(const CompareOptions& o) {
   if (fs::exists(o.outDir, ec) && !fs::is_empty(o.outDir, ec)) {
     return fail(o.outDir.string() + ": exists and is not empty (choose a new folder)");
   }
-  STRATA_TRY(auto a, readSeries(o.runA));
-  STRATA_TRY(auto b, readSeries(o.runB));
+  STRATA_TRY(auto a, readSeriesCsv(o.runA / "series.csv"));
+  STRATA_TRY(auto b, readSeriesCsv(o.runB / "series.csv"));
   fs::create_directories(o.outDir / "maps", ec);
   if (ec) return fail(o.outDir.string() + ": cannot create it: " + ec.message());
   std::vector<std::string> written;

@@ -930,6 +930,32 @@ std::vector<std::string> runFolderTemporaries(const fs::path& runDir) {
   return out;
 }
 
+Result<std::map<std::string, std::vector<double>>> readSeriesCsv(const fs::path& file) {
+  STRATA_TRY_STATUS(requireRegularFile(file, "a run's series"));
+  std::ifstream in(file);
+  std::string line;
+  std::vector<std::string> header;
+  if (!std::getline(in, line)) return fail(file.string() + ": empty");
+  std::stringstream hs(line);
+  for (std::string h; std::getline(hs, h, ',');) header.push_back(h);
+  std::map<std::string, std::vector<double>> cols;
+  int row = 1;
+  while (std::getline(in, line)) {
+    ++row;
+    std::stringstream ls(line);
+    size_t k = 0;
+    for (std::string v; std::getline(ls, v, ',') && k < header.size(); ++k) {
+      char* end = nullptr;
+      const double x = std::strtod(v.c_str(), &end);
+      if (end == v.c_str()) return fail(file.string() + ":" + std::to_string(row) + ": not a number: " + v);
+      cols[header[k]].push_back(x);
+    }
+  }
+  if (cols.empty() || cols.begin()->second.empty())
+    return fail(file.string() + ": no rows (the run has no output yet)");
+  return cols;
+}
+
 std::string seriesCsv(const std::vector<SeriesRow>& rows) {
   std::string out =
       "time_s,steps,dt_s,water_volume_m3,flooded_area_km2,inflow_m3,rain_m3,outflow_m3,evaporation_m3,"

@@ -11,6 +11,7 @@
 
 #include <strata/gis/dem_io.hpp>
 #include <strata/gis/geodesy.hpp>
+#include <strata/scenario/run.hpp>
 #include <strata/scenario/scenario.hpp>
 
 #include "strata_test.hpp"
@@ -77,6 +78,16 @@ inline gis::Raster utmRaster(int width, int height, double x0, double y0, double
   r.georef.transform = gis::GeoTransform{{x0, cellM, 0, y0, 0, -cellM}};
   r.values = gis::Grid<float>(width, height, fill);
   return r;
+}
+
+/// A run into `out` on the CPU backend, without pictures (and without plots unless asked).
+inline RunOptions cpuOptions(const std::filesystem::path& out, bool plots = false) {
+  RunOptions o;
+  o.outDir = out;
+  o.backend = Backend::kCpu;
+  o.pictures = false;
+  o.plots = plots;
+  return o;
 }
 
 inline gis::ReadOptions allowEmpty() {

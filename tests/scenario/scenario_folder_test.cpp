@@ -22,19 +22,10 @@ namespace {
 using namespace test_support;
 namespace fs = std::filesystem;
 
-RunOptions cpuRun(const fs::path& dir) {
-  RunOptions opt;
-  opt.outDir = dir;
-  opt.backend = Backend::kCpu;
-  opt.pictures = false;
-  opt.plots = false;
-  return opt;
-}
-
 TEST(RunFolder, AnEarlierRunIsNeitherMixedNorRemovedUnasked) {
   const auto dir = strata::test::tempDir("rerun");
   const auto s = writeScenario(dir);
-  auto opt = cpuRun(dir / "run");
+  auto opt = cpuOptions(dir / "run");
   opt.stopAfterIntervals = 1;
   ASSERT_TRUE(runScenario(s, opt));
   // What a user keeps there, and what an earlier erode run left (the issue: a stale
@@ -77,7 +68,7 @@ TEST(RunFolder, AnEarlierRunIsNeitherMixedNorRemovedUnasked) {
 TEST(RunFolder, ASecondWriterIsRefused) {
   const auto dir = strata::test::tempDir("second-writer");
   const auto s = writeScenario(dir);
-  auto opt = cpuRun(dir / "run");
+  auto opt = cpuOptions(dir / "run");
   fs::create_directories(opt.outDir);
   auto lock = FileLock::acquire(opt.outDir / "run.lock");  // a run in progress
   ASSERT_TRUE(lock) << lock.message();
@@ -96,7 +87,7 @@ TEST(RunFolder, ASecondWriterIsRefused) {
 TEST(RunFolder, ErodeDoesNotResumeAFloodsCheckpoint) {
   const auto dir = strata::test::tempDir("erode-resume");
   auto s = writeScenario(dir);
-  auto opt = cpuRun(dir / "run");
+  auto opt = cpuOptions(dir / "run");
   opt.stopAfterIntervals = 2;
   ASSERT_TRUE(runScenario(s, opt));
   auto erode = opt;
@@ -120,7 +111,7 @@ TEST(RunFolder, ErodeDoesNotResumeAFloodsCheckpoint) {
 TEST(RunFolder, ACorruptedCheckpointIsRefused) {
   const auto dir = strata::test::tempDir("corrupt");
   auto s = writeScenario(dir);
-  auto opt = cpuRun(dir / "run");
+  auto opt = cpuOptions(dir / "run");
   opt.stopAfterIntervals = 2;
   ASSERT_TRUE(runScenario(s, opt));
   const auto path = opt.outDir / "checkpoint.bin";
@@ -155,7 +146,7 @@ TEST(RunFolder, ACorruptedCheckpointIsRefused) {
 TEST(RunFolder, AResumeIsTidyAndItsReportComplete) {
   const auto dir = strata::test::tempDir("resume-tidy");
   const auto s = writeScenario(dir);
-  auto opt = cpuRun(dir / "run");
+  auto opt = cpuOptions(dir / "run");
   auto first = runScenario(s, opt);
   ASSERT_TRUE(first) << first.message();
   // Killed after its last checkpoint, while writing the report and plots.
@@ -187,7 +178,7 @@ TEST(RunFolder, AResumeIsTidyAndItsReportComplete) {
 
   // Stopped half-way and resumed: the sessions add up.
   const auto dir2 = strata::test::tempDir("resume-wall");
-  auto half = cpuRun(dir2 / "run");
+  auto half = cpuOptions(dir2 / "run");
   half.stopAfterIntervals = 2;
   auto part1 = runScenario(s, half);
   ASSERT_TRUE(part1);
@@ -209,7 +200,7 @@ TEST(RunFolder, AHugeNameIsNotRepeatedInEveryLine) {
   auto s = loadScenario(dir / "flood.toml");
   ASSERT_TRUE(s) << s.message();
   EXPECT_EQ(s->name.size(), name.size() + 7);
-  auto opt = cpuRun(dir / "run");
+  auto opt = cpuOptions(dir / "run");
   const auto level = log::level();
   log::setLevel(log::Level::Info);  // the run's log lines and progress lines
   ::testing::internal::CaptureStderr();

@@ -48,16 +48,6 @@ std::string text(const std::string& infiltration) {
          "[time]\nduration = \"30 min\"\noutput_interval = \"10 min\"\n[outputs]\nmaps = [\"max_depth\"]\n";
 }
 
-// The CPU backend, no pictures or plots, into `out`.
-RunOptions cpuOptions(const std::filesystem::path& out) {
-  RunOptions o;
-  o.outDir = out;
-  o.backend = Backend::kCpu;
-  o.pictures = false;
-  o.plots = false;
-  return o;
-}
-
 struct Outcome {
   std::vector<std::vector<double>> series;
   std::string report;

@@ -35,14 +35,6 @@ Scenario load(const std::filesystem::path& dir, const std::string& text) {
   return *s;
 }
 
-RunOptions cpuRun(const std::filesystem::path& out) {
-  RunOptions opt;
-  opt.outDir = out;
-  opt.backend = Backend::kCpu;
-  opt.pictures = false;
-  return opt;
-}
-
 TEST(ScenarioProbes, FacesCrossedByALineCarryTheSignOfItsRightHandSide) {
   // A line heading south between columns 2 and 3 (x = 3.0 in pixels, the face between cells 2
   // and 3) over rows 0..3: four x faces (3, y); its right is west, so an eastward flux counts -1.
@@ -73,7 +65,7 @@ TEST(ScenarioProbes, FacesCrossedByALineCarryTheSignOfItsRightHandSide) {
 TEST(ScenarioProbes, SectionVolumeIsTheWaterThatCrossedAndGaugePeakIsTheMap) {
   const auto dir = strata::test::tempDir("probes");
   const Scenario s = load(dir, damBreakText(kProbes));
-  auto summary = runScenario(s, cpuRun(dir / "run"));
+  auto summary = runScenario(s, cpuOptions(dir / "run", true));
   ASSERT_TRUE(summary) << summary.message();
   ASSERT_EQ(summary->sections.size(), 1u);
   ASSERT_EQ(summary->gauges.size(), 1u);
@@ -136,11 +128,11 @@ TEST(ScenarioProbes, SectionVolumeIsTheWaterThatCrossedAndGaugePeakIsTheMap) {
 TEST(ScenarioProbes, AStoppedAndResumedRunWritesTheSameRows) {
   const auto dir = strata::test::tempDir("probes-resume");
   const Scenario s = load(dir, damBreakText(kProbes));
-  auto whole = cpuRun(dir / "whole");
+  auto whole = cpuOptions(dir / "whole", true);
   whole.plots = false;
   auto once = runScenario(s, whole);
   ASSERT_TRUE(once) << once.message();
-  auto parts = cpuRun(dir / "parts");
+  auto parts = cpuOptions(dir / "parts", true);
   parts.plots = false;
   parts.stopAfterIntervals = 2;
   auto first = runScenario(s, parts);

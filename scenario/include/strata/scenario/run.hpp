@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -136,5 +137,8 @@ std::vector<std::string> runFolderTemporaries(const std::filesystem::path& runDi
 
 /// The CSV text of a series (header + rows), as series.csv holds it.
 std::string seriesCsv(const std::vector<SeriesRow>& rows);
+/// A series.csv read back: its columns by header name (a run stopped before its first output
+/// interval has no rows: refused, as is a cell that is not a number, naming file and line).
+Result<std::map<std::string, std::vector<double>>> readSeriesCsv(const std::filesystem::path& file);
 
 }  // namespace strata::scenario
