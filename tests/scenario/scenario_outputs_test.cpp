@@ -45,12 +45,7 @@ void cpuRun(const std::filesystem::path& dir, const std::string& name, const std
   std::ofstream(dir / (name + ".toml")) << text;
   auto s = loadScenario(dir / (name + ".toml"));
   ASSERT_TRUE(s) << s.message();
-  RunOptions opt;
-  opt.outDir = dir / name;
-  opt.backend = Backend::kCpu;
-  opt.pictures = false;
-  opt.plots = false;
-  auto summary = runScenario(*s, opt);
+  auto summary = runScenario(*s, cpuOptions(dir / name));
   ASSERT_TRUE(summary) << summary.message();
 }
 

@@ -61,12 +61,7 @@ Result<gis::Raster> maxDepth(const std::filesystem::path& dir, const std::string
   std::ofstream(dir / (name + ".toml")) << text(model);
   auto s = loadScenario(dir / (name + ".toml"));
   if (!s) return s.error();
-  RunOptions opt;
-  opt.outDir = dir / name;
-  opt.backend = Backend::kCpu;
-  opt.pictures = false;
-  opt.plots = false;
-  auto run = runScenario(*s, opt);
+  auto run = runScenario(*s, cpuOptions(dir / name));
   if (!run) return run.error();
   return gis::readDem((dir / name / "maps" / "max_depth.tif").string(), allowEmpty());
 }

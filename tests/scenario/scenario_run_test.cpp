@@ -280,15 +280,10 @@ TEST(ScenarioRun, SpinUpEndsOnceTheRiverIsSteady) {
     auto scenario = loadScenario(dir / (name + ".toml"));
     EXPECT_TRUE(scenario) << scenario.message();
     if (!scenario) return std::pair{SpinUpSummary{}, std::string()};
-    RunOptions opt;
-    opt.outDir = dir / name;
-    opt.backend = Backend::kCpu;
-    opt.pictures = false;
-    opt.plots = false;
-    auto summary = runScenario(*scenario, opt);
+    auto summary = runScenario(*scenario, cpuOptions(dir / name));
     EXPECT_TRUE(summary) << summary.message();
     if (!summary) return std::pair{SpinUpSummary{}, std::string()};
-    return std::pair{summary->spinUp, slurp(opt.outDir / "report.md")};
+    return std::pair{summary->spinUp, slurp(dir / name / "report.md")};
   };
   const auto [steady, report] = run("spin_up = \"48 h\"\nspin_up_tolerance = 0.01\n", "steady");
   EXPECT_TRUE(steady.steady);
