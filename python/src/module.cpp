@@ -15,6 +15,7 @@
 #include <csignal>
 #include <cstdio>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <regex>
 #include <sstream>
@@ -24,6 +25,7 @@
 #include <toml++/toml.h>
 
 #include <strata/core/interrupt.hpp>
+#include <strata/core/log.hpp>
 #include <strata/gis/dem_io.hpp>
 #include <strata/gl/context.hpp>
 #include <strata/scenario/domain.hpp>
@@ -166,10 +168,55 @@ py::dict readSeries(const fs::path& path) {
   return out;
 }
 
+// The run's log lines (strata::log: "warning: ..." on stderr from the command line) for a Python
+// callback log(level, category, message). They are held while the run goes on and handed over
+// from the thread that holds the GIL (at each progress call and at the end): the sink itself
+// never waits for the GIL, so no thread logging with the GIL held can deadlock against it.
+class LogRelay {
+ public:
+  using Callback = std::function<void(std::string, std::string, std::string)>;
+  explicit LogRelay(Callback callback) : callback_(std::move(callback)) {
+    if (!callback_) return;
+    strata::log::setSink([this](strata::log::Level level, std::string_view category, std::string_view message) {
+      std::lock_guard lock(mutex_);
+      pending_.push_back({levelName(level), std::string(category), std::string(message)});
+    });
+  }
+  ~LogRelay() {
+    if (callback_) strata::log::resetSink();
+  }
+  LogRelay(const LogRelay&) = delete;
+  LogRelay& operator=(const LogRelay&) = delete;
+  /// Hands the lines over; the caller holds the GIL.
+  void flush() {
+    if (!callback_) return;
+    std::vector<std::array<std::string, 3>> lines;
+    {
+      std::lock_guard lock(mutex_);
+      lines.swap(pending_);
+    }
+    for (auto& [level, category, message] : lines) callback_(level, category, message);
+  }
+
+ private:
+  static std::string levelName(strata::log::Level level) {
+    switch (level) {
+      case strata::log::Level::Debug: return "debug";
+      case strata::log::Level::Warn: return "warning";
+      case strata::log::Level::Error: return "error";
+      default: return "info";
+    }
+  }
+  Callback callback_;
+  std::mutex mutex_;
+  std::vector<std::array<std::string, 3>> pending_;
+};
+
 // Runs with Python's own SIGINT and SIGTERM handlers put back afterwards (the run installs its
 // own, which stop it cleanly); the GIL released while it runs and taken for each callback.
 py::dict run(const Scenario& s, const fs::path& outDir, const std::string& backend, bool pictures, bool plots,
-             bool resume, bool overwrite, const std::function<py::object(double, double)>& progress) {
+             bool resume, bool overwrite, const std::function<py::object(double, double)>& progress,
+             const LogRelay::Callback& log) {
   RunOptions o;
   o.outDir = outDir;
   o.resume = resume;
@@ -187,12 +234,16 @@ py::dict run(const Scenario& s, const fs::path& outDir, const std::string& backe
   }
   bool cancelled = false;
   std::string callbackError;
-  if (progress) {
+  LogRelay relay(log);
+  if (progress || log) {
     o.onProgress = [&](double t, double duration) {
       py::gil_scoped_acquire gil;
       try {
-        const py::object answer = progress(t, duration);
-        if (!answer.is_none() && !answer.cast<bool>()) cancelled = true;
+        relay.flush();
+        if (progress) {
+          const py::object answer = progress(t, duration);
+          if (!answer.is_none() && !answer.cast<bool>()) cancelled = true;
+        }
       } catch (py::error_already_set& e) {
         callbackError = e.what();
         cancelled = true;
@@ -214,8 +265,15 @@ py::dict run(const Scenario& s, const fs::path& outDir, const std::string& backe
   sigaction(SIGTERM, &oldTerm, nullptr);
   const bool interrupted = strata::interrupted();
   strata::setInterrupted(false);
+  if (callbackError.empty()) {
+    try {
+      relay.flush();
+    } catch (py::error_already_set& e) {
+      callbackError = e.what();
+    }
+  }
   if (!r) raiseScenario(r.message());
-  if (!callbackError.empty()) throw std::runtime_error("the progress callback raised: " + callbackError);
+  if (!callbackError.empty()) throw std::runtime_error("the progress or log callback raised: " + callbackError);
   if (!r->completed && cancelled) {
     char at[64];
     std::snprintf(at, sizeof at, "cancelled at t = %.0f s; ", r->simulatedS);
@@ -437,7 +495,8 @@ PYBIND11_MODULE(_strata, m) {
       py::arg("scenario"), "The TOML text of a scenario dict (what scenario_from_dict checks).");
   m.def("run", &run, py::arg("scenario"), py::arg("out_dir"), py::arg("backend") = "cpu", py::arg("pictures") = false,
         py::arg("plots") = false, py::arg("resume") = false, py::arg("overwrite") = false,
-        py::arg("progress") = std::function<py::object(double, double)>(), "Runs a scenario into out_dir.");
+        py::arg("progress") = std::function<py::object(double, double)>(), py::arg("log") = LogRelay::Callback(),
+        "Runs a scenario into out_dir.");
   py::class_<PySolver>(m, "Solver",
                        "One flood-mode solver over a window of a DEM, stepped from Python (docs/python.md).")
       .def(py::init<const fs::path&, std::optional<std::array<int, 4>>, const std::string&, double, double, double,

@@ -52,12 +52,15 @@ class Run:
 
 
 def run(scenario, out_dir, *, backend="cpu", pictures=False, plots=False, resume=False, overwrite=False,
-        progress=None):
+        progress=None, log=None):
     """Runs `scenario` (a Scenario) into the folder `out_dir` and returns a Run.
 
     backend: "cpu", "gpu" (the GL backend) or "auto", as the command line's --backend
     progress(time_s, duration_s) is called a few times a second; returning False stops the run
     (Cancelled is raised; resume=True continues it). The run refuses to overwrite an earlier run's
-    outputs unless overwrite=True, as `strata flood` does."""
-    info = _strata.run(scenario, os.fspath(out_dir), backend, pictures, plots, resume, overwrite, progress)
+    outputs unless overwrite=True, as `strata flood` does.
+    log(level, category, message) receives the lines the command line prints on stderr (level
+    "debug", "info", "warning" or "error"; category e.g. "flood") instead of stderr, from the
+    calling thread: at each progress call and at the end."""
+    info = _strata.run(scenario, os.fspath(out_dir), backend, pictures, plots, resume, overwrite, progress, log)
     return Run(out_dir, info)

@@ -1035,7 +1035,7 @@ class Session {
       STRATA_TRY(domain_, scenario::buildDomain(s_, opt_.memoryBudgetBytes));
     }
     STRATA_TRY_STATUS(takeFolder());
-    scenarioText_ = ranks_.fromLead(ranks_.lead() ? slurp(s_.file) : std::string());
+    scenarioText_ = ranks_.fromLead(ranks_.lead() ? (s_.text.empty() ? slurp(s_.file) : s_.text) : std::string());
     // The bed the model uses (conditioned), written once the domain is built: a map for the GIS
     // user, and what pictures and plots draw.
     if (rows) {

@@ -1235,7 +1235,9 @@ bool renameNearMiss(toml::table& root, const std::vector<std::string>& parts, co
 
 Result<Scenario> parseScenario(std::string_view text, const std::filesystem::path& fileName) {
   STRATA_TRY(const auto root, parseToml(withoutBom(text), fileName.string()));
-  return readScenario(root, fileName);
+  STRATA_TRY(auto s, readScenario(root, fileName));
+  s.text = std::string(text);
+  return s;
 }
 
 ScenarioCheck checkScenarioText(std::string_view text, const std::filesystem::path& fileName) {

@@ -80,10 +80,15 @@ def main():
         f.write(strata.scenario_toml(d))
     check(strata.load_scenario(os.path.join(work, "coarse.toml")).name == s.name, "load_scenario reads the same file")
 
-    calls = []
-    run = strata.run(s, os.path.join(work, "module"), progress=lambda t, total: calls.append((t, total)))
+    calls, lines = [], []
+    run = strata.run(s, os.path.join(work, "module"), progress=lambda t, total: calls.append((t, total)),
+                     log=lambda *line: lines.append(line))
+    check(any(level == "info" and category == "flood" and "running on CPU" in message
+              for level, category, message in lines), f"the log callback got the run's {len(lines)} lines")
     check(run.completed and run.backend.startswith("CPU"), f"the module's run completed on the CPU ({run!r})")
     check(len(calls) >= 3 and calls[-1] == (1800.0, 1800.0), f"progress was called {len(calls)} times, ending at the end")
+    with open(os.path.join(work, "module", "scenario.toml")) as f:
+        check(f.read() == strata.scenario_toml(d), "the run folder's scenario.toml is the dict's TOML")
     subprocess.run([cli, "flood", os.path.join(work, "coarse.toml"), "-o", os.path.join(work, "cli"), "--backend",
                     "cpu", "--no-pictures", "--no-plots"], check=True, stdout=subprocess.DEVNULL)
     mine = run.map("max_depth")

@@ -97,6 +97,10 @@ struct LayerSpec {
 
 struct Scenario {
   std::filesystem::path file;  ///< the scenario file; relative paths inside are relative to it
+  /// The TOML text it was read from (parseScenario): a run writes it to its folder as
+  /// scenario.toml and ties its checkpoints to it. A scenario given as text (the Python module's
+  /// dicts) has no file of its own.
+  std::string text;
   std::string name, description;
   /// The line of every key read ("region.cell_size", "water.inflow[0].hydrograph"; a table's
   /// own name, e.g. "region", for the table), for messages of checks that come later.
