@@ -47,5 +47,15 @@ if [ -d "$build/python/strata" ]; then
     /usr/bin/python3 "$src/tests/python/test_module.py" "$work/prefix/bin/strata" "$src" "$work/python" |
     grep -q "python module: all checks passed" || { echo "the installed Python module failed its test" >&2; exit 1; }
   [ -s "$work/prefix/lib/python3/dist-packages/strata/__init__.pyi" ] || { echo "the type stubs are not installed" >&2; exit 1; }
+  # The QGIS plugin: installed where QGIS looks (QGIS_PLUGINPATH for this prefix), finding the
+  # prefix's module and command.
+  plugin="$work/prefix/share/qgis/python/plugins/strata_processing"
+  [ -s "$plugin/metadata.txt" ] || { echo "the QGIS plugin is not installed" >&2; exit 1; }
+  (cd "$plugin" && /usr/bin/python3 -c '
+import os, sys
+import locations
+sys.exit(0 if os.path.isfile(os.path.join(locations.PYTHON_DIR, "strata", "__init__.py")) and
+         os.access(locations.EXECUTABLE, os.X_OK) else "the installed plugin does not find its module and command")
+') || exit 1
 fi
 echo "installed run: report, plots and maps written from $work"
