@@ -8,7 +8,8 @@ processing.run would use it:
   gauge's series);
 - an inflow layer in another CRS (Web Mercator) reaches the scenario in the DEM's CRS; a cancelled
   run raises, leaves a resumable folder, and RESUME finishes it; a bad field value is refused
-  naming the layer, the feature and the field;
+  naming the layer, the feature and the field; a dam-break polygon layer and a level line layer
+  reach the scenario with their fields' elevations;
 - Erosion what-if on Mount Rainier gives a styled terrain change with cut and fill;
 - Ingest DEM to store writes a store, and Render picture draws it to a PNG that is not blank;
 - the Flood algorithm runs as a child of a Processing model (the graphical modeller's form).
@@ -224,6 +225,27 @@ at_xy = [-112.1, 36.1]
         check("bad inflows" in message and "feature" in message and "'peak'" in message,
               f"a bad discharge is refused: {message.splitlines()[0]}")
     check(not os.path.exists(os.path.join(work, "bad", "maps")), "...and nothing ran")
+
+    # A dam break (a polygon of water standing at 900 m, closed ring in QGIS, open in the scenario)
+    # and a fixed level (a line across the river at 850 m) from layers with their fields.
+    ring = [QgsPointXY(-112.06, 36.055), QgsPointXY(-112.03, 36.055), QgsPointXY(-112.03, 36.085),
+            QgsPointXY(-112.06, 36.085)]
+    dam = memory_layer("Polygon?crs=EPSG:4326&field=surface:double", "reservoir",
+                       [QgsGeometry.fromPolygonXY([ring + ring[:1]])], [[900.0]])
+    level = memory_layer("LineString?crs=EPSG:4326&field=name:string&field=stage:double", "stage",
+                         [QgsGeometry.fromPolylineXY(line)], [["river stage", 850.0]])
+    results = processing.run("strata:flood", dict(params, INFLOWS=None, GAUGES=None, DAM_BREAKS=dam,
+                                                  DAM_SURFACE_FIELD="surface", LEVELS=level, LEVEL_FIELD="stage",
+                                                  OUTPUT=os.path.join(work, "dam")),
+                             context=QgsProcessingContext(), feedback=QgsProcessingFeedback())
+    with open(results["SCENARIO"], "rb") as f:
+        water = tomllib.load(f)["water"]
+    check(water["dam_break"] == [{"polygon_xy": [[p.x(), p.y()] for p in ring], "surface": "900.0 m"}],
+          "the dam-break polygon and its field's surface reach the scenario")
+    check(water["level"][0]["line_xy"] == [[p.x(), p.y()] for p in line] and water["level"][0]["name"] == "river stage"
+          and water["level"][0]["stage"] == [[0, 850.0], [900.0, 850.0]], "the level line, its name and stage")
+    dam_depth = values(results["MAX_DEPTH"])
+    check(np.nanmax(dam_depth) > 10, f"the released reservoir floods ({np.nanmax(dam_depth):.1f} m deep at most)")
 
     # Erosion what-if: a short cloudburst on Rainier's flank at 450 m cells.
     rainier = QgsRasterLayer(os.path.join(data, "rainier", "mt_rainier_90m.tif"), "rainier")
