@@ -33,6 +33,7 @@
 #include <strata/scenario/scenario.hpp>
 #include <strata/sim/cpu_solver.hpp>
 #include <strata/sim/gl/gl_solver.hpp>
+#include <strata/terrain/material.hpp>
 
 namespace py = pybind11;
 namespace fs = std::filesystem;
@@ -326,12 +327,17 @@ strata::TimeSeries seriesOf(const std::vector<std::array<double, 2>>& samples, c
   return std::move(t).value();
 }
 
-// Step-by-step use of one solver over a window of a DEM (flood mode; one layer of rock under the
-// DEM's surface): the scenario's cell sizes (geodesic) and model parameters, the CPU or GL backend.
+// Step-by-step use of one solver over a window of a DEM (flood mode): the scenario's cell sizes
+// (geodesic) and model parameters, the CPU or GL backend. Material layers lie on the DEM's
+// surface as a scenario's [[terrain.layer]] do (bare rock when none), and erosion, when asked for,
+// works them with the scenario's laws and the default materials' constants.
+using LayerSpec = std::pair<std::string, py::object>;  // (material, thickness: metres or an array)
+
 class PySolver {
  public:
   PySolver(const fs::path& dem, std::optional<std::array<int, 4>> window, const std::string& backend, double manningN,
-           double cfl, double maxStepS, const std::vector<std::string>& openEdges) {
+           double cfl, double maxStepS, const std::vector<std::string>& openEdges, const std::vector<LayerSpec>& layers,
+           const std::optional<std::string>& erosion, bool thermal) {
     gis::ReadOptions ro;
     auto r = gis::readDem(dem.string(), ro);
     if (!r) throw std::runtime_error(r.message());
@@ -362,9 +368,48 @@ class PySolver {
     in.dyM = sizes->dyM;
     in.rowDxM = sizes->rowDxM;
     in.datumM = std::floor(lo);
-    in.layersM = {gis::Grid<float>(w, h, 0.0f)};
-    in.materials = {strata::terrain::Material{}};
+    const auto table = strata::terrain::defaultMaterials();
+    auto material = [&](const std::string& name) {
+      const int i = strata::terrain::findMaterial(table, name);
+      if (i < 0) {
+        std::string names;
+        for (const auto& m : table) names += (names.empty() ? "" : ", ") + m.name;
+        throw py::value_error("layer material \"" + name + "\": expected one of " + names);
+      }
+      return table[size_t(i)];
+    };
+    for (const auto& [name, thickness] : layers) {
+      in.materials.push_back(material(name));
+      gis::Grid<float> t(w, h, 0.0f);
+      if (py::isinstance<py::float_>(thickness) || py::isinstance<py::int_>(thickness)) {
+        const double v = thickness.cast<double>();
+        if (!(v >= 0) || !std::isfinite(v)) throw py::value_error("layer \"" + name + "\": a thickness >= 0 in m");
+        std::fill(t.data.begin(), t.data.end(), float(v));
+      } else {
+        t = gridOf(thickness.cast<py::array_t<float, py::array::c_style | py::array::forcecast>>(), w, h,
+                   ("layer \"" + name + "\" thickness").c_str());
+        for (float v : t.data) {
+          if (!(v >= 0) || !std::isfinite(v)) throw py::value_error("layer \"" + name + "\": thicknesses >= 0 in m");
+        }
+      }
+      in.layersM.push_back(std::move(t));
+    }
+    if (layers.empty()) {  // bare rock: one layer of zero thickness so erosion has a material to read
+      in.materials.push_back(material("rock"));
+      in.layersM.push_back(gis::Grid<float>(w, h, 0.0f));
+    }
     Scenario s;
+    if (erosion) {
+      s.erosion.enabled = true;
+      s.erosion.thermal = thermal;
+      if (*erosion == "shear") {
+        s.erosion.law = sim::ErosionLaw::kShearStress;
+      } else if (*erosion == "force-based") {
+        s.erosion.law = sim::ErosionLaw::kForceBased;
+      } else {
+        throw py::value_error("erosion \"" + *erosion + "\": expected \"shear\", \"force-based\" or None");
+      }
+    }
     s.model.manningN = manningN;
     s.model.cfl = cfl;
     s.model.maxStepS = maxStepS;
@@ -423,6 +468,12 @@ class PySolver {
     return py::make_tuple(arrayOf(v.uMS), arrayOf(v.vMS));
   }
   py::array_t<float> bed() const { return arrayOf(solver_->readBed(), float(solver_->grid().datumM)); }
+  py::list layers() const {
+    py::list out;
+    for (const auto& l : solver_->readLayers()) out.append(arrayOf(l));
+    return out;
+  }
+  py::array_t<float> suspended() const { return arrayOf(solver_->readSuspended()); }
   double timeS() const { return solver_->timeS(); }
   py::dict stats() const {
     const auto st = solver_->stats();
@@ -438,6 +489,11 @@ class PySolver {
     d["infiltrated_m3"] = st.infiltratedM3;
     d["balance_m3"] = st.waterBalanceM3();
     d["max_depth_m"] = st.maxDepthM;
+    d["material_m3"] = st.materialM3;
+    d["initial_material_m3"] = st.initialMaterialM3;
+    d["suspended_m3"] = st.suspendedM3;
+    d["sediment_outflow_m3"] = st.sedimentOutflowM3;
+    d["material_balance_m3"] = st.materialM3 + st.sedimentOutflowM3 - st.initialMaterialM3;
     return d;
   }
   py::tuple geotransform() const {
@@ -500,10 +556,12 @@ PYBIND11_MODULE(_strata, m) {
   py::class_<PySolver>(m, "Solver",
                        "One flood-mode solver over a window of a DEM, stepped from Python (docs/python.md).")
       .def(py::init<const fs::path&, std::optional<std::array<int, 4>>, const std::string&, double, double, double,
-                    const std::vector<std::string>&>(),
+                    const std::vector<std::string>&, const std::vector<LayerSpec>&, const std::optional<std::string>&,
+                    bool>(),
            py::arg("dem"), py::arg("window") = std::nullopt, py::arg("backend") = "cpu", py::arg("manning_n") = 0.035,
            py::arg("cfl") = 0.45, py::arg("max_step_s") = 30.0,
-           py::arg("open_edges") = std::vector<std::string>{"west", "east", "south", "north"})
+           py::arg("open_edges") = std::vector<std::string>{"west", "east", "south", "north"},
+           py::arg("layers") = std::vector<LayerSpec>{}, py::arg("erosion") = std::nullopt, py::arg("thermal") = true)
       .def("set_rain", &PySolver::setRain, py::arg("mm_per_hour"), "Uniform rain from the next step on.")
       .def("set_rain_raster", &PySolver::setRainRaster, py::arg("mm_per_hour"),
            "Rain per cell (an array of the grid's shape, mm/h) from the next step on; None: none.")
@@ -515,9 +573,11 @@ PYBIND11_MODULE(_strata, m) {
       .def("advance", &PySolver::advance, py::arg("seconds"), "Steps until that much more time has passed.")
       .def_property_readonly("depth", &PySolver::depth, "Water depth (m), rows north to south.")
       .def_property_readonly("velocity", &PySolver::velocity, "(u east, v south) in m/s.")
-      .def_property_readonly("bed", &PySolver::bed, "Bed elevation (m).")
+      .def_property_readonly("bed", &PySolver::bed, "Bed elevation (m): the DEM plus the material layers.")
+      .def_property_readonly("layers", &PySolver::layers, "Each layer's thickness (m), bottom first.")
+      .def_property_readonly("suspended", &PySolver::suspended, "Suspended sediment (m of material).")
       .def_property_readonly("time_s", &PySolver::timeS)
-      .def_property_readonly("stats", &PySolver::stats, "The water budget since the start (m3).")
+      .def_property_readonly("stats", &PySolver::stats, "The water and material budgets since the start (m3).")
       .def_property_readonly("geotransform", &PySolver::geotransform)
       .def_property_readonly("crs_wkt", &PySolver::crsWkt)
       .def_property_readonly("backend", &PySolver::backendName);

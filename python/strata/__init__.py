@@ -8,7 +8,8 @@
 
 For step-by-step work, strata.Solver("dem.tif", window=(x, y, w, h), backend="cpu") steps one
 flood-mode solver over a window of a DEM: add_inflow, add_level, set_rain, advance, then depth,
-velocity, bed and stats.
+velocity, bed and stats. layers=[("soil", 2.0), ("sand", 1.0)] lays material on the DEM and
+erosion="shear" (or "force-based") works it: then layers and suspended too.
 
 A refused scenario raises ScenarioError with the command line's message (file, line, key); a
 progress callback that returns False stops the run and raises Cancelled, leaving a folder that
