@@ -9,7 +9,7 @@ processing.run would use it:
 - an inflow layer in another CRS (Web Mercator) reaches the scenario in the DEM's CRS; a cancelled
   run raises, leaves a resumable folder, and RESUME finishes it; a bad field value is refused
   naming the layer, the feature and the field; a dam-break polygon layer and a level line layer
-  reach the scenario with their fields' elevations;
+  reach the scenario with their fields' elevations; a Manning raster layer sets n;
 - Erosion what-if on Mount Rainier gives a styled terrain change with cut and fill;
 - Ingest DEM to store writes a store, and Render picture draws it to a PNG that is not blank;
 - the Flood algorithm runs as a child of a Processing model (the graphical modeller's form).
@@ -189,6 +189,20 @@ at_xy = [-112.1, 36.1]
         check(a.read() == b.read(), "gauges.csv (the gauge named from the layer's field) equals the command line's")
     with open(results["SCENARIO"], "rb") as f:
         check(tomllib.load(f)["water"]["inflow"][0]["name"] == "Colorado", "the run folder's scenario.toml")
+
+    # A Manning raster layer (n = 0.04 everywhere, written here) under a MANNING of 0.2: the map's
+    # n holds wherever it has data, so the answer is the first run's.
+    n_file = os.path.join(work, "manning.tif")
+    n_ds = gdal.GetDriverByName("GTiff").Create(n_file, 64, 48, 1, gdal.GDT_Float32)
+    n_ds.SetGeoTransform([-112.3, 0.005, 0, 36.2, 0, -0.005])
+    n_ds.SetProjection(dem.crs().toWkt())
+    n_ds.GetRasterBand(1).Fill(0.04)
+    n_ds = None
+    manning = QgsRasterLayer(n_file, "manning")
+    results_n = processing.run("strata:flood", dict(params, MANNING=0.2, MANNING_RASTER=manning,
+                                                    OUTPUT=os.path.join(work, "manning")),
+                               context=QgsProcessingContext(), feedback=QgsProcessingFeedback())
+    check(same(values(results_n["MAX_DEPTH"]), depth), "a Manning raster layer of 0.04 gives the 0.04 run's depths")
 
     # The inflow in Web Mercator reaches the scenario in the DEM's CRS; cancel, then resume.
     def web_mercator(p):  # EPSG:3857 on the sphere of radius 6378137 m
