@@ -12,6 +12,8 @@ writes OUT_DIR/qgis_flood_dialog.png and OUT_DIR/qgis_flood_result.png.
 import os
 import sys
 
+os.environ["GDAL_PAM_ENABLED"] = "NO"  # no .aux.xml of the layers' statistics beside the shared DEMs
+
 from qgis.core import (QgsApplication, QgsFeature, QgsGeometry, QgsHillshadeRenderer, QgsLayerTreeModel, QgsPointXY,
                        QgsProcessingContext, QgsProcessingFeedback, QgsProcessingUtils, QgsProject, QgsRasterLayer,
                        QgsVectorLayer)

@@ -24,6 +24,9 @@ import sys
 import tomllib
 
 os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
+# QGIS computes a DEM layer's statistics for its default style, and GDAL would keep them in a
+# .aux.xml beside the shared DEMs (where gdaldem, in another test, would then read them).
+os.environ["GDAL_PAM_ENABLED"] = "NO"
 
 import numpy as np  # noqa: E402
 from osgeo import gdal  # noqa: E402

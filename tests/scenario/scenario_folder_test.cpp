@@ -134,8 +134,11 @@ TEST(RunFolder, ACorruptedCheckpointIsRefused) {
   r = resumeWith("STRATAC1 an old format");
   ASSERT_FALSE(r);
   EXPECT_EQ(r.message(), path.string() + ": not a Strata checkpoint (or one of an older format)");
-  // The scenario changed since.
+  // The scenario changed since (read again, as `strata flood --resume` reads it).
   std::ofstream(s.file, std::ios::app) << "# edited\n";
+  auto edited = loadScenario(s.file);
+  ASSERT_TRUE(edited) << edited.message();
+  s = std::move(edited).value();
   r = resumeWith(good);
   ASSERT_FALSE(r);
   EXPECT_EQ(r.message(), path.string() + ": written by a different scenario (the file changed)");

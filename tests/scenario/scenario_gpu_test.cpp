@@ -203,9 +203,11 @@ TEST_F(GlTest, ResumeRefusesACheckpointOfAnotherScenario) {
   opt.plots = false;
   opt.stopAfterIntervals = 1;
   ASSERT_TRUE(runScenario(scenario, opt));
-  std::ofstream(scenario.file, std::ios::app) << "# edited\n";
+  std::ofstream(scenario.file, std::ios::app) << "# edited\n";  // and read again, as --resume reads it
+  auto edited = loadScenario(scenario.file);
+  ASSERT_TRUE(edited) << edited.message();
   opt.resume = true;
-  auto again = runScenario(scenario, opt);
+  auto again = runScenario(*edited, opt);
   ASSERT_FALSE(again);
   EXPECT_EQ(again.message(),
             (opt.outDir / "checkpoint.bin").string() + ": written by a different scenario (the file changed)");
