@@ -1,7 +1,8 @@
 #pragma once
-// Private: tile files as multi-channel, MIP-mapped, tiled, zip-compressed float32 OpenEXR images
-// held in memory (so the checksum covers exactly the bytes written and read). Keeps OpenEXR's
-// headers out of the public ones.
+// Private: tile files as multi-channel, MIP-mapped, tiled OpenEXR images, each float32 field
+// kept exactly as a PXR24-compressed channel and its low 8 bits (exr_codec.cpp), held in memory
+// (so the checksum covers exactly the bytes written and read). Keeps OpenEXR's headers out of the
+// public ones.
 
 #include <string>
 #include <vector>

@@ -149,7 +149,7 @@ struct StorageFootprint {
   uint64_t denseSamples = 0;    ///< width x height x fields of the base grid
   uint64_t storedSamples = 0;   ///< over present tiles: samples (finest level) covering the grid, x fields
   uint64_t storedWithMips = 0;  ///< the same with each tile's mip chain
-  uint64_t fileBytes = 0;       ///< tile files on disk (zip compressed)
+  uint64_t fileBytes = 0;       ///< tile files on disk (compressed)
   double savedFraction() const { return denseSamples ? 1.0 - double(storedSamples) / double(denseSamples) : 0.0; }
 };
 
