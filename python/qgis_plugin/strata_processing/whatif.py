@@ -90,6 +90,11 @@ class _WhatIf(QgsProcessingAlgorithm):
         self.addOutput(QgsProcessingOutputFile("REPORT", "Report (Markdown)"))
         self.addOutput(QgsProcessingOutputFile("SCENARIO", "Scenario (TOML, for `strata flood`)"))
 
+    def layerName(self, parameters, key, context):
+        """The name of the layer behind a vector parameter, for messages."""
+        layer = self.parameterAsVectorLayer(parameters, key, context)
+        return layer.name() if layer is not None else key.lower()
+
     # --- the scenario -------------------------------------------------------------------------------
 
     def baseScenario(self, parameters, context, dem):
@@ -128,8 +133,6 @@ class _WhatIf(QgsProcessingAlgorithm):
         source = self.parameterAsSource(parameters, "INFLOWS", context)
         if source is None:
             return
-        layer = parameters.get("INFLOWS")
-        layer_name = getattr(layer, "name", lambda: str(layer))() if not isinstance(layer, str) else layer
         field = self.parameterAsString(parameters, "INFLOW_PEAK_FIELD", context)
         default_peak = self.parameterAsDouble(parameters, "PEAK", context)
         matrix = self.parameterAsMatrix(parameters, "HYDROGRAPH", context)
@@ -138,7 +141,8 @@ class _WhatIf(QgsProcessingAlgorithm):
         shape = [(number(matrix[i], f"Hydrograph row {i // 2 + 1}: time"),
                   number(matrix[i + 1], f"Hydrograph row {i // 2 + 1}: fraction")) for i in range(0, len(matrix), 2)]
         inflows = []
-        for i, f in enumerate(features(source, layer_name, dem.crs(), context, ["line", "point"])):
+        for i, f in enumerate(features(source, self.layerName(parameters, "INFLOWS", context), dem.crs(), context,
+                                       ["line", "point"])):
             peak = f.value(field, "peak discharge") if field else default_peak
             inflows.append({"name": feature_name(f, None, f"inflow {i + 1}"), f.key: f.coords,
                             "hydrograph": [[t, frac * peak] for t, frac in shape], "hydrograph_units": ["h", "m3/s"]})
@@ -257,7 +261,8 @@ class FloodAlgorithm(_WhatIf):
                 raise QgsProcessingException(f"{what.capitalize()}s given: name the field with their water surface "
                                              f"elevation ({field_param})")
             entries = []
-            for i, f in enumerate(features(source, kind.lower(), dem.crs(), context, kinds)):
+            for i, f in enumerate(features(source, self.layerName(parameters, kind, context), dem.crs(), context,
+                                           kinds)):
                 z = f.value(field, "water surface elevation")
                 if kind == "LEVELS":
                     entries.append({"name": feature_name(f, None, f"level {i + 1}"), f.key: f.coords,
@@ -269,7 +274,8 @@ class FloodAlgorithm(_WhatIf):
         gauges = self.parameterAsSource(parameters, "GAUGES", context)
         name_field = self.parameterAsString(parameters, "GAUGE_NAME_FIELD", context)
         gauge_list = [{"name": feature_name(f, name_field, f"gauge {i + 1}"), "at_xy": f.coords}
-                      for i, f in enumerate(features(gauges, "gauges", dem.crs(), context, ["point"]))]
+                      for i, f in enumerate(features(gauges, self.layerName(parameters, "GAUGES", context), dem.crs(),
+                                                     context, ["point"]))]
         if gauge_list:
             d["outputs"]["gauge"] = gauge_list
         d["outputs"]["maps"] = ["max_depth", "max_speed", "arrival_time", "inundation_duration", "final_depth",
