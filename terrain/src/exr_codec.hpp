@@ -19,6 +19,22 @@ namespace strata::terrain::detail {
 std::vector<char> encodeTileExr(const std::vector<std::string>& channels,
                                 const std::vector<std::vector<gis::Grid<float>>>& levels, const std::string& tag);
 
+/// While one lives, encodeTileExr compresses a tile's EXR tiles on OpenEXR's global thread pool,
+/// one thread per core (PXR24 runs zlib at its default level: an ingest's main cost). The pool is
+/// emptied again when it dies, so no pool thread outlives the work (they would not survive a
+/// fork(): a forked child that encodes would wait for them forever). Does nothing where the pool
+/// already has threads (another user set them).
+class EncodeThreads {
+ public:
+  EncodeThreads();
+  ~EncodeThreads();
+  EncodeThreads(const EncodeThreads&) = delete;
+  EncodeThreads& operator=(const EncodeThreads&) = delete;
+
+ private:
+  bool started_ = false;
+};
+
 /// The "strata:tile" attribute of a tile file (empty when it has none).
 Result<std::string> decodeTileExrTag(const std::string& name, const std::vector<char>& bytes);
 

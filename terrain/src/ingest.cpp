@@ -9,6 +9,8 @@
 #include <strata/core/log.hpp>
 #include <strata/core/progress.hpp>
 
+#include "exr_codec.hpp"
+
 namespace strata::terrain {
 
 namespace {
@@ -91,6 +93,7 @@ std::string difference(const StoreDesc& have, const StoreDesc& want, const Build
 Result<IngestReport> ingest(const fs::path& dir, const gis::Georef& georef, const std::vector<IngestSource>& sources,
                             const IngestOptions& options) {
   const auto start = Clock::now();
+  const detail::EncodeThreads threads;  // tiles compressed on every core while the ingest runs
   if (options.commitEveryTiles < 1 || !(options.commitEverySeconds > 0)) {
     return fail("ingest: checkpoints need commitEveryTiles >= 1 and commitEverySeconds > 0");
   }
