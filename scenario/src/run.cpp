@@ -40,13 +40,6 @@ namespace fs = std::filesystem;
 using detail::Ranks;
 namespace {
 
-std::string slurp(const fs::path& p) {
-  std::ifstream f(p, std::ios::binary);
-  std::stringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
-
 // The net change of material thickness at cell i of a piece (m): the layers summed in float,
 // bottom first, now less at the start.
 float materialChange(const detail::Piece& p, size_t i) {
@@ -1035,7 +1028,7 @@ class Session {
       STRATA_TRY(domain_, scenario::buildDomain(s_, opt_.memoryBudgetBytes));
     }
     STRATA_TRY_STATUS(takeFolder());
-    scenarioText_ = ranks_.fromLead(ranks_.lead() ? (s_.text.empty() ? slurp(s_.file) : s_.text) : std::string());
+    scenarioText_ = ranks_.fromLead(ranks_.lead() ? s_.text : std::string());
     // The bed the model uses (conditioned), written once the domain is built: a map for the GIS
     // user, and what pictures and plots draw.
     if (rows) {

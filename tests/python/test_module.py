@@ -83,8 +83,9 @@ def check_erosion_solver(source, work):
               f"{backend}: the sand moves (cut {changes[backend].min():.2f} m, fill {changes[backend].max():.2f} m)")
     diff = float(np.abs(changes["cpu"] - changes["gpu"]).max())
     check(diff < 1e-3, f"GL's layers agree with the CPU's to {diff:.1e} m")
-    c0, c1, r0, r1 = (-122.00041666666667 + (x0 + 0.25) * 1 / 1200, -122.00041666666667 + (x0 + w - 0.25) / 1200,
-                      47.000416666666666 - (y0 + h - 0.25) / 1200, 47.000416666666666 - (y0 + 0.25) / 1200)
+    gt = strata.read_map(dem)["geotransform"]  # north-up: x = gt[0] + col gt[1], y = gt[3] + row gt[5]
+    c0, c1 = gt[0] + (x0 + 0.25) * gt[1], gt[0] + (x0 + w - 0.25) * gt[1]
+    r0, r1 = gt[3] + (y0 + h - 0.25) * gt[5], gt[3] + (y0 + 0.25) * gt[5]
     d = {"terrain": {"dem": dem, "layer": [{"material": "soil", "thickness": "2 m"},
                                            {"material": "sand", "thickness": "1 m"}]},
          "region": {"bbox_xy": [c0, r0, c1, r1]},  # the window's cells (their centres inside)

@@ -27,7 +27,7 @@ class _WhatIf(QgsProcessingAlgorithm):
     """What both what-ifs take (a DEM, a region, inflows, roughness, time, the run folder) and do
     (build the scenario, run it with progress and cancel, return the maps)."""
 
-    map_outputs = {}  # output name -> map name, per algorithm
+    maps = {}  # output name -> map name, per algorithm
 
     def createInstance(self):  # noqa: N802 (QGIS's names from here on)
         return type(self)()
@@ -83,7 +83,7 @@ class _WhatIf(QgsProcessingAlgorithm):
         self.addParameter(_advanced(QgsProcessingParameterBoolean(
             "OVERWRITE", "Replace an earlier run in the folder", False)))
         self.addParameter(QgsProcessingParameterFolderDestination("OUTPUT", "Run folder"))
-        for output, name in self.map_outputs.items():
+        for output, name in self.maps.items():
             title = name.replace("_", " ").capitalize()
             self.addOutput(QgsProcessingOutputVectorLayer(output, title) if name == "flood_outline"
                            else QgsProcessingOutputRasterLayer(output, title))
@@ -191,12 +191,12 @@ class _WhatIf(QgsProcessingAlgorithm):
             raise QgsProcessingException(str(e)) from None
         feedback.pushInfo(f"{run!r}: {run.steps} steps in {run.wall_s:.1f} s")
         results = {"OUTPUT": folder, "REPORT": os.path.join(folder, "report.md"), "SCENARIO": scenario_file}
-        results.update(map_outputs(folder, self.map_outputs, context, self.displayName() + ":"))
+        results.update(map_outputs(folder, self.maps, context, self.displayName() + ":"))
         return results
 
 
 class FloodAlgorithm(_WhatIf):
-    map_outputs = {"MAX_DEPTH": "max_depth", "MAX_SPEED": "max_speed", "ARRIVAL_TIME": "arrival_time",
+    maps = {"MAX_DEPTH": "max_depth", "MAX_SPEED": "max_speed", "ARRIVAL_TIME": "arrival_time",
                    "HAZARD_RATING": "hazard_rating", "FLOOD_OUTLINE": "flood_outline"}
 
     def name(self):
@@ -289,7 +289,7 @@ class FloodAlgorithm(_WhatIf):
 
 
 class ErosionAlgorithm(_WhatIf):
-    map_outputs = {"TERRAIN_CHANGE": "terrain_change", "EXPOSED_MATERIAL": "exposed_material",
+    maps = {"TERRAIN_CHANGE": "terrain_change", "EXPOSED_MATERIAL": "exposed_material",
                    "MAX_DEPTH": "max_depth", "SUSPENDED_SEDIMENT": "suspended_sediment"}
 
     def name(self):

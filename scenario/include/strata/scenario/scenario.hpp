@@ -97,9 +97,9 @@ struct LayerSpec {
 
 struct Scenario {
   std::filesystem::path file;  ///< the scenario file; relative paths inside are relative to it
-  /// The TOML text it was read from (parseScenario): a run writes it to its folder as
-  /// scenario.toml and ties its checkpoints to it. A scenario given as text (the Python module's
-  /// dicts) has no file of its own.
+  /// The TOML text it was read from (parseScenario, which every run's scenario comes through): a
+  /// run writes it to its folder as scenario.toml and ties its checkpoints to it. A scenario
+  /// given as text (the Python module's dicts) has no file of its own to copy.
   std::string text;
   std::string name, description;
   /// The line of every key read ("region.cell_size", "water.inflow[0].hydrograph"; a table's
