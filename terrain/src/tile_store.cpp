@@ -116,11 +116,27 @@ Result<std::vector<Grid<float>>> TileStore::Impl::loadFull(int tx, int ty) {
 }
 
 Status TileStore::Impl::store(int tx, int ty, Fit f) {
+  // The mip chain: box means of the level before. A field whose samples are whole numbers (an
+  // integer DEM's: SRTM, ETOPO, MOLA) has its means rounded to whole numbers, as GDAL's overviews
+  // of an integer raster are (each within 0.5 of the exact mean): the tile then stores as integers
+  // (exr_codec.cpp), where the exact means would carry two more fractional bits each level.
+  std::vector<bool> whole;
+  for (const auto& g : f.samples) {
+    whole.push_back(
+        std::all_of(g.data.begin(), g.data.end(), [](float v) { return std::isnan(v) || v == std::nearbyint(v); }));
+  }
+  std::vector<Grid<float>> exact = f.samples;
   std::vector<std::vector<Grid<float>>> levels;
   levels.push_back(std::move(f.samples));
   while (levels.back()[0].width > 1) {
     std::vector<Grid<float>> next;
-    for (const auto& g : levels.back()) next.push_back(boxDownsample(g, 2));
+    for (size_t c = 0; c < exact.size(); ++c) {
+      exact[c] = boxDownsample(exact[c], 2);
+      next.push_back(exact[c]);
+      if (whole[c]) {
+        for (float& v : next.back().data) v = std::nearbyint(v);
+      }
+    }
     levels.push_back(std::move(next));
   }
   const auto bytes = detail::encodeTileExr(fieldNames, levels, tileTag(tx, ty, f.exp));

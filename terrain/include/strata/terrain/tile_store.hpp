@@ -8,7 +8,9 @@
 // Grids and levels: the store's base grid (level 0) is georef.width x georef.height cells. A tile
 // covers footprint() = 2^maxExp base cells a side; level L has cells 2^L base cells wide, so a tile
 // spans footprint() >> L level-L cells. A tile of exponent e stores 2^e x 2^e samples per field
-// (box means of the base cells; e = maxExp is the base grid itself) plus its mip chain down to 1x1.
+// (box means of the base cells; e = maxExp is the base grid itself) plus its mip chain down to 1x1
+// (box means of the level before; rounded to whole numbers where the samples are whole numbers,
+// as GDAL's overviews of an integer raster are).
 // A base-grid read of a tile repeats each sample over its block (piecewise constant): that is the
 // reconstruction the error bound is measured on.
 
