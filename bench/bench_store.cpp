@@ -3,6 +3,11 @@
 //
 //   build/bench/strata_bench_store [--size 32768] [--dir /tmp/strata-bench-store] [--no-gdal]
 //   build/bench/strata_bench_store --striped 16384 [--dir DIR]
+//   build/bench/strata_bench_store --reads STORE
+//
+// --reads STORE: cold reads of whole tiles at levels 0, 1 and 2 (the cache cleared before each),
+// every full-resolution tile of the store in turn, three rounds: the best round's mean ms per
+// tile and the store's bytes per stored sample.
 //
 // --striped N: the ingest benchmark. A real-relief N x N striped GeoTIFF (Mount Rainier's
 // SRTM tile resampled by gdalwarp -r cubic, float32, DEFLATE, one row a strip) is made in DIR;
@@ -179,6 +184,39 @@ std::pair<int, long> checkRoughTiles(const fs::path& store) {
   return {tiles, bad};
 }
 
+// --reads STORE (see the top).
+int readsBenchmark(const fs::path& path) {
+  auto store = TileStore::open(path, {.budgetBytes = size_t(256) << 20, .prefetch = false});
+  if (!store) die(store.message());
+  const int fp = store->footprint();
+  std::vector<std::pair<int, int>> tiles;
+  for (int ty = 0; ty < store->tilesY(); ++ty) {
+    for (int tx = 0; tx < store->tilesX(); ++tx) {
+      if (store->tile(tx, ty).present && store->tile(tx, ty).exp == store->desc().metric.maxExp)
+        tiles.push_back({tx, ty});
+    }
+  }
+  if (tiles.empty()) die(path.string() + ": no full-resolution tile");
+  std::printf("{\"store\": \"%s\", \"tiles\": %zu", path.c_str(), tiles.size());
+  for (int level : {0, 1, 2}) {
+    double best = 1e300;
+    for (int round = 0; round < 3; ++round) {
+      auto t0 = Clock::now();
+      for (auto [tx, ty] : tiles) {
+        store->clearCache();
+        const int side = fp >> level;
+        if (!store->readWindow(0, {tx * side, ty * side, side, side}, level)) die("read failed");
+      }
+      best = std::min(best, since(t0) * 1e3 / double(tiles.size()));
+    }
+    std::printf(", \"level%d_ms_per_tile\": %.2f", level, best);
+  }
+  uint64_t bytes = 0;
+  for (const auto& e : fs::directory_iterator(path / "tiles")) bytes += e.file_size();
+  std::printf(", \"tile_bytes\": %llu}\n", static_cast<unsigned long long>(bytes));
+  return 0;
+}
+
 int main(int argc, char** argv) {
   int n = 32768;
   fs::path dir = fs::temp_directory_path() / "strata-bench-store";
@@ -194,12 +232,15 @@ int main(int argc, char** argv) {
       dir = argv[++i];
     } else if (a == "--no-gdal") {
       gdal = false;
+    } else if (a == "--reads" && i + 1 < argc) {
+      return readsBenchmark(argv[++i]);
     } else if (a == "--check" && i + 1 < argc) {
       const auto [tiles, bad] = checkRoughTiles(argv[++i]);
       std::printf("{\"rough_tiles_checked\": %d, \"mismatching_cells\": %ld}\n", tiles, bad);
       return bad ? 1 : 0;
     } else {
-      die("unknown argument '" + a + "' (use --size N, --dir DIR, --no-gdal, --striped N, or --check STORE)");
+      die("unknown argument '" + a +
+          "' (use --size N, --dir DIR, --no-gdal, --striped N, --reads STORE, or --check STORE)");
     }
   }
   if (striped) {
