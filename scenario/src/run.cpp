@@ -1252,23 +1252,28 @@ class Session {
     FloodSummary flood = run_->floodSummary(*pieces);
     STRATA_TRY_STATUS(ranks_.agree(run_->addPonding(*pieces, flood)));
     if (!ranks_.lead()) return summary_;  // the lead writes the styles, plots and the report
-    std::vector<std::string> written;
+    std::vector<std::string> written;     // the maps
     for (const auto& f : summary_.files) {
-      if (!f.starts_with("maps/")) continue;
-      written.push_back(f);
-      // The run's maps as Cloud Optimized GeoTIFFs (overviews: a GIS pans a large one quickly);
-      // written window by window during the run, rewritten once here.
-      if (f.ends_with(".tif")) STRATA_TRY_STATUS(gis::rewriteAsCog((opt_.outDir / f).string()));
+      if (f.starts_with("maps/")) written.push_back(f);
     }
     STRATA_TRY(auto styles, detail::writeMapStyles(opt_.outDir, written, s_.outputs.wetThresholdM));
     summary_.files.insert(summary_.files.end(), styles.begin(), styles.end());
-    if (opt_.plots) {
-      STRATA_TRY(auto plots, writePlots(opt_.outDir, !summary_.series.empty()));
-      summary_.files.insert(summary_.files.end(), plots.begin(), plots.end());
-    }
+    // The report before the slow parts (plots, the maps' COG copies): the ranks of a run that
+    // mpirun stops are killed about a second after they are told to stop (Open MPI sends SIGTERM,
+    // then SIGKILL), and the report says where the run stands. Written again with the plots.
     const ReportInput report{s_, run_->domain(), summary_, flood, run_->backendName(), pictureFiles, maxDepthLegend()};
     for (const auto& w : runWarnings(report)) log::warn(opt_.command) << w;
     STRATA_TRY_STATUS(writeReport(opt_.outDir, report));
+    if (opt_.plots) {
+      STRATA_TRY(auto plots, writePlots(opt_.outDir, !summary_.series.empty()));
+      summary_.files.insert(summary_.files.end(), plots.begin(), plots.end());
+      STRATA_TRY_STATUS(writeReport(opt_.outDir, report));
+    }
+    // The run's maps as Cloud Optimized GeoTIFFs (overviews: a GIS pans a large one quickly);
+    // written window by window during the run, rewritten once here.
+    for (const auto& f : written) {
+      if (f.ends_with(".tif")) STRATA_TRY_STATUS(gis::rewriteAsCog((opt_.outDir / f).string()));
+    }
     summary_.files.push_back("report.md");
     return summary_;
   }

@@ -195,6 +195,51 @@ TEST(StrataCli, AFloodRunsOverMpiRanks) {
   EXPECT_EQ(count("strata: only `strata flood` and `strata erode` run over MPI ranks (2 ranks given)"), 1u) << out;
 }
 
+// Issue 33: Ctrl-C to `mpirun` left no report. Open MPI's mpirun answers a Ctrl-C (or SIGTERM)
+// by sending the ranks SIGTERM and, a second later, SIGKILL, and exits 1 whatever the ranks do
+// (orterun's abort path; `mpirun sh -c 'exit 130'` exits 130, the same interrupted exits 1). The
+// ranks stop after the step they are in and the lead writes the report before the plots (a
+// second and more of matplotlib, which the SIGKILL cut short: no report before); the folder
+// resumes.
+TEST(StrataCli, CtrlCToMpirunLeavesTheStoppedRunsReport) {
+  const auto dir = strata::test::tempDir("cli-mpi-ctrl-c");
+  std::string text = damBreakText();
+  text.replace(text.find("cell_size = \"600 m\""), 19, "cell_size = \"60 m\"");  // ~5 s of stepping
+  text.replace(text.find("output_interval = \"5 min\""), 25, "output_interval = \"1 min\"");
+  text.replace(text.find("kind = \"flood\""), 14, "kind = \"flood\"\nbackend = \"cpu\"");
+  std::ofstream(dir / "dam.toml") << text;
+  const pid_t pid =
+      spawn({"flood", "dam.toml", "-o", "run", "--no-pictures"}, dir, dir / "run.log", 0, mpiEnv(), mpirun(2));
+  // Two intervals closed (the series has a header and a row per interval).
+  ASSERT_TRUE(waitUntil([&] { return readCsv(dir / "run" / "series.csv").size() >= 2; }, 120))
+      << slurp(dir / "run.log");
+  ASSERT_EQ(::kill(-pid, SIGINT), 0);  // what the terminal does: mpirun's foreground group
+  const int code = waitFor(pid);
+  const std::string log = slurp(dir / "run.log");
+  EXPECT_EQ(code, 1) << log;  // Open MPI's, see above
+  EXPECT_NE(log.find("stopping after this interval"), std::string::npos) << log;
+  const std::string report = slurp(dir / "run" / "report.md");
+  EXPECT_NE(report.find("The run was stopped before the end"), std::string::npos) << log;
+  EXPECT_NE(report.find("on 2 MPI ranks"), std::string::npos) << report;
+  // The plotting child (its own process group) may outlive the killed lead: wait until no
+  // process names the run folder, so that it does not write beside the resume.
+  const std::string folder = (dir / "run").string();
+  auto plotting = [&] {
+    for (const auto& e : fs::directory_iterator("/proc")) {
+      if (slurp(e.path() / "cmdline").find(folder) != std::string::npos) return true;
+    }
+    return false;
+  };
+  EXPECT_TRUE(waitUntil([&] { return !plotting(); }, 60));
+  std::string out;
+  EXPECT_EQ(strata({"flood", "dam.toml", "-o", "run", "--resume", "--no-pictures", "--no-plots"}, dir, out, 0, mpiEnv(),
+                   mpirun(2)),
+            0)
+      << out;
+  EXPECT_NE(out.find("resuming at"), std::string::npos) << out;
+  EXPECT_EQ(slurp(dir / "run" / "report.md").find("stopped before the end"), std::string::npos);
+}
+
 // Issue 33: a FIFO named as an input (a DEM to describe, a drape, a scenario's DEM, the scenario
 // itself) is refused at once in one line naming it; opening it would wait for a writer forever.
 TEST(StrataCli, AFifoGivenAsAnInputIsRefusedAtOnce) {
