@@ -1,5 +1,6 @@
 #include <strata/render/gpu_tile_cache.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -48,15 +49,12 @@ Result<int> GpuTileCache::acquire(const PageKey& key, bool wait) {
     if (!ready) return -1;  // requested; counted as a miss when it is uploaded
     grid = std::move(*ready);
   }
-  ++stats_.misses;
   STRATA_CHECK(grid.width == p && grid.height == p) << "readWindow returned " << grid.width << "x" << grid.height;
-  if (options_.noDataFill) {
-    for (int y = 0; y < p; ++y) {
-      for (int x = 0; x < p; ++x) {
-        if (float& v = grid.at(x, y); std::isnan(v)) v = options_.noDataFill(key, x, y);
-      }
-    }
+  if (options_.fillVoids && std::any_of(grid.data.begin(), grid.data.end(), [](float v) { return std::isnan(v); })) {
+    STRATA_TRY(const bool filled, options_.fillVoids(key, grid, wait));
+    if (!filled) return -1;  // its neighbours requested
   }
+  ++stats_.misses;
   int layer = 0;
   if (freeLayers_.empty()) {
     const PageKey victim = lru_.back();

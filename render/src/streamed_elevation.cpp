@@ -62,10 +62,10 @@ Result<std::unique_ptr<StreamedElevation>> StreamedElevation::create(strata::ter
   s->coarse_ = c;
   const int cw = st.levelWidth(c), ch = st.levelHeight(c);
   STRATA_TRY(auto coarse, st.readWindow(field, {0, 0, cw, ch}, c));
-  // Voids of the coarse level filled from the cells around them, not pits. A streamed page has
-  // no neighbours to fill from: its voids take the filled coarse level's surface there
-  // (voidFill; docs/render-rings.md, "Voids"), as the whole-DEM render's filled surface would
-  // be seen from afar, never the lowest elevation (shafts down to it).
+  // Voids of the coarse level filled from the cells around them, not pits. A streamed page's
+  // voids are filled the same way from the page and a margin around it (fillPage); what that
+  // cannot reach takes the filled coarse level's surface (voidFill; docs/render-rings.md,
+  // "Voids"), never the lowest elevation (shafts down to it).
   STRATA_TRY(const size_t filled, gis::fillVoids(coarse));
   (void)filled;
   s->coarseCpu_ = std::move(coarse);
@@ -95,12 +95,12 @@ Result<std::unique_ptr<StreamedElevation>> StreamedElevation::create(strata::ter
     return fail(where + "GPU budget of " + std::to_string(params.gpuBudgetBytes) + " bytes is below the stack's " +
                 std::to_string(fixed) + " bytes plus one " + std::to_string(page) + "-byte page");
   }
-  STRATA_TRY(auto cache, GpuTileCache::create(st, {.pageSize = p,
-                                                   .budgetBytes = params.gpuBudgetBytes - fixed,
-                                                   .noDataFill = [raw = s.get(), p](const PageKey& key, int x, int y) {
-                                                     return raw->voidFill((key.x * p + x + 0.5) * double(1 << key.lod),
-                                                                          (key.y * p + y + 0.5) * double(1 << key.lod));
-                                                   }}));
+  STRATA_TRY(auto cache, GpuTileCache::create(
+                             st, {.pageSize = p,
+                                  .budgetBytes = params.gpuBudgetBytes - fixed,
+                                  .fillVoids = [raw = s.get()](const PageKey& key, gis::Grid<float>& page, bool wait) {
+                                    return raw->fillPage(key, page, wait);
+                                  }}));
   s->cache_ = std::make_unique<GpuTileCache>(std::move(cache));
   s->stats_.gpuBudgetBytes = params.gpuBudgetBytes;
   return s;
@@ -206,6 +206,52 @@ Status StreamedElevation::update(glm::dvec2 cell) {
     flagsDirty_ = false;
   }
   return {};
+}
+
+Result<bool> StreamedElevation::fillPage(const PageKey& key, gis::Grid<float>& page, bool wait) {
+  // The page with a margin of a page on each side, within the level on a planar store (outside
+  // it there is nothing to fill from; a global store's reads wrap): GDAL's fill there, as the
+  // whole-DEM render fills the whole grid (gis::fillVoids), gives a void the same surface
+  // wherever its nearest cells are within the margin.
+  const int p = page.width, lw = store_->levelWidth(key.lod), lh = store_->levelHeight(key.lod);
+  int x0 = key.x * p - p, y0 = key.y * p - p, x1 = key.x * p + 2 * p, y1 = key.y * p + 2 * p;
+  if (!wrapX_) x0 = std::max(x0, 0), y0 = std::max(y0, 0), x1 = std::min(x1, lw), y1 = std::min(y1, lh);
+  const auto inside = [&](int x, int y) {  // texel (x, y) of the page inside the margin's window
+    const int gx = key.x * p + x, gy = key.y * p + y;
+    return gx >= x0 && gx < x1 && gy >= y0 && gy < y1;
+  };
+  bool voidInside = false;
+  for (int y = 0; y < p && !voidInside; ++y) {
+    for (int x = 0; x < p && !voidInside; ++x) voidInside = std::isnan(page.at(x, y)) && inside(x, y);
+  }
+  if (voidInside) {
+    const gis::CellRect window{x0, y0, x1 - x0, y1 - y0};
+    std::optional<gis::Grid<float>> around;
+    if (wait) {
+      STRATA_TRY(around, store_->readWindow(key.field, window, key.lod));
+    } else {
+      STRATA_TRY(around, store_->tryReadWindow(key.field, window, key.lod));
+      if (!around) return false;
+    }
+    const bool anyData = std::any_of(around->data.begin(), around->data.end(), [](float v) { return !std::isnan(v); });
+    if (anyData) {
+      STRATA_TRY_STATUS(gis::fillVoids(*around));
+      for (int y = 0; y < p; ++y) {
+        for (int x = 0; x < p; ++x) {
+          if (std::isnan(page.at(x, y)) && inside(x, y))
+            page.at(x, y) = around->at(key.x * p + x - x0, key.y * p + y - y0);
+        }
+      }
+    }
+  }
+  for (int y = 0; y < p; ++y) {  // outside the level, or no data around: the coarse surface
+    for (int x = 0; x < p; ++x) {
+      if (float& v = page.at(x, y); std::isnan(v)) {
+        v = voidFill((key.x * p + x + 0.5) * double(1 << key.lod), (key.y * p + y + 0.5) * double(1 << key.lod));
+      }
+    }
+  }
+  return true;
 }
 
 float StreamedElevation::voidFill(double x, double y) const {

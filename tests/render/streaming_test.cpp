@@ -321,13 +321,15 @@ TEST_F(GlTest, StreamedVoidsAreDrawnAsTheWholeDemDrawsThem) {
       << "\ncolour_fraction_over_8 " << d.colourFraction << "\nelev_mean_m " << d.elevMeanM << "\nelev_p99_m "
       << d.elevP99M << "\nelev_max_m " << d.elevMaxM << "\n";
   ASSERT_TRUE(render::writeImage8((test::outputDir("render") / "streaming_voids.png").string(), w, h, 4, picture));
-  // Measured on llvmpipe: 1.1 % of pixels off by more than 8, elevation mean 1.3 m, 99th
-  // percentile 36 m (the coarse level's fill against GDAL's fill of the full-resolution grid,
-  // over the voids); drawn with the lowest elevation before: 5.0 %, 13.5 m and 362 m, a pit
-  // in the picture.
-  EXPECT_LT(d.colourFraction, 0.02);
-  EXPECT_LT(d.elevMeanM, 3.0);
-  EXPECT_LT(d.elevP99M, 60.0);
+  // Measured on llvmpipe: 0.29 % of pixels off by more than 8, elevation mean 0.69 m, 99th
+  // percentile 17 m (a streamed page's voids filled by GDAL from the page and a page-wide margin,
+  // as the whole-DEM render fills its grid; the rest is the levels' box means over the voids'
+  // edges). With the coarse level's surface over a page's voids: 1.1 %, 1.3 m and 36 m; with the
+  // lowest elevation before that: 5.0 %, 13.5 m and 362 m, a pit in the picture. Issue 33 asks
+  // for under 1 % of pixels.
+  EXPECT_LT(d.colourFraction, 0.01);
+  EXPECT_LT(d.elevMeanM, 1.0);
+  EXPECT_LT(d.elevP99M, 25.0);
 }
 
 // A drape, cast shadows and a graticule on a streamed scene (the drape over the whole terrain,

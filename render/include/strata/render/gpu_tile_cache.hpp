@@ -19,6 +19,7 @@
 #include <vector>
 
 #include <strata/core/result.hpp>
+#include <strata/gis/raster.hpp>
 #include <strata/gl/objects.hpp>
 
 namespace strata::terrain {
@@ -37,9 +38,10 @@ struct PageKey {
 struct GpuCacheOptions {
   int pageSize = 64;                      ///< P: texels a page side (a power of two, 8..1024)
   size_t budgetBytes = size_t(32) << 20;  ///< GPU bytes of the page array; capacity = budget / (P^2 * 4)
-  /// NaN samples of a page replaced on upload by noDataFill(key, x, y), (x, y) the texel in the
-  /// page (unset: NaN kept).
-  std::function<float(const PageKey&, int, int)> noDataFill;
+  /// Fills the NaN samples of a page (p x p, read at the key's level) before it is uploaded;
+  /// `wait` as acquire's. Returns false when it needs samples not in RAM yet (wait false: asked
+  /// for; acquire then answers -1 and the page is read again later). Unset: NaN kept.
+  std::function<Result<bool>(const PageKey&, gis::Grid<float>&, bool wait)> fillVoids;
 };
 
 /// Lookups and traffic since creation (or resetStats()).

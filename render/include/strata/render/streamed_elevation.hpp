@@ -92,6 +92,10 @@ class StreamedElevation {
   /// The elevation a void takes at base-cell coordinates (x, y) (cell (i, j) spans [i, i+1)):
   /// the filled coarse level, bilinear (its voids filled from the cells around them).
   float voidFill(double x, double y) const;
+  /// Fills a page's voids from the page and a page-wide margin around it, as the whole-DEM
+  /// render fills its grid (GDAL's fill); texels outside the level, or with no data around,
+  /// take voidFill. False (wait false) while the margin's tiles are being read.
+  Result<bool> fillPage(const PageKey& key, gis::Grid<float>& page, bool wait);
   float maxElevationM() const { return maxM_; }
   /// The four base-grid samples (i, j), (i+1, j), (i, j+1), (i+1, j+1), NaN filled with the
   /// minimum, through the store's RAM cache (the coarse level's samples if a tile cannot be read,
