@@ -88,6 +88,16 @@ void writeCpuScenario(const fs::path& dir) {
   std::ofstream(dir / "flood.toml") << text;
 }
 
+// The dam break at 60 m cells on the CPU (~5 s of stepping), an output every `interval`
+// ("1 min", "20 min"), as dir/dam.toml.
+void writeLongDamBreak(const fs::path& dir, const std::string& interval) {
+  std::string text = damBreakText();
+  text.replace(text.find("cell_size = \"600 m\""), 19, "cell_size = \"60 m\"");
+  text.replace(text.find("output_interval = \"5 min\""), 25, "output_interval = \"" + interval + "\"");
+  text.replace(text.find("kind = \"flood\""), 14, "kind = \"flood\"\nbackend = \"cpu\"");
+  std::ofstream(dir / "dam.toml") << text;
+}
+
 // Issue 31: `strata check SCENARIO` prints every problem of the file in one pass, in file order,
 // each with its line and key (a raster path included), and exits 1; a good file exits 0. A key
 // spelt one letter off ("duraton") is reported once, and read on as the key it meant.
@@ -203,11 +213,7 @@ TEST(StrataCli, AFloodRunsOverMpiRanks) {
 // resumes.
 TEST(StrataCli, CtrlCToMpirunLeavesTheStoppedRunsReport) {
   const auto dir = strata::test::tempDir("cli-mpi-ctrl-c");
-  std::string text = damBreakText();
-  text.replace(text.find("cell_size = \"600 m\""), 19, "cell_size = \"60 m\"");  // ~5 s of stepping
-  text.replace(text.find("output_interval = \"5 min\""), 25, "output_interval = \"1 min\"");
-  text.replace(text.find("kind = \"flood\""), 14, "kind = \"flood\"\nbackend = \"cpu\"");
-  std::ofstream(dir / "dam.toml") << text;
+  writeLongDamBreak(dir, "1 min");
   const pid_t pid =
       spawn({"flood", "dam.toml", "-o", "run", "--no-pictures"}, dir, dir / "run.log", 0, mpiEnv(), mpirun(2));
   // Two intervals closed (the series has a header and a row per interval).
@@ -339,11 +345,7 @@ TEST(StrataCli, CtrlCWhilePlotsAreDrawnKeepsTheReport) {
 // starts: the report is written, marked stopped, and --resume runs it to the end.
 TEST(StrataCli, CtrlCBeforeTheFirstOutputLeavesAResumableRun) {
   const auto dir = strata::test::tempDir("cli-ctrl-c-early");
-  std::string text = damBreakText();
-  text.replace(text.find("cell_size = \"600 m\""), 19, "cell_size = \"60 m\"");  // ~5 s of stepping
-  text.replace(text.find("output_interval = \"5 min\""), 25, "output_interval = \"20 min\"");
-  text.replace(text.find("kind = \"flood\""), 14, "kind = \"flood\"\nbackend = \"cpu\"");
-  std::ofstream(dir / "dam.toml") << text;
+  writeLongDamBreak(dir, "20 min");
   const pid_t pid = spawn({"flood", "dam.toml", "-o", "run", "--no-pictures"}, dir, dir / "run.log");
   ASSERT_TRUE(waitUntil([&] { return slurp(dir / "run.log").find("running on") != std::string::npos; }, 120))
       << slurp(dir / "run.log");
