@@ -95,12 +95,13 @@ Result<std::unique_ptr<StreamedElevation>> StreamedElevation::create(strata::ter
     return fail(where + "GPU budget of " + std::to_string(params.gpuBudgetBytes) + " bytes is below the stack's " +
                 std::to_string(fixed) + " bytes plus one " + std::to_string(page) + "-byte page");
   }
-  STRATA_TRY(auto cache, GpuTileCache::create(
-                             st, {.pageSize = p,
-                                  .budgetBytes = params.gpuBudgetBytes - fixed,
-                                  .fillVoids = [raw = s.get()](const PageKey& key, gis::Grid<float>& page, bool wait) {
-                                    return raw->fillPage(key, page, wait);
-                                  }}));
+  STRATA_TRY(
+      auto cache,
+      GpuTileCache::create(st, {.pageSize = p,
+                                .budgetBytes = params.gpuBudgetBytes - fixed,
+                                .fillVoids = [raw = s.get()](const PageKey& key, gis::Grid<float>& values, bool wait) {
+                                  return raw->fillPage(key, values, wait);
+                                }}));
   s->cache_ = std::make_unique<GpuTileCache>(std::move(cache));
   s->stats_.gpuBudgetBytes = params.gpuBudgetBytes;
   return s;
