@@ -7,7 +7,7 @@
 //
 // --reads STORE: cold reads of whole tiles at levels 0, 1 and 2 (the cache cleared before each),
 // every full-resolution tile of the store in turn, three rounds: the best round's mean ms per
-// tile and the store's bytes per stored sample.
+// tile, and the bytes of the store's tile files.
 //
 // --striped N: the ingest benchmark. A real-relief N x N striped GeoTIFF (Mount Rainier's
 // SRTM tile resampled by gdalwarp -r cubic, float32, DEFLATE, one row a strip) is made in DIR;

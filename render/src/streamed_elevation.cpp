@@ -216,7 +216,12 @@ Result<bool> StreamedElevation::fillPage(const PageKey& key, gis::Grid<float>& p
   // wherever its nearest cells are within the margin.
   const int p = page.width, lw = store_->levelWidth(key.lod), lh = store_->levelHeight(key.lod);
   int x0 = key.x * p - p, y0 = key.y * p - p, x1 = key.x * p + 2 * p, y1 = key.y * p + 2 * p;
-  if (!wrapX_) x0 = std::max(x0, 0), y0 = std::max(y0, 0), x1 = std::min(x1, lw), y1 = std::min(y1, lh);
+  if (!wrapX_) {
+    x0 = std::max(x0, 0);
+    y0 = std::max(y0, 0);
+    x1 = std::min(x1, lw);
+    y1 = std::min(y1, lh);
+  }
   const auto inside = [&](int x, int y) {  // texel (x, y) of the page inside the margin's window
     const int gx = key.x * p + x, gy = key.y * p + y;
     return gx >= x0 && gx < x1 && gy >= y0 && gy < y1;

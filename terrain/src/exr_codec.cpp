@@ -195,7 +195,7 @@ std::vector<char> encodeTileExr(const std::vector<std::string>& channels,
     STRATA_CHECK(out.numLevels() == int(levels.size()))
         << out.numLevels() << " EXR levels, " << levels.size() << " given";
     std::vector<gis::Grid<float>> high(channels.size());
-    std::vector<std::vector<uint32_t>> low(channels.size());
+    std::vector<std::vector<uint32_t>> words(channels.size());  // the low bits, or the integer samples
     for (int l = 0; l < out.numLevels(); ++l) {
       Imf::FrameBuffer fb;
       for (size_t c = 0; c < channels.size(); ++c) {
@@ -203,15 +203,15 @@ std::vector<char> encodeTileExr(const std::vector<std::string>& channels,
         STRATA_CHECK(g.width == out.levelWidth(l) && g.height == out.levelHeight(l)) << "mip level " << l << " size";
         const size_t row = size_t(g.width);
         if (voidCode[c]) {
-          low[c] = integerSamples(g, *voidCode[c], size_t(ts));
-          fb.insert(intChannel(channels[c]), Imf::Slice(Imf::UINT, reinterpret_cast<char*>(low[c].data()),
+          words[c] = integerSamples(g, *voidCode[c], size_t(ts));
+          fb.insert(intChannel(channels[c]), Imf::Slice(Imf::UINT, reinterpret_cast<char*>(words[c].data()),
                                                         sizeof(uint32_t), sizeof(uint32_t) * row));
           continue;
         }
-        splitLowBits(g, high[c], low[c]);
+        splitLowBits(g, high[c], words[c]);
         fb.insert(channels[c], Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(high[c].data.data()), sizeof(float),
                                           sizeof(float) * row));
-        fb.insert(lowChannel(channels[c]), Imf::Slice(Imf::UINT, reinterpret_cast<char*>(low[c].data()),
+        fb.insert(lowChannel(channels[c]), Imf::Slice(Imf::UINT, reinterpret_cast<char*>(words[c].data()),
                                                       sizeof(uint32_t), sizeof(uint32_t) * row));
       }
       out.setFrameBuffer(fb);
@@ -249,7 +249,7 @@ Result<std::vector<gis::Grid<float>>> decodeTileExrLevel(const std::string& name
       return fail(name + ": channel '" + ch + "' is not " + (type == Imf::FLOAT ? "float32" : "uint32"));
     };
     std::vector<gis::Grid<float>> out;
-    std::vector<std::vector<uint32_t>> low(channels.size());  // the low bits, or the integer samples
+    std::vector<std::vector<uint32_t>> words(channels.size());  // the low bits, or the integer samples
     std::vector<std::optional<uint32_t>> voidCode(channels.size());
     Imf::FrameBuffer fb;
     out.reserve(channels.size());
@@ -261,8 +261,8 @@ Result<std::vector<gis::Grid<float>>> decodeTileExrLevel(const std::string& name
         const auto* code = in.header().findTypedAttribute<Imf::IntAttribute>(voidAttribute(channels[c]));
         if (!code) return fail(name + ": integer channel '" + channels[c] + "' has no void code");
         voidCode[c] = uint32_t(code->value());
-        low[c].assign(size_t(w) * size_t(h), 0);
-        fb.insert(intChannel(channels[c]), Imf::Slice(Imf::UINT, reinterpret_cast<char*>(low[c].data()),
+        words[c].assign(size_t(w) * size_t(h), 0);
+        fb.insert(intChannel(channels[c]), Imf::Slice(Imf::UINT, reinterpret_cast<char*>(words[c].data()),
                                                       sizeof(uint32_t), sizeof(uint32_t) * row));
         continue;
       }
@@ -272,21 +272,21 @@ Result<std::vector<gis::Grid<float>>> decodeTileExrLevel(const std::string& name
                                         sizeof(float) * row));
       if (!list.findChannel(lowChannel(channels[c]))) continue;  // the first layout: the field alone
       STRATA_TRY_STATUS(isType(lowChannel(channels[c]), Imf::UINT));
-      low[c].assign(size_t(w) * size_t(h), 0);
-      fb.insert(lowChannel(channels[c]), Imf::Slice(Imf::UINT, reinterpret_cast<char*>(low[c].data()), sizeof(uint32_t),
-                                                    sizeof(uint32_t) * row));
+      words[c].assign(size_t(w) * size_t(h), 0);
+      fb.insert(lowChannel(channels[c]), Imf::Slice(Imf::UINT, reinterpret_cast<char*>(words[c].data()),
+                                                    sizeof(uint32_t), sizeof(uint32_t) * row));
     }
     in.setFrameBuffer(fb);
     in.readTiles(0, in.numXTiles(level) - 1, 0, in.numYTiles(level) - 1, level);
     for (size_t c = 0; c < channels.size(); ++c) {
       if (voidCode[c]) {
-        integerValues(low[c], *voidCode[c], size_t(in.tileXSize()), out[c]);
+        integerValues(words[c], *voidCode[c], size_t(in.tileXSize()), out[c]);
         continue;
       }
-      for (size_t i = 0; i < low[c].size(); ++i) {
+      for (size_t i = 0; i < words[c].size(); ++i) {
         uint32_t bits;
         std::memcpy(&bits, &out[c].data[i], sizeof bits);
-        bits = (bits & ~0xffu) | (low[c][i] & 0xffu);
+        bits = (bits & ~0xffu) | (words[c][i] & 0xffu);
         std::memcpy(&out[c].data[i], &bits, sizeof bits);
       }
     }

@@ -409,7 +409,7 @@ Grid<float> cubicUpsampledInt16(const std::string& path, int x0, int y0, int n, 
 // (tile_store.cpp): with every mip level a tile stays within the GeoTIFF, which has none.
 // Rainier's SRTM (int16, with voids), the same relief upsampled 13.6x as the 16384^2 DEM
 // was (smooth: the case the float layout stored worst), and the Grand Canyon (float32).
-TEST(StoreOnRealData, ATileStoresWithinHalfAgainTheDeflateGeoTiffAndExactly) {
+TEST(StoreOnRealData, ATileStoresWithinTheDeflateGeoTiffAndExactly) {
   const auto rainier = readPixels(test::dataPath("rainier/mt_rainier_90m.tif"));
   Grid<float> window(1024, 1024);
   for (int y = 0; y < 1024; ++y)
