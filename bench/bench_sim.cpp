@@ -65,6 +65,13 @@ struct Work {
 constexpr Work kPipes{24 + 40 + 40, 8 + 68 + 30};
 constexpr Work kErosion{kPipes.bytes + 8 + 68 + 40, kPipes.flops + 75 + 10 + 48 + 120};
 constexpr Work kFlood{24 + 59 + 72 + 99 + 16 + 76 + 12, 8 + 236 + 56 + 246 + 15 + 76 + 10};
+// Flood mode's local-inertial scheme (W30-W33): sources 24 B / 8; the face pass reads h, bed and
+// the cell's four applied face discharges (24 B; a neighbour's are cache hits) and writes its east
+// and south faces (8 B), 45 flops a face (W31 3, W1a 5, q* 4, h^(7/3) with its cube root 12, the
+// implicit friction 16, the tangential mean 4, the division); fv_limit 16 B / 15; the update reads
+// 3 faces, a limit, h and s (20 B) and writes h, s, hu, hv and the four applied faces (32 B), 17
+// flops; the wave speed h alone, 4 B / 2.
+constexpr Work kFloodInertial{24 + 32 + 16 + 52 + 4, 8 + 90 + 15 + 17 + 2};
 // Flood mode with sediment (E5's denominators and transport: 12 B, 40 flops) and the erosion
 // passes above, by law.
 constexpr Work kFloodForceBased{kFlood.bytes + 12 + 8 + 68 + 40, kFlood.flops + 40 + 10 + 48 + 120};
@@ -193,6 +200,12 @@ ts::SimParams flood() {
   p.manningN = 0.03f;
   return p;
 }
+ts::SimParams floodInertial() {
+  ts::SimParams p = flood();
+  p.floodScheme = ts::FloodScheme::kLocalInertial;
+  p.cflAlpha = 0.7f;
+  return p;
+}
 // Flood mode with erosion, weathering and bank failure on four layers, by law (issue 30: the
 // shear-stress law's cost beside the force-based one's).
 ts::SimParams floodErosion(ts::ErosionLaw law) {
@@ -297,6 +310,7 @@ void registerAll() {
       {"pipes", pipes(), kPipes},
       {"pipes_erosion_thermal_4layers", erosion(), kErosion},
       {"flood", flood(), kFlood},
+      {"flood_inertial", floodInertial(), kFloodInertial},
       {"flood_green_ampt", flood(), kFloodInfiltration, true},
       {"flood_erosion_forcebased_4layers", floodErosion(ts::ErosionLaw::kForceBased), kFloodForceBased},
       {"flood_erosion_shear_4layers", floodErosion(ts::ErosionLaw::kShearStress), kFloodShear}};

@@ -24,7 +24,9 @@ void addRunCommand(CLI::App& app, const char* name, const char* help, bool erosi
   auto* cmd = app.add_subcommand(name, help);
   cmd->footer(
       "[model] kind = \"flood\" (the default) is the finite-volume shallow-water model with Manning friction "
-      "whose answers converge with the step and the cell size. kind = \"pipe\" is the virtual-pipe model of "
+      "whose answers converge with the step and the cell size; [model] scheme = \"inertial\" swaps in the faster "
+      "local-inertial scheme (Bates et al. 2010) for gently varying, subcritical floodplain flow (water only). "
+      "kind = \"pipe\" is the virtual-pipe model of "
       "interactive terrain authoring: it has no friction, and its depths and speeds depend on the pipe area and the "
       "time step; they are not physical (docs/sim-water.md).");
   auto args = std::make_shared<FloodArgs>();

@@ -1225,6 +1225,7 @@ Result<CellSizes> measureCells(const gis::Georef& g) {
 sim::SimParams modelParams(const Scenario& s) {
   sim::SimParams p;
   p.waterModel = s.model.kind;
+  p.floodScheme = s.model.inertial ? sim::FloodScheme::kLocalInertial : sim::FloodScheme::kFiniteVolume;
   p.cflAlpha = float(s.model.cfl);
   // The CFL step (W10) is capped (docs/scenario.md, max_step).
   p.maxDtS = float(s.model.maxStepS);

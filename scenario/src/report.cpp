@@ -271,13 +271,15 @@ Status writeReport(const fs::path& runDir, const ReportInput& in) {
         " m |\n";
   md += std::string("| model | ") +
         (s.model.kind == sim::WaterModel::kFiniteVolume
-             ? "flood mode (finite-volume shallow water, Manning friction)"
+             ? (s.model.inertial ? "flood mode (local-inertial shallow water, Bates et al. 2010, Manning friction)"
+                                 : "flood mode (finite-volume shallow water, Manning friction)")
              : "virtual pipes: an interactive authoring model without friction, whose depths and speeds depend on "
                "the pipe area and the time step and are not physical (kind = \"flood\" for analysis, "
                "docs/sim-water.md)") +
         ", " + manningText(s) + infiltrationText(s) + ", CFL " + fmt("%.2f", s.model.cfl) +
-        (s.model.kind == sim::WaterModel::kFiniteVolume ? (s.model.sharpSlopes ? ", MC slopes" : ", minmod slopes")
-                                                        : "") +
+        (s.model.kind == sim::WaterModel::kFiniteVolume && !s.model.inertial
+             ? (s.model.sharpSlopes ? ", MC slopes" : ", minmod slopes")
+             : "") +
         " |\n";
   const char* edges[4] = {"west", "east", "south", "north"};
   std::string bounds;
@@ -493,6 +495,13 @@ std::vector<std::string> runWarnings(const ReportInput& in) {
     }
     out.push_back("The fastest water, " + fmt("%.1f", f.fastest.value) + " m/s at " +
                   where(g, f.fastest.x, f.fastest.y) + ", is faster than floods run but over steep chutes: " + why);
+  }
+  if (in.scenario.model.inertial && f.supercriticalM2 > 0) {
+    out.push_back("The flow was supercritical on " + areaText(f.supercriticalM2) + " (Froude number up to at least " +
+                  fmt("%.1f", f.froude.value) + ", at " + where(g, f.froude.x, f.froude.y) +
+                  "): the local-inertial scheme leaves out advection and holds only for gently varying, subcritical "
+                  "flow (de Almeida and Bates 2013). Its depths and speeds there and downstream are not reliable; "
+                  "run it again with `[model] scheme = \"finite_volume\"` (docs/sim-water.md).");
   }
   return out;
 }

@@ -751,8 +751,9 @@ class Run {
   FloodSummary floodSummary(const std::vector<detail::Piece>& pieces) {
     const double wet = s_.outputs.wetThresholdM;
     const auto& g = d_.bed.georef;
-    detail::Extreme deep, fast, far;
-    std::vector<sim::ExactSum> everWet(5);  // all, then per hazard class
+    detail::Extreme deep, fast, far, froude;
+    std::vector<sim::ExactSum> everWet(6);  // all, then per hazard class, then supercritical
+    const double gravity = double(solver().params().gravityMS2);
     sim::ExactSum wetVoid;
     detail::Extreme deepVoid;
     int wetVoidCells = 0;
@@ -778,6 +779,9 @@ class Run {
       if (p.inside.data[i]) {
         everWet[0].add(area);
         everWet[1 + size_t(hazardClass(hazardRating(depth, speed, s_.outputs.hazardLandUse)))].add(area);
+        const double fr = double(speed) / std::sqrt(gravity * double(depth));
+        if (std::isfinite(fr) && detail::beats({fr, x, y, 0}, froude)) froude = {fr, x, y, 0};
+        if (fr > 1.0) everWet[5].add(area);
         if (voidsHere && d_.voids.at(x, y)) {
           wetVoid.add(area);
           ++wetVoidCells;
@@ -792,6 +796,7 @@ class Run {
     deep = detail::largest(ranks_, deep);
     fast = detail::largest(ranks_, fast);
     far = detail::largest(ranks_, far);
+    froude = detail::largest(ranks_, froude);
     ranks_.sum(everWet);
     FloodSummary f;
     f.deepest = {deep.value, deep.x, deep.y};
@@ -803,6 +808,8 @@ class Run {
     f.wetVoidM2 = wetVoid.value();
     f.wetVoidCells = wetVoidCells;
     f.deepestVoid = {deepVoid.value, deepVoid.x, deepVoid.y};
+    f.froude = {froude.value, froude.x, froude.y};
+    f.supercriticalM2 = everWet[5].value();
     return f;
   }
 

@@ -466,9 +466,9 @@ Status readRegion(const Reader& r, const toml::table& root, Scenario& s) {
 Status readModel(const Reader& r, const toml::table& root, Scenario& s) {
   const auto* t = root["model"].as_table();
   if (!t) return {};
-  STRATA_TRY_STATUS(r.onlyKeys(
-      *t, "model",
-      {"kind", "manning_n", "manning_raster", "land_cover", "cfl", "max_step", "slopes", "boundary", "backend"}));
+  STRATA_TRY_STATUS(r.onlyKeys(*t, "model",
+                               {"kind", "scheme", "manning_n", "manning_raster", "land_cover", "cfl", "max_step",
+                                "slopes", "boundary", "backend"}));
   if (const auto* m = t->get("manning_raster")) {
     STRATA_TRY(auto path, r.string(*m, "model.manning_raster"));
     s.model.manningRaster = r.path(path);
@@ -511,6 +511,17 @@ Status readModel(const Reader& r, const toml::table& root, Scenario& s) {
       return r.error(*k, "model.kind", "expected \"flood\" or \"pipe\", got \"" + v + "\"");
     }
   }
+  if (const auto* sc = t->get("scheme")) {
+    STRATA_TRY(auto v, r.string(*sc, "model.scheme"));
+    if (v != "finite_volume" && v != "inertial") {
+      return r.error(*sc, "model.scheme", "expected \"finite_volume\" or \"inertial\", got \"" + v + "\"");
+    }
+    if (s.model.kind != sim::WaterModel::kFiniteVolume) {
+      return r.error(*sc, "model.scheme", "is flood mode's choice; kind = \"pipe\" has no scheme");
+    }
+    s.model.inertial = v == "inertial";
+    if (s.model.inertial) s.model.cfl = 0.7;  // Bates et al. (2010)'s alpha, unless cfl says otherwise
+  }
   if (const auto* b = t->get("backend")) {
     STRATA_TRY(auto v, r.string(*b, "model.backend"));
     auto backend = parseBackend(v);
@@ -526,7 +537,7 @@ Status readModel(const Reader& r, const toml::table& root, Scenario& s) {
   if (const auto* c = t->get("cfl")) {
     STRATA_TRY(s.model.cfl, r.number(*c, "model.cfl"));
     if (!(s.model.cfl > 0 && s.model.cfl <= 1)) return r.error(*c, "model.cfl", "must be in (0, 1]");
-    if (s.model.kind == sim::WaterModel::kFiniteVolume && s.model.cfl > 0.5) {
+    if (s.model.kind == sim::WaterModel::kFiniteVolume && !s.model.inertial && s.model.cfl > 0.5) {
       return r.error(*c, "model.cfl", "flood mode needs cfl <= 0.5 (positivity of the finite-volume scheme)");
     }
   }
@@ -1080,6 +1091,10 @@ Result<Scenario> readScenario(const toml::table& root, const std::filesystem::pa
   if ((!s.outputs.gauges.empty() || !s.outputs.sections.empty()) && s.durationS / s.outputs.probeIntervalS > 1e6) {
     return fail(s.at("outputs.probe_interval") + "more than a million rows over the duration (" +
                 std::to_string(s.durationS / s.outputs.probeIntervalS) + "): choose a longer interval");
+  }
+  if (s.model.inertial && s.erosion.enabled) {
+    return fail(s.at("model.scheme") +
+                "the local-inertial scheme moves water only; erosion needs scheme = \"finite_volume\" (the default)");
   }
   if (!s.outputs.sections.empty() && s.model.kind == sim::WaterModel::kVirtualPipes) {
     return fail(s.at("outputs.section") +

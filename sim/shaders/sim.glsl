@@ -32,7 +32,7 @@ struct SimParams {
   float waterDensityKgM3;
   float bankFillShare;
   int slopeLimiter;  // SlopeLimiter: 0 minmod, 1 MC (W21)
-  float pad0;
+  int floodScheme;   // FloodScheme: 0 finite volume, 1 local inertial (W30-W33)
   float pad1;
   float pad2;
   float pad3;

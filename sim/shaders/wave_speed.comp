@@ -1,5 +1,5 @@
 #version 450
-// W10: max over cells of |u| + sqrt(g h), as float bits (non-negative floats order like uints).
+// W10: max over cells of |u| + sqrt(g h) (W33: sqrt(g h) with the local-inertial scheme), as float bits (non-negative floats order like uints).
 #include "sim.glsl"
 layout(local_size_x = 256) in;
 layout(std430, binding = SLOT_STATE_IN) readonly buffer StateIn { vec4 state[]; };
@@ -11,7 +11,8 @@ void main() {
   if (i < uint(P.width * P.height)) {
     const vec4 s = state[i];
     const float u = velocityOf(s.x, s.z), w = velocityOf(s.x, s.w);
-    v = sqrt(u * u + w * w) + sqrt(P.gravityMS2 * s.x);
+    // The local-inertial scheme's step has no advection in it (W33): sqrt(g h) alone.
+    v = (P.floodScheme == 1 ? 0.0 : sqrt(u * u + w * w)) + sqrt(P.gravityMS2 * s.x);
   }
   sMax[l] = v;
   barrier();

@@ -39,8 +39,11 @@ AdaptiveSolver::AdaptiveSolver(const SimInput& input, const SimParams& params, c
 Result<AdaptiveSolver> AdaptiveSolver::create(const SimInput& input, const SimParams& params,
                                               const AdaptiveOptions& options, const SolverFactory& makeTile) {
   STRATA_TRY_STATUS(validate(input, params));
-  if (params.waterModel != WaterModel::kFiniteVolume || params.erosionEnabled || params.thermalEnabled) {
-    return fail("adaptive tiles: flood mode (waterModel = finite volume) without erosion or thermal weathering only");
+  if (params.waterModel != WaterModel::kFiniteVolume || params.floodScheme != FloodScheme::kFiniteVolume ||
+      params.erosionEnabled || params.thermalEnabled) {
+    return fail(
+        "adaptive tiles: flood mode's finite-volume scheme (waterModel = finite volume) without erosion or thermal "
+        "weathering only");
   }
   if (input.infiltrationMmPerHour.size() > 0) {
     // A level's cells would start with a dry soil where a finer or coarser one had taken water in.

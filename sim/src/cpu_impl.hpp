@@ -185,6 +185,12 @@ struct Impl {
   float maxWaveSpeed() const;
   float outflowLimited(int x, int y) const;  // W25-limited volume rate leaving a cell (m^3/s)
   float fvSedimentEdge(int x, int y, const FaceFlux limited[4]);
+  // The local-inertial scheme (W30-W33): faceX.mass / faceY.mass hold each face's new discharge
+  // per unit width, fvLimitPass its W25 limits, and flux[0..3] every cell's W, E, N, S face
+  // discharges as the last step applied them (the state the next step starts from).
+  bool inertial() const { return p.floodScheme == FloodScheme::kLocalInertial; }
+  void inertialFacePass();
+  void inertialUpdatePass();
 
   // ---- passes (cpu_erosion.cpp) ----
   void erosionPass();

@@ -108,7 +108,12 @@ Impl::Impl(const SimInput& input, const SimParams& params, int threadCount, bool
     }
   }
   for (auto& a : accum) a = Plane(w, h);
-  if (flood) {
+  if (flood && p.floodScheme == FloodScheme::kLocalInertial) {
+    faceX = Faces{Plane(w + 1, h), Plane(), Plane(), Plane()};
+    faceY = Faces{Plane(w, h + 1), Plane(), Plane(), Plane()};
+    limit = Plane(w, h);
+    for (auto& f : flux) f = Plane(w, h);
+  } else if (flood) {
     stage = Water{Plane(w, h), Plane(w, h), Plane(w, h), Plane(w, h)};
     faceX = Faces{Plane(w + 1, h), Plane(w + 1, h), Plane(w + 1, h), Plane(w + 1, h)};
     faceY = Faces{Plane(w, h + 1), Plane(w, h + 1), Plane(w, h + 1), Plane(w, h + 1)};
@@ -331,6 +336,10 @@ void Impl::step(const std::vector<SourceEntry>& entries, const std::vector<Level
   if (p.waterModel == WaterModel::kVirtualPipes) {
     pipeFluxPass();
     pipeUpdatePass();
+  } else if (inertial()) {
+    inertialFacePass();
+    fvLimitPass();
+    inertialUpdatePass();
   } else {
     fvFacePass(now(), false);
     fvUpdatePass(false);

@@ -826,6 +826,218 @@ float Impl::fvSedimentEdge(int x, int y, const FaceFlux limited[4]) {
 }
 
 // ---------------------------------------------------------------------------------------------
+// Flood mode, local-inertial scheme (W30-W33)
+
+namespace {
+
+// W30-W31: the discharge per unit width (m^2/s, + towards b) on the face between cells a (west /
+// north) and b, `dist` apart, which carried q0 last step while qt crossed it (the mean of the four
+// nearest faces across): the local-inertial momentum equation (Bates et al. 2010) with Manning
+// friction implicit as the finite-volume scheme's W19,
+//   q* = q0 - g hf dt deta / dist,   q = q* / c,   c = (1 + sqrt(1 + 4 a |(q*, qt)|)) / 2,
+// a = dt g n^2 / hf^(7/3): backward Euler's q (1 + a |q|) = q*. Bates et al.'s semi-implicit
+// 1 + a |q0| iterates towards the same Manning balance but oscillates about it once the friction
+// time is below the step (thin sheets: a rain-fed plane held a third of its water at the CFL
+// step); on the magnitude, because the normal component alone under-counts the friction of flow at
+// an angle to the grid (1 / sqrt 2 of it at 45 degrees: a point-fed flood 1.2 cm low 50 m out).
+// hf = max(eta_a, eta_b) - max(b_a, b_b) is the depth of water above the higher bed (W31), 0 when
+// that is dry. A surface difference below float32 resolution of the surfaces is 0 (W1a).
+inline float inertialFace(float q0, float qt, float ba, float ha, float bb, float hb, float dist, float dtg, float n2,
+                          float dry) {
+  const float ea = ba + ha, eb = bb + hb;
+  const float hf = maxOf(ea, eb) - maxOf(ba, bb);
+  float dEta = eb - ea;
+  dEta = std::abs(dEta) <= kHeadNoise * maxOf(std::abs(ea), std::abs(eb)) ? 0.0f : dEta;
+  const bool wet = hf > dry;
+  const float hw = wet ? hf : 1.0f;
+  const float qStar = q0 - dtg * hw * dEta / dist;
+  const float a = dtg * n2 / (hw * hw * cubeRoot(hw));
+  const float c = 0.5f + 0.5f * std::sqrt(1.0f + 4.0f * a * std::sqrt(qStar * qStar + qt * qt));
+  return wet ? qStar / c : 0.0f;
+}
+
+// W32: the discharge out through an open edge (m^2/s, >= 0, away from the grid) of edge cell e
+// whose inner neighbour's surface is etaIn (etaIn = the cell's own without one): a ghost cell
+// beyond the edge continues the water surface's slope (free outflow; water does not come in).
+inline float inertialEdgeFace(float q0Out, float qt, float be, float he, float etaIn, float dist, float dtg, float n2,
+                              float dry) {
+  const float eta = be + he;
+  const float q = inertialFace(q0Out, qt, be, he, be, he - (etaIn - eta), dist, dtg, n2, dry);
+  return maxOf(q, 0.0f);
+}
+
+}  // namespace
+
+// A row of faces' inputs: cells a and b on either side (bed, depth, n^2 of a roughness map or
+// null), last step's discharge through each face and the two faces across of each of its cells.
+struct InertialFaces {
+  const float *q0, *ba, *ha, *bb, *hb, *n2a, *n2b;
+  const float *ta0, *ta1, *tb0, *tb1;
+};
+
+// W30 for a row of faces: out[x] from r's values at x; n^2 of a face the mean of its two cells'
+// (a roughness map) or `n2`.
+STRATA_ROW_KERNEL void inertialFaceRow(const InertialFaces& r, float* out, int x0, int x1, float dist, float dtg,
+                                       float n2, float dry) {
+  auto faces = [=](auto kMap) {
+#pragma omp simd
+    for (int x = x0; x < x1; ++x) {
+      float n2f = n2;
+      if constexpr (decltype(kMap)::value) n2f = 0.5f * (r.n2a[x] + r.n2b[x]);
+      const float qt = 0.25f * ((r.ta0[x] + r.ta1[x]) + (r.tb0[x] + r.tb1[x]));
+      out[x] = inertialFace(r.q0[x], qt, r.ba[x], r.ha[x], r.bb[x], r.hb[x], dist, dtg, n2f, dry);
+    }
+  };
+  r.n2a ? faces(std::true_type{}) : faces(std::false_type{});
+}
+
+// W30 and W32 on every face of the active runs, into faceX.mass / faceY.mass (unlimited; W25's
+// limits follow in fvLimitPass). Each cell owns its east and south faces, and the west face in
+// column 0 and the north face in row 0, as in fvFacePass; a face owned by an inactive cell is
+// zero and stays so. Reads last step's applied discharges from flux[0..3].
+void Impl::inertialFacePass() {
+  forRuns(water, [&](const Run& r, int) {
+    const float dtg = dt * p.gravityMS2, dry = p.dryDepthM, n2u = p.manningN * p.manningN;
+    const Water& u = now();
+    auto n2At = [&](int x, int y) { return manningN2.empty() ? n2u : manningN2.at(x, y); };
+    auto etaAt = [&](int x, int y) { return bed.at(x, y) + u.h.at(x, y); };
+    // The discharge across an edge cell's face to the edge: the mean of its two faces across.
+    auto acrossX = [&](int x, int y) { return 0.5f * (flux[2].at(x, y) + flux[3].at(x, y)); };
+    auto acrossY = [&](int x, int y) { return 0.5f * (flux[0].at(x, y) + flux[1].at(x, y)); };
+    for (int y = r.y0; y < r.y1; ++y) {
+      const float* hh = u.h.row(y);
+      const float* b = bed.row(y);
+      const float* n2 = manningN2.empty() ? nullptr : manningN2.row(y);
+      const float dx = rowDx[size_t(y)];
+      float* fx = faceX.mass.row(y);
+      // East faces of the interior (x + 1 < w): face x + 1 between cells x and x + 1.
+      const int xe = std::min(r.x1, w - 1);
+      const float *qN = flux[2].row(y), *qS = flux[3].row(y);
+      inertialFaceRow({flux[1].row(y), b, hh, b + 1, hh + 1, n2, n2 ? n2 + 1 : nullptr, qN, qS, qN + 1, qS + 1}, fx + 1,
+                      r.x0, xe, dx, dtg, n2u, dry);
+      if (r.x1 == w) {  // the east edge
+        const float etaIn = w > 1 ? etaAt(w - 2, y) : etaAt(w - 1, y);
+        fx[w] = (p.openEdges & kEdgeEast) ? inertialEdgeFace(flux[1].at(w - 1, y), acrossX(w - 1, y), b[w - 1],
+                                                             hh[w - 1], etaIn, dx, dtg, n2At(w - 1, y), dry)
+                                          : 0.0f;
+      }
+      // The west edge: positive discharge is eastwards, into the grid (0 - q keeps a zero +0, so
+      // a dry edge block stays quiet).
+      if (r.x0 == 0) {
+        const float etaIn = w > 1 ? etaAt(1, y) : etaAt(0, y);
+        fx[0] = (p.openEdges & kEdgeWest) ? 0.0f - inertialEdgeFace(0.0f - flux[0].at(0, y), acrossX(0, y), b[0], hh[0],
+                                                                    etaIn, dx, dtg, n2At(0, y), dry)
+                                          : 0.0f;
+      }
+      // South faces: face row y + 1 between rows y and y + 1.
+      if (y + 1 < h) {
+        const float* n2s = manningN2.empty() ? nullptr : manningN2.row(y + 1);
+        inertialFaceRow({flux[3].row(y), b, hh, bed.row(y + 1), u.h.row(y + 1), n2, n2s, flux[0].row(y), flux[1].row(y),
+                         flux[0].row(y + 1), flux[1].row(y + 1)},
+                        faceY.mass.row(y + 1), r.x0, r.x1, dy, dtg, n2u, dry);
+      } else {
+        float* fs = faceY.mass.row(h);
+        for (int x = r.x0; x < r.x1; ++x) {
+          const float etaIn = h > 1 ? etaAt(x, h - 2) : etaAt(x, h - 1);
+          fs[x] = (p.openEdges & kEdgeSouth)
+                      ? inertialEdgeFace(flux[3].at(x, y), acrossY(x, y), b[x], hh[x], etaIn, dy, dtg, n2At(x, y), dry)
+                      : 0.0f;
+        }
+      }
+      if (y == 0) {
+        float* fn = faceY.mass.row(0);
+        for (int x = r.x0; x < r.x1; ++x) {
+          const float etaIn = h > 1 ? etaAt(x, 1) : etaAt(x, 0);
+          fn[x] = (p.openEdges & kEdgeNorth) ? 0.0f - inertialEdgeFace(0.0f - flux[2].at(x, 0), acrossY(x, 0), b[x],
+                                                                       hh[x], etaIn, dy, dtg, n2At(x, 0), dry)
+                                             : 0.0f;
+        }
+      }
+    }
+  });
+}
+
+// One row of the local-inertial update's inputs and outputs.
+struct InertialRow {
+  float A, wN, wS, dy, dt;
+  const float *fx, *fn, *fs;       // faces: x faces of the row, y faces above and below
+  const float *lim, *limN, *limS;  // W25 limits of rows y, y - 1, y + 1 (row y at an edge)
+  const float* h;
+  float *oh, *ohu, *ohv, *qW, *qE, *qN, *qS;
+};
+
+namespace {
+
+// The update of cell x (kEdge: neighbours may be outside the grid, whose limits are 1): each face's
+// discharge scaled by its upwind cell's W25 limit, the depth from their net inflow (W18), the
+// applied discharges kept as the next step's q0 and the cell's discharge as the mean of its two
+// faces' on each axis. Returns the volume leaving through the grid's edge (m^3).
+template <bool kEdge>
+inline float inertialUpdateCell(const InertialRow& r, int x, bool inW, bool inE, bool inN, bool inS) {
+  float fW = r.fx[x], fE = r.fx[x + 1], fN = r.fn[x], fS = r.fs[x];
+  const float kc = r.lim[x];
+  const float kw = !kEdge || inW ? r.lim[x - 1] : 1.0f, ke = !kEdge || inE ? r.lim[x + 1] : 1.0f;
+  const float kn = !kEdge || inN ? r.limN[x] : 1.0f, ks = !kEdge || inS ? r.limS[x] : 1.0f;
+  fW *= fW > 0.0f ? kw : kc;
+  fE *= fE > 0.0f ? kc : ke;
+  fN *= fN > 0.0f ? kn : kc;
+  fS *= fS > 0.0f ? kc : ks;
+  const float hNew = r.h[x] + r.dt / r.A * ((fW - fE) * r.dy + fN * r.wN - fS * r.wS);
+  r.oh[x] = maxOf(hNew, 0.0f);
+  r.ohu[x] = 0.5f * (fW + fE);
+  r.ohv[x] = 0.5f * (fN + fS);
+  r.qW[x] = fW, r.qE[x] = fE, r.qN[x] = fN, r.qS[x] = fS;
+  if constexpr (!kEdge) return 0.0f;
+  return ((inW ? 0.0f : maxOf(-fW, 0.0f)) + (inE ? 0.0f : maxOf(fE, 0.0f))) * r.dy * r.dt +
+         (inN ? 0.0f : maxOf(-fN, 0.0f)) * r.wN * r.dt + (inS ? 0.0f : maxOf(fS, 0.0f)) * r.wS * r.dt;
+}
+
+}  // namespace
+
+STRATA_ROW_KERNEL void inertialUpdateRow(const InertialRow& r, int x0, int x1) {
+#pragma omp simd
+  for (int x = x0; x < x1; ++x) inertialUpdateCell<false>(r, x, true, true, true, true);
+}
+
+// The local-inertial update (W18 with W30's faces, W25 final): the depths into next(), the applied
+// face discharges into flux[0..3], the water leaving through open edges into the outflow sums.
+void Impl::inertialUpdatePass() {
+  forRuns(water, [&](const Run& run, int) {
+    for (int y = run.y0; y < run.y1; ++y) {
+      const int yn = std::max(y - 1, 0), ys = std::min(y + 1, h - 1);
+      const Water& u = now();
+      Water& o = next();
+      const InertialRow r{rowArea[size_t(y)],
+                          faceWidthY[size_t(y)],
+                          faceWidthY[size_t(y) + 1],
+                          dy,
+                          dt,
+                          faceX.mass.row(y),
+                          faceY.mass.row(y),
+                          faceY.mass.row(y + 1),
+                          limit.row(y),
+                          limit.row(yn),
+                          limit.row(ys),
+                          u.h.row(y),
+                          o.h.row(y),
+                          o.hu.row(y),
+                          o.hv.row(y),
+                          flux[0].row(y),
+                          flux[1].row(y),
+                          flux[2].row(y),
+                          flux[3].row(y)};
+      std::copy(u.s.row(y) + run.x0, u.s.row(y) + run.x1, o.s.row(y) + run.x0);
+      auto edgeCell = [&](int x) {
+        const float out = inertialUpdateCell<true>(r, x, x > 0, x<w - 1, y> 0, y < h - 1);
+        if (out > 0.0f) kahanAdd(accum[kAccumOutflow].at(x, y), accum[kAccumOutflow + 1].at(x, y), out);
+      };
+      forEdgesAndInterior(run.x0, run.x1, w, y == 0 || y == h - 1, edgeCell,
+                          [&](int xa, int xb) { inertialUpdateRow(r, xa, xb); });
+    }
+  });
+}
+
+// ---------------------------------------------------------------------------------------------
 // Levels, flood statistics, wave speed
 
 // sim/shaders/level_boundary.comp: W26, the fixed levels at the end of the step (after the
@@ -873,9 +1085,15 @@ void Impl::floodStatsPass(float endTimeS) {
 }
 
 // max over [x0, x1) of a row of |u| + sqrt(g h).
+// Without advection (`gravityOnly`: the local-inertial scheme, W33) max sqrt(g h).
 STRATA_ROW_KERNEL float waveSpeedRow(const float* h, const float* hu, const float* hv, int x0, int x1, float g,
-                                     float dry) {
+                                     float dry, bool gravityOnly) {
   float m = 0.0f;
+  if (gravityOnly) {
+#pragma omp simd reduction(max : m)
+    for (int x = x0; x < x1; ++x) m = maxOf(m, h[x]);
+    return std::sqrt(g * m);
+  }
 #pragma omp simd reduction(max : m)
   for (int x = x0; x < x1; ++x) {
     const float hx = h[x];
@@ -885,7 +1103,8 @@ STRATA_ROW_KERNEL float waveSpeedRow(const float* h, const float* hu, const floa
   return m;
 }
 
-// sim/shaders/wave_speed.comp: max over cells of |u| + sqrt(g h) (W10), over the blocks that
+// sim/shaders/wave_speed.comp: max over cells of |u| + sqrt(g h) (W10; sqrt(g h) with the
+// local-inertial scheme, W33), over the blocks that
 // are not quiet (a quiet cell's is 0). A max is exact, so the order of the reduction is free.
 float Impl::maxWaveSpeed() const {
   float m = 0.0f;
@@ -899,7 +1118,8 @@ float Impl::maxWaveSpeed() const {
     const int bx = b % bw, by = b / bw;
     const int x0 = bx * kBlock, x1 = std::min(x0 + kBlock, w), y0 = by * kBlock, y1 = std::min(y0 + kBlock, h);
     for (int y = y0; y < y1; ++y) {
-      m = maxOf(m, waveSpeedRow(now().h.row(y), now().hu.row(y), now().hv.row(y), x0, x1, p.gravityMS2, p.dryDepthM));
+      m = maxOf(m, waveSpeedRow(now().h.row(y), now().hu.row(y), now().hv.row(y), x0, x1, p.gravityMS2, p.dryDepthM,
+                                inertial()));
     }
   }
   return m;

@@ -20,6 +20,22 @@ Status validateParams(const SimParams& p) {
     return failField("sim params: waterModel " + std::to_string(int(p.waterModel)) + " is not 0 (pipes) or 1 (flood)",
                      "waterModel", "is not 0 (pipes) or 1 (flood)");
   }
+  if (p.floodScheme != FloodScheme::kFiniteVolume && p.floodScheme != FloodScheme::kLocalInertial) {
+    return failField("sim params: floodScheme " + std::to_string(int(p.floodScheme)) +
+                         " is not 0 (finite volume) or 1 (local inertial)",
+                     "floodScheme", "is not 0 (finite volume) or 1 (local inertial)");
+  }
+  const bool inertial = p.floodScheme == FloodScheme::kLocalInertial;
+  if (inertial && p.waterModel != WaterModel::kFiniteVolume) {
+    return failField("sim params: the local-inertial scheme is a flood-mode scheme (waterModel 1)", "floodScheme",
+                     "is a flood-mode scheme");
+  }
+  if (inertial && (p.erosionEnabled || p.thermalEnabled)) {
+    return failField(
+        "sim params: the local-inertial scheme moves water only: erosion and thermal weathering need the "
+        "finite-volume scheme",
+        "floodScheme", "moves water only: erosion and thermal weathering need the finite-volume scheme");
+  }
   if (p.slopeLimiter != SlopeLimiter::kMinmod && p.slopeLimiter != SlopeLimiter::kMonotonizedCentral) {
     return failField("sim params: slopeLimiter " + std::to_string(int(p.slopeLimiter)) + " is not 0 (minmod) or 1 (MC)",
                      "slopeLimiter", "is not 0 (minmod) or 1 (MC)");
@@ -49,9 +65,13 @@ Status validateParams(const SimParams& p) {
   STRATA_TRY_STATUS(require(p.maxDtS > 0, "maxDtS", p.maxDtS, "positive"));
   STRATA_TRY_STATUS(require(p.gravityMS2 > 0, "gravityMS2", p.gravityMS2, "positive"));
   STRATA_TRY_STATUS(require(p.cflAlpha >= 0, "cflAlpha", p.cflAlpha, ">= 0"));
-  if (p.waterModel == WaterModel::kFiniteVolume) {
+  if (p.waterModel == WaterModel::kFiniteVolume && !inertial) {
     STRATA_TRY_STATUS(require(p.cflAlpha > 0 && p.cflAlpha <= 0.5f, "cflAlpha", p.cflAlpha,
                               "in (0, 0.5] in flood mode (positivity of the finite-volume scheme)"));
+  }
+  if (inertial) {  // W33: the gravity wave's Courant number (Bates et al. 2010 use 0.7)
+    STRATA_TRY_STATUS(require(p.cflAlpha > 0 && p.cflAlpha <= 1.0f, "cflAlpha", p.cflAlpha,
+                              "in (0, 1] with the local-inertial scheme (stability of its explicit step)"));
   }
   if (p.erosionLaw != ErosionLaw::kShearStress && p.erosionLaw != ErosionLaw::kForceBased) {
     return failField(
@@ -80,6 +100,7 @@ Status validateParams(const SimParams& p) {
 SimParams runtimeParams(const SimParams& current, const SimParams& next) {
   SimParams p = next;
   p.waterModel = current.waterModel;
+  p.floodScheme = current.floodScheme;
   p.diagonalPipes = current.diagonalPipes;
   return p;
 }

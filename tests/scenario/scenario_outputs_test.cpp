@@ -163,6 +163,31 @@ TEST(ScenarioOutputs, TheReportWarnsOfPondedWaterAndOfInflowSpeeds) {
       << report;
 }
 
+// Issue 35: the local-inertial scheme leaves out advection. The fixture's 20,000 m3/s down the
+// canyon on it races down chutes at a Froude number well above 1: the report names the scheme,
+// says where the flow was supercritical and sends the user to the finite-volume scheme; the same
+// run on the finite-volume scheme has no such warning. Erosion is refused with the scheme.
+TEST(ScenarioOutputs, TheInertialSchemeWarnsWhereTheFlowWasSupercritical) {
+  const auto dir = strata::test::tempDir("inertial_warning");
+  std::string text = scenarioText();
+  text.replace(text.find("kind = \"flood\"\n"), 15, "kind = \"flood\"\nscheme = \"inertial\"\n");
+  cpuRun(dir, "inertial", text);
+  const std::string report = slurp(dir / "inertial" / "report.md");
+  EXPECT_NE(report.find("local-inertial shallow water, Bates et al. 2010"), std::string::npos) << report;
+  EXPECT_NE(report.find("CFL 0.70"), std::string::npos) << report;
+  const size_t at = report.find("The flow was supercritical on ");
+  ASSERT_NE(at, std::string::npos) << report;
+  EXPECT_NE(report.find("`[model] scheme = \"finite_volume\"`", at), std::string::npos) << report;
+  cpuRun(dir, "finite_volume", scenarioText());
+  EXPECT_EQ(slurp(dir / "finite_volume" / "report.md").find("supercritical"), std::string::npos);
+
+  std::ofstream(dir / "eroding.toml") << text << "[erosion]\nenabled = true\n";
+  const auto refused = loadScenario(dir / "eroding.toml");
+  ASSERT_FALSE(refused);
+  EXPECT_NE(refused.message().find("model.scheme"), std::string::npos) << refused.message();
+  EXPECT_NE(refused.message().find("erosion needs scheme = \"finite_volume\""), std::string::npos) << refused.message();
+}
+
 // Issue 31: strata compare. The fixture's flood with Manning n 0.04 against 0.08: every map's
 // difference is B - A cell by cell (never-wet cells count as 0 depth), the headline table has
 // both runs and the change, and a folder that holds anything, or runs of other grids, are refused.

@@ -122,6 +122,14 @@ INSTANTIATE_TEST_SUITE_P(
                 "/data/runs/gc.toml:11: Error while parsing value: could not determine value type"},
         BadCase{"unknown slope limiter", "manning_n = 0.035", "manning_n = 0.035\nslopes = \"superbee\"",
                 "/data/runs/gc.toml:12: key 'model.slopes': expected \"minmod\" or \"mc\", got \"superbee\""},
+        BadCase{"unknown flood scheme", "manning_n = 0.035", "manning_n = 0.035\nscheme = \"diffusive\"",
+                "/data/runs/gc.toml:12: key 'model.scheme': expected \"finite_volume\" or \"inertial\", got "
+                "\"diffusive\""},
+        BadCase{"a scheme for the pipe model", "kind = \"flood\"", "kind = \"pipe\"\nscheme = \"inertial\"",
+                "/data/runs/gc.toml:11: key 'model.scheme': is flood mode's choice; kind = \"pipe\" has no scheme"},
+        BadCase{"finite volumes above CFL 0.5", "manning_n = 0.035", "manning_n = 0.035\ncfl = 0.7",
+                "/data/runs/gc.toml:12: key 'model.cfl': flood mode needs cfl <= 0.5 (positivity of the "
+                "finite-volume scheme)"},
         BadCase{"terrain change without erosion", "[time]", "[outputs]\nmaps = [\"terrain_change\"]\n[time]",
                 "/data/runs/gc.toml: outputs.maps asks for terrain_change but erosion is not enabled"},
         BadCase{"unknown erosion law", "[time]", "[erosion]\nlaw = \"stream power\"\n[time]",
@@ -188,6 +196,23 @@ TEST(Scenario, SlopeLimiterIsMinmodUnlessAskedForMc) {
   s = parse(replaced(kGood, "manning_n = 0.035", "manning_n = 0.035\nslopes = \"mc\""));
   ASSERT_TRUE(s) << s.message();
   EXPECT_TRUE(s->model.sharpSlopes);
+}
+
+TEST(Scenario, TheInertialSchemeTakesItsOwnCflUnlessGiven) {
+  auto s = parse(kGood);
+  ASSERT_TRUE(s) << s.message();
+  EXPECT_FALSE(s->model.inertial);
+  s = parse(replaced(kGood, "manning_n = 0.035", "manning_n = 0.035\nscheme = \"inertial\""));
+  ASSERT_TRUE(s) << s.message();
+  EXPECT_TRUE(s->model.inertial);
+  EXPECT_DOUBLE_EQ(s->model.cfl, 0.7);
+  EXPECT_EQ(modelParams(*s).floodScheme, sim::FloodScheme::kLocalInertial);
+  s = parse(replaced(kGood, "manning_n = 0.035", "manning_n = 0.035\nscheme = \"inertial\"\ncfl = 0.9"));
+  ASSERT_TRUE(s) << s.message();
+  EXPECT_DOUBLE_EQ(s->model.cfl, 0.9);
+  s = parse(replaced(kGood, "manning_n = 0.035", "cfl = 0.3\nscheme = \"finite_volume\""));
+  ASSERT_TRUE(s) << s.message();
+  EXPECT_DOUBLE_EQ(s->model.cfl, 0.3);
 }
 
 TEST(Scenario, NeedsASource) {

@@ -57,7 +57,7 @@ TEST(GpuLayouts, SimParamsMatchesGlsl) {
                                            STRATA_FIELD(SimParams, waterDensityKgM3),
                                            STRATA_FIELD(SimParams, bankFillShare),
                                            STRATA_FIELD(SimParams, slopeLimiter),
-                                           STRATA_FIELD(SimParams, pad0),
+                                           STRATA_FIELD(SimParams, floodScheme),
                                            STRATA_FIELD(SimParams, pad1),
                                            STRATA_FIELD(SimParams, pad2),
                                            STRATA_FIELD(SimParams, pad3)});

@@ -28,6 +28,7 @@ GpuSimParams gpuParams(const SimParams& p, const CellGrid& grid, float dtS) {
   g.deepWaterM = p.deepWaterM;
   g.minSinTilt = p.minSinTilt;
   g.slowWaterMS = p.slowWaterMS;
+  g.floodScheme = int32_t(p.floodScheme);
   g.erosionLaw = int32_t(p.erosionLaw);
   g.waterDensityKgM3 = p.waterDensityKgM3;
   g.bankFillShare = p.bankFillShare;

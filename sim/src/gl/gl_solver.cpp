@@ -44,8 +44,8 @@ struct GlSolver::Impl {
   gl::Buffer params, materials, rowDx, base, bed, layerBuf, stateA, stateB, stage, flux, fluxDiag, faceX, faceY, tilt,
       accum, rain, manning, infiltration, thermal, scour, sourceEntries, maxSpeed, floodStats, fvLimit, levelEntries;
   bool aIsCurrent = true;
-  gl::Program pSources, pPointSources, pWaveSpeed, pPipeFlux, pPipeUpdate, pFvFace, pFvLimit, pFvUpdate, pErode,
-      pThermalFlux, pThermalApply, pFloodStats, pLevel, pCopyRect, pBedRect;
+  gl::Program pSources, pPointSources, pWaveSpeed, pPipeFlux, pPipeUpdate, pFvFace, pFvLimit, pFvUpdate, pInertialFace,
+      pInertialUpdate, pErode, pThermalFlux, pThermalApply, pFloodStats, pLevel, pCopyRect, pBedRect;
   gl::Buffer maxSpeedHost;  // maxSpeed copied to host memory, read every step (maxWaveSpeed)
   gl::Buffer packed;        // copy_rect.comp's side of a rectangle moved to or from the host
 
@@ -118,6 +118,13 @@ struct GlSolver::Impl {
       pPipeFlux.dispatchCovering(w, h);
       barrier();
       pPipeUpdate.dispatchCovering(w, h);
+      barrier();
+    } else if (p.floodScheme == int32_t(FloodScheme::kLocalInertial)) {
+      pInertialFace.dispatchCovering(w, h);
+      barrier();
+      pFvLimit.dispatchCovering(w, h);
+      barrier();
+      pInertialUpdate.dispatchCovering(w, h);
       barrier();
     } else {
       pFvFace.set("average", 0);
@@ -261,7 +268,9 @@ Result<GlSolver> GlSolver::create(const SimInput& input, const SimParams& params
         Kernel{&s.pWaveSpeed, "sim/shaders/wave_speed.comp"}, Kernel{&s.pPipeFlux, "sim/shaders/pipe_flux.comp"},
         Kernel{&s.pPipeUpdate, "sim/shaders/pipe_update.comp"}, Kernel{&s.pFvFace, "sim/shaders/fv_face.comp"},
         Kernel{&s.pFvLimit, "sim/shaders/fv_limit.comp"}, Kernel{&s.pFvUpdate, "sim/shaders/fv_update.comp"},
-        Kernel{&s.pErode, "sim/shaders/erode.comp"}, Kernel{&s.pThermalFlux, "sim/shaders/thermal_flux.comp"},
+        Kernel{&s.pInertialFace, "sim/shaders/inertial_face.comp"},
+        Kernel{&s.pInertialUpdate, "sim/shaders/inertial_update.comp"}, Kernel{&s.pErode, "sim/shaders/erode.comp"},
+        Kernel{&s.pThermalFlux, "sim/shaders/thermal_flux.comp"},
         Kernel{&s.pThermalApply, "sim/shaders/thermal_apply.comp"},
         Kernel{&s.pFloodStats, "sim/shaders/flood_stats.comp"}, Kernel{&s.pLevel, "sim/shaders/level_boundary.comp"},
         Kernel{&s.pCopyRect, "sim/shaders/copy_rect.comp"}, Kernel{&s.pBedRect, "sim/shaders/bed_rect.comp"}}) {

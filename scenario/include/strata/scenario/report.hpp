@@ -39,6 +39,11 @@ struct FloodSummary {
   double wetVoidM2 = 0;
   int wetVoidCells = 0;
   AtCell deepestVoid;
+  /// A lower bound of each wet cell's largest Froude number over the run, its fastest speed over
+  /// sqrt(g x its deepest water) (when the speed peaked the water was no deeper): the largest,
+  /// and the area where it is above 1 (flow that was certainly supercritical at some time).
+  AtCell froude;
+  double supercriticalM2 = 0;
 };
 
 struct ReportInput {
@@ -57,7 +62,7 @@ struct ReportInput {
 /// elevation map first.
 /// What the report warns about (one paragraph each, Markdown): water ending in closed depressions
 /// of the bed (more than a fifth of the water at the end), speeds above 10 m/s, water over filled
-/// voids of the DEM. Also logged.
+/// voids of the DEM, supercritical flow under the local-inertial scheme. Also logged.
 std::vector<std::string> runWarnings(const ReportInput& in);
 
 /// `haveSeries` false (a run stopped before its first output interval): no series plots.

@@ -143,8 +143,10 @@ struct Scenario {
     std::string manningRaster;
     std::string landCoverRaster;
     std::map<long long, double> landCoverManning;  ///< class code -> n
-    double cfl = 0.45;                             ///< flood mode needs <= 0.5 (positivity of the finite-volume scheme)
-    double maxStepS = 30.0;                        ///< cap on the adaptive step (s); see docs/scenario.md
+    /// Flood mode's scheme: the local-inertial one (W30-W33) instead of finite volumes.
+    bool inertial = false;
+    double cfl = 0.45;         ///< finite volumes need <= 0.5 (positivity); the local-inertial default is 0.7
+    double maxStepS = 30.0;    ///< cap on the adaptive step (s); see docs/scenario.md
     bool sharpSlopes = false;  ///< flood mode: MC slopes instead of minmod (W21); see docs/sim-water.md
     std::array<Boundary, 4> boundaries{Boundary::Open, Boundary::Open, Boundary::Open, Boundary::Open};  ///< W E S N
   } model;

@@ -16,6 +16,20 @@ enum class WaterModel : int32_t {
   kFiniteVolume = 1,  ///< flood mode: Godunov finite volumes, HLL + hydrostatic reconstruction (W13-W24)
 };
 
+/// Flood mode's scheme (docs/sim-water.md): both keep the depth on the cells and budget every
+/// volume the same way; they differ in how the discharge is carried.
+enum class FloodScheme : int32_t {
+  /// Godunov finite volumes (HLL with hydrostatic reconstruction, Heun in time, W13-W25): the
+  /// full shallow-water equations, shocks, supercritical and steep flow (the default).
+  kFiniteVolume = 0,
+  /// Local inertial (Bates, Horritt and Fewtrell 2010, J. Hydrology 387; the semi-implicit
+  /// friction of de Almeida et al. 2012, Water Resources Research 48; W30-W33): the discharge on
+  /// each face from the water-surface slope and Manning friction, no advection. One face pass and
+  /// one update a step, and a step set by sqrt(g h) alone: the fast choice for gently varying
+  /// floodplain flow (LISFLOOD-FP's ACC solver); not for supercritical flow or steep slopes.
+  kLocalInertial = 1,
+};
+
 /// Flood mode's slope limiter (W21).
 enum class SlopeLimiter : int32_t {
   kMinmod = 0,  ///< the smaller one-sided slope: the most diffusive, robust on steep real terrain (the default)
@@ -38,14 +52,15 @@ enum class ErosionLaw : int32_t {
 /// a closed one is a wall.
 enum EdgeBits : uint32_t { kEdgeWest = 1u, kEdgeEast = 2u, kEdgeNorth = 4u, kEdgeSouth = 8u };
 
-/// The model and its constants. setParams() may change any of them mid-run but the water model
-/// and diagonal pipes, which decide what the solver allocates.
+/// The model and its constants. setParams() may change any of them mid-run but the water model,
+/// the flood scheme and diagonal pipes, which decide what the solver allocates.
 struct SimParams {
   WaterModel waterModel = WaterModel::kVirtualPipes;
-  SlopeLimiter slopeLimiter = SlopeLimiter::kMinmod;  ///< flood mode's W21 slopes
-  uint32_t openEdges = 0;                             ///< EdgeBits; 0 = closed box
-  bool erosionEnabled = false;                        ///< erosion, deposition, dissolution and transport (E1-E6)
-  bool thermalEnabled = false;                        ///< weathering of slopes and bank failure (E7-E8)
+  FloodScheme floodScheme = FloodScheme::kFiniteVolume;  ///< flood mode's scheme (fixed at creation)
+  SlopeLimiter slopeLimiter = SlopeLimiter::kMinmod;     ///< flood mode's W21 slopes
+  uint32_t openEdges = 0;                                ///< EdgeBits; 0 = closed box
+  bool erosionEnabled = false;                           ///< erosion, deposition, dissolution and transport (E1-E6)
+  bool thermalEnabled = false;                           ///< weathering of slopes and bank failure (E7-E8)
   bool diagonalPipes = false;         ///< pipes model with 8 pipes (diagonals too), no axis-aligned gullies (W1b)
   float gravityMS2 = 9.81f;           ///< g (m/s^2)
   float maxDtS = 0.05f;               ///< fixed step, or the upper bound of the adaptive one (s)
@@ -73,7 +88,7 @@ struct SimParams {
 /// parameter and the problem.
 Status validateParams(const SimParams& params);
 
-/// `next` with what is fixed at creation (water model, diagonal pipes) taken from `current`: what
+/// `next` with what is fixed at creation (water model, flood scheme, diagonal pipes) taken from `current`: what
 /// setParams() applies mid-run.
 SimParams runtimeParams(const SimParams& current, const SimParams& next);
 

@@ -41,7 +41,8 @@ struct GpuSimParams {
   float waterDensityKgM3 = 1000.0f;
   float bankFillShare = 0.5f;
   int32_t slopeLimiter = 0;
-  float pad0 = 0.0f, pad1 = 0.0f, pad2 = 0.0f, pad3 = 0.0f;  ///< std430 rounds the block to 16 bytes
+  int32_t floodScheme = 0;                      ///< FloodScheme: 0 finite volume, 1 local inertial
+  float pad1 = 0.0f, pad2 = 0.0f, pad3 = 0.0f;  ///< std430 rounds the block to 16 bytes
 };
 static_assert(sizeof(GpuSimParams) == 128);
 static_assert(offsetof(GpuSimParams, dyM) == 32);
