@@ -1,5 +1,6 @@
 # strata_add_library(NAME SOURCES ... DEPS ...): a library with public headers in include/.
-# strata_add_test(NAME SOURCES ... DEPS ... [LABELS ...]): one GoogleTest binary, registered with ctest.
+# strata_add_test(NAME SOURCES ... DEPS ... [LABELS ...] [ENVIRONMENT VAR=value ...]): one GoogleTest
+# binary, registered with ctest.
 
 set(CMAKE_CXX_STANDARD 20)
 set(CMAKE_CXX_STANDARD_REQUIRED ON)
@@ -41,12 +42,19 @@ endfunction()
 # Tests get STRATA_SOURCE_DIR / STRATA_DATA_DIR (../shared/data) / STRATA_BINARY_DIR compiled in.
 set(STRATA_DATA_DIR "${PROJECT_SOURCE_DIR}/../shared/data" CACHE PATH "Shared real DEMs")
 function(strata_add_test name)
-  cmake_parse_arguments(ARG "" "" "SOURCES;DEPS;LABELS" ${ARGN})
+  cmake_parse_arguments(ARG "" "" "SOURCES;DEPS;LABELS;ENVIRONMENT" ${ARGN})
   add_executable(${name} ${ARG_SOURCES})
   target_link_libraries(${name} PRIVATE strata_options ${ARG_DEPS} GTest::gtest GTest::gmock strata_test_main)
   target_compile_definitions(${name} PRIVATE
     STRATA_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
     STRATA_DATA_DIR="${STRATA_DATA_DIR}"
     STRATA_TEST_OUTPUT_DIR="${PROJECT_BINARY_DIR}/test-output")
-  gtest_discover_tests(${name} PROPERTIES LABELS "${ARG_LABELS}" DISCOVERY_TIMEOUT 60)
+  set(properties)  # an empty value would swallow the next property's name
+  if(ARG_LABELS)
+    list(APPEND properties LABELS "${ARG_LABELS}")
+  endif()
+  if(ARG_ENVIRONMENT)
+    list(APPEND properties ENVIRONMENT "${ARG_ENVIRONMENT}")
+  endif()
+  gtest_discover_tests(${name} PROPERTIES ${properties} DISCOVERY_TIMEOUT 60)
 endfunction()

@@ -14,6 +14,7 @@
 #include <CLI/CLI.hpp>
 
 #include <strata/core/log.hpp>
+#include <strata/core/process.hpp>
 #include <strata/gis/dem_io.hpp>
 #include <strata/gl/context.hpp>
 #include <strata/terrain/tile_store.hpp>
@@ -233,6 +234,7 @@ int run(const Args& a) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  strata::preferSleepingOpenMpWaits(argv);  // may start this program again, before anything else
   CLI::App app{"strata-view: fly through a DEM or a terrain store, edit it and simulate water live"};
   auto a = std::make_shared<Args>();
   app.add_option("input", a->input, "DEM file (any raster GDAL reads) or a store folder")->required();

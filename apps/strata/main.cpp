@@ -7,6 +7,7 @@
 #include <cstring>
 
 #include <strata/core/log.hpp>
+#include <strata/core/process.hpp>
 
 #include "commands.hpp"
 
@@ -30,6 +31,7 @@ const MpiLaunch& mpiLaunch() { return gLaunch; }
 }  // namespace strata::app
 
 int main(int argc, char** argv) {
+  strata::preferSleepingOpenMpWaits(argv);  // may start this program again, before anything else
   // Over the file size limit (ulimit -f) a write fails with EFBIG and the message names the file,
   // instead of the process dying silently of SIGXFSZ.
   std::signal(SIGXFSZ, SIG_IGN);

@@ -8,6 +8,8 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
 
 extern char** environ;
@@ -98,6 +100,28 @@ Result<std::string> runProcess(const std::vector<std::string>& argv, std::string
   const std::string how = WIFEXITED(status) ? "exited with status " + std::to_string(WEXITSTATUS(status))
                                             : "was killed by signal " + std::to_string(WTERMSIG(status));
   return fail(argv[0] + " " + how + (output.empty() ? "" : ": " + output));
+}
+
+bool machineIsBusy() {
+  const long cores = sysconf(_SC_NPROCESSORS_ONLN);
+  std::FILE* f = std::fopen("/proc/loadavg", "r");
+  if (!f || cores < 1) {
+    if (f) std::fclose(f);
+    return false;
+  }
+  double load1 = 0, load5 = 0, load15 = 0;
+  long running = 0, tasks = 0;
+  const int n = std::fscanf(f, "%lf %lf %lf %ld/%ld", &load1, &load5, &load15, &running, &tasks);
+  std::fclose(f);
+  // `running` counts this process too. (Not the load averages: they remember the user's own run
+  // that just ended.)
+  return n == 5 && running - 1 >= cores;
+}
+
+void preferSleepingOpenMpWaits(char** argv) {
+  if (std::getenv("OMP_WAIT_POLICY") || !argv || !argv[0] || !machineIsBusy()) return;
+  if (setenv("OMP_WAIT_POLICY", "PASSIVE", 0) != 0) return;
+  execv("/proc/self/exe", argv);  // only returns on failure: go on as we are
 }
 
 }  // namespace strata

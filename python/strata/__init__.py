@@ -17,6 +17,10 @@ strata.run(..., resume=True) continues.
 """
 import os
 
+# OpenMP threads that wait by sleeping, not spinning (core/src/openmp_waits.cpp): libgomp reads
+# this when it is loaded, with the extension below, unless the user has set it.
+os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+
 from ._strata import (Cancelled, Scenario, ScenarioError, Solver, load_scenario, read_map, read_series,
                       scenario_from_dict, scenario_toml)
 from . import _strata

@@ -81,13 +81,47 @@ struct BlockSet {
   size_t cells = 0;
 };
 
+/// Chooses between one thread and `most` for the passes by their measured speed (issue 35): on a
+/// machine whose cores are busy with other work each pass's join waits for a thread the scheduler
+/// has put aside, and a run on two threads took twice as long as on one. Steps are timed in
+/// windows of kWindow; the first 2 x kRounds windows alternate the two counts, then the count
+/// whose median seconds per cell update over its last kRounds windows is lower runs for kRun
+/// steps (`most` only when it is at least kGain faster: a thread that barely helps is not worth
+/// taking from a shared machine), then the other count runs one window and the choice is made
+/// again. The results do not depend on the thread count (SimCpu.ResultsDoNotDependOnTheThreadCount),
+/// so the choice changes no bit.
+class ThreadTuner {
+ public:
+  static constexpr int kWindow = 4, kRounds = 3, kRun = 256;
+  static constexpr double kGain = 0.9;
+  ThreadTuner() = default;
+  explicit ThreadTuner(int most) : most_(most), now_(most) {}
+  int threads() const { return now_; }
+  /// One step took `seconds` to update `updates` cells.
+  void record(double seconds, long long updates);
+  /// Steps run on one thread and on `most` so far.
+  long long stepsOn(bool one) const { return steps_[one ? 0 : 1]; }
+
+ private:
+  double median(int k) const;  // of count k's (0: one thread, 1: most) last kRounds windows
+  int most_ = 1, now_ = 1;
+  int inWindow_ = 0, windows_ = 0, runLeft_ = 0;
+  double seconds_ = 0, updates_ = 0;
+  double rates_[2][kRounds] = {};  // seconds per cell update of each count's last windows (ring)
+  int measured_[2] = {0, 0};
+  long long steps_[2] = {0, 0};
+};
+
 struct Impl {
   // ---- the grid and the model ----
   int w = 0, h = 0, L = 0;
   int bw = 0, bh = 0;  // blocks across and down
   float dy = 1.0f;
   SimParams p;
-  int threads = 1;
+  int threads = 1;      // the most threads the passes may use (per-thread scratch is allocated for these)
+  int passThreads = 1;  // the threads the passes use this step (threads, or what `tuner` chose)
+  bool tune = false;    // OpenMP's default count asked for: `tuner` chooses between 1 and `threads`
+  ThreadTuner tuner;
   bool skip = true;
   // Per layer, MaterialConstants as columns (E1-E8).
   std::vector<float> erodibility, dissolutionRate, tanTalus, weatheringRate, criticalShear, shearErodibility;
@@ -154,8 +188,8 @@ struct Impl {
   template <class F>
   void forRuns(const BlockSet& set, F&& f) const {
     const int n = int(set.runs.size());
-    const bool parallel = threads > 1 && n > 1 && set.cells >= kMinParallelCells;
-#pragma omp parallel for schedule(dynamic, 1) num_threads(threads) if (parallel)
+    const bool parallel = passThreads > 1 && n > 1 && set.cells >= kMinParallelCells;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(passThreads) if (parallel)
     for (int k = 0; k < n; ++k) f(set.runs[size_t(k)], omp_get_thread_num());
   }
 

@@ -3,6 +3,7 @@
 #include <strata/sim/cpu_solver.hpp>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <string>
@@ -42,8 +43,15 @@ bool anyBits(const Plane& plane, int x0, int x1, int y0, int y1) {
 }  // namespace
 
 Impl::Impl(const SimInput& input, const SimParams& params, int threadCount, bool skipQuiet)
-    : p(params), threads(threadCount > 0 ? threadCount : omp_get_max_threads()), skip(skipQuiet) {
+    : p(params), skip(skipQuiet) {
   const CellGrid grid = CellGrid::of(input);
+  // OpenMP's default count is the most a grid of this size can use: no more threads than it has
+  // kMinParallelCells (a 5,000-cell grid runs on one), and the tuner's choice between one and those.
+  threads = threadCount > 0 ? threadCount
+                            : std::clamp(int(grid.cells() / kMinParallelCells), 1, std::max(1, omp_get_max_threads()));
+  tune = threadCount <= 0 && threads > 1;
+  passThreads = threads;
+  tuner = ThreadTuner(threads);
   w = grid.width;
   h = grid.height;
   L = grid.layers;
@@ -313,11 +321,11 @@ void Impl::finishStep() {
   thermalDirty = false;
   if (!skip) return;
   const int blocks = bw * bh;
-  const bool parallel = threads > 1 && water.cells >= kMinParallelCells;
+  const bool parallel = passThreads > 1 && water.cells >= kMinParallelCells;
   // While rain falls everywhere every block is busy anyway: the blocks that ran count as not
   // quiet (which is always safe) without a look at their cells.
   const bool rainEverywhere = p.rainMmPerHour != 0.0f;
-#pragma omp parallel for schedule(dynamic, 8) num_threads(threads) if (parallel)
+#pragma omp parallel for schedule(dynamic, 8) num_threads(passThreads) if (parallel)
   for (int b = 0; b < blocks; ++b) {
     if (water.on[size_t(b)]) quiet[size_t(b)] = !rainEverywhere && blockQuiet(b % bw, b / bw);
     if (sources.on[size_t(b)]) evapResidual[size_t(b)] = blockEvapResidual(b % bw, b / bw);
@@ -393,6 +401,14 @@ Result<CpuSolver> CpuSolver::create(const SimInput& input, const SimParams& para
 
 std::string CpuSolver::backendName() const {
   const int n = impl_->threads;
+  if (impl_->tune) {  // how the steps so far were shared
+    const auto& t = impl_->tuner;
+    const long long one = t.stepsOn(true), all = one + t.stepsOn(false);
+    const std::string counts = "CPU, 1 or " + std::to_string(n) + " OpenMP threads, whichever ";
+    if (all == 0) return counts + "runs faster";
+    return counts + "ran faster (" + std::to_string(int(std::lround(100.0 * double(one) / double(all)))) +
+           "% of the steps on 1)";
+  }
   return "CPU, " + std::to_string(n) + (n == 1 ? " OpenMP thread" : " OpenMP threads");
 }
 
@@ -406,11 +422,52 @@ SolverFactory cpuSolverFactory(const CpuOptions& options) {
   };
 }
 
+double cpu::ThreadTuner::median(int k) const {
+  static_assert(kRounds == 3);
+  const double* r = rates_[k];
+  switch (std::min(measured_[k], kRounds)) {
+    case 0: return 0.0;
+    case 1: return r[0];
+    case 2: return 0.5 * (r[0] + r[1]);
+    default: return std::max(std::min(r[0], r[1]), std::min(std::max(r[0], r[1]), r[2]));
+  }
+}
+
+void cpu::ThreadTuner::record(double seconds, long long updates) {
+  const int k = now_ == 1 ? 0 : 1;
+  ++steps_[k];
+  seconds_ += seconds;
+  updates_ += double(updates);
+  if (++inWindow_ < kWindow) return;
+  if (updates_ > 0) rates_[k][measured_[k]++ % kRounds] = seconds_ / updates_;
+  inWindow_ = 0;
+  seconds_ = updates_ = 0;
+  ++windows_;
+  if (windows_ < 2 * kRounds) {  // the first windows alternate the counts
+    now_ = now_ == 1 ? most_ : 1;
+    return;
+  }
+  if ((runLeft_ -= kWindow) > 0) return;
+  if (runLeft_ > -kWindow) {  // a run ended: the other count for one window
+    now_ = now_ == 1 ? most_ : 1;
+    runLeft_ = -kWindow;
+    return;
+  }
+  const bool both = measured_[0] > 0 && measured_[1] > 0;
+  now_ = both && median(1) < kGain * median(0) ? most_ : 1;
+  runLeft_ = kRun;
+}
+
 void CpuSolver::runStep(const StepInputs& step) {
   Impl& m = *impl_;
   m.floodStats = floodThresholdM() >= 0;
   m.wetThresholdM = floodThresholdM();
+  if (!m.tune) return m.step(step.sources, step.levels, step.dtS, step.startS + double(step.dtS));
+  m.passThreads = m.tuner.threads();
+  const long long before = m.cellUpdates;
+  const auto t0 = std::chrono::steady_clock::now();
   m.step(step.sources, step.levels, step.dtS, step.startS + double(step.dtS));
+  m.tuner.record(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), m.cellUpdates - before);
 }
 
 Status CpuSolver::onRainRasterChanged(const gis::Grid<float>& mmPerHour) {

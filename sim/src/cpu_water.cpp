@@ -1111,8 +1111,8 @@ float Impl::maxWaveSpeed() const {
   const int blocks = bw * bh;
   size_t wetBlocks = 0;
   for (int b = 0; b < blocks; ++b) wetBlocks += !(skip && quiet[size_t(b)]);
-  const bool parallel = threads > 1 && wetBlocks * kBlock * kBlock >= kMinParallelCells;
-#pragma omp parallel for schedule(dynamic, 8) num_threads(threads) if (parallel) reduction(max : m)
+  const bool parallel = passThreads > 1 && wetBlocks * kBlock * kBlock >= kMinParallelCells;
+#pragma omp parallel for schedule(dynamic, 8) num_threads(passThreads) if (parallel) reduction(max : m)
   for (int b = 0; b < blocks; ++b) {
     if (skip && quiet[size_t(b)]) continue;
     const int bx = b % bw, by = b / bw;
