@@ -1,3 +1,5 @@
+// Also the flat-plain flood after the EA's test 4, whole, by scheme, backend and cell size
+// (flat_plain/..., issue 35).
 // Simulation step cost side by side in one run: the CPU backend (sim::CpuSolver) with 1 and 2
 // OpenMP threads (and all cores, on a machine with more than two), and the GL backend
 // (sim::GlSolver) on whatever GL the machine has (Mesa llvmpipe without a GPU), at 256^2 to 4096^2
@@ -26,6 +28,7 @@
 #include <vector>
 
 #include "bench_context.hpp"
+#include "flat_plain.hpp"
 
 #include <strata/gl/context.hpp>
 #include <strata/gl/state.hpp>
@@ -299,7 +302,54 @@ void glHaloStrip(benchmark::State& state) {
   state.counters["bytes_per_strip"] = double(n) * 8 * (16 + 16 + 16);
 }
 
+// The flat-plain flood after the Environment Agency's test 4 (tests/support/flat_plain.hpp) run
+// whole by one solver, as issue 35 compares with LISFLOOD-FP: 5 h, or 1 h at cells of 1 m and
+// less (the issue's 1 m case). Arg: the cell size in metres. threads 0: GL; else the CPU backend
+// with OpenMP's default count (grid-capped, tuned). Reports the steps and the solver's wall time.
+void flatPlain(benchmark::State& state, ts::FloodScheme scheme, bool gl) {
+  const double cellM = double(state.range(0));
+  const auto plain = test::flatPlain(cellM);
+  const double duration = cellM <= 1.0 ? 3600.0 : test::kPlainDurationS;
+  for (auto _ : state) {
+    std::unique_ptr<ts::Solver> sim;
+    if (gl) {
+      if (!gContext) return state.SkipWithError("no GL context");
+      auto s = ts::GlSolver::create(plain.input, test::flatPlainParams(scheme));
+      if (s) sim = std::make_unique<ts::GlSolver>(std::move(s).value());
+    } else {
+      auto s = ts::CpuSolver::create(plain.input, test::flatPlainParams(scheme));
+      if (s) sim = std::make_unique<ts::CpuSolver>(std::move(s).value());
+    }
+    if (!sim || !sim->addSource(plain.breach)) return state.SkipWithError("the solver could not be created");
+    const auto t0 = std::chrono::steady_clock::now();
+    sim->advance(duration);
+    if (gl) gl::finish();
+    state.SetIterationTime(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    const auto st = sim->stats();
+    state.counters["steps"] = double(st.steps);
+    state.counters["balance"] = st.waterBalanceM3() / st.inflowM3;
+    state.counters["cell_steps/s"] = benchmark::Counter(double(st.steps) * double(plain.input.baseM.size()),
+                                                        benchmark::Counter::kIsIterationInvariantRate);
+    state.SetLabel(sim->backendName());
+  }
+}
+
 void registerAll() {
+  for (auto [scheme, name] : {std::pair{ts::FloodScheme::kFiniteVolume, "finite_volume"},
+                              std::pair{ts::FloodScheme::kLocalInertial, "inertial"}}) {
+    for (bool gl : {false, true}) {
+      benchmark::RegisterBenchmark((std::string("flat_plain/") + name + (gl ? "/gl" : "/cpu")).c_str(),
+                                   [scheme, gl](benchmark::State& s) { flatPlain(s, scheme, gl); })
+          ->Arg(20)
+          ->Arg(10)
+          ->Arg(5)
+          ->Arg(2)
+          ->Arg(1)
+          ->Iterations(1)
+          ->UseManualTime()
+          ->Unit(benchmark::kSecond);
+    }
+  }
   struct Model {
     const char* name;
     ts::SimParams params;
