@@ -17,7 +17,7 @@ strata.run(..., resume=True) continues.
 """
 import os
 
-# OpenMP threads that wait by sleeping, not spinning (core/src/openmp_waits.cpp): libgomp reads
+# OpenMP threads that wait by sleeping, not spinning (strata/core/process.hpp): libgomp reads
 # this when it is loaded, with the extension below, unless the user has set it.
 os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 
