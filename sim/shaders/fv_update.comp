@@ -5,6 +5,7 @@
 // E5 sediment transport, E0 tilt.
 #include "sim.glsl"
 #include "sim_accum.glsl"
+#include "sim_limit.glsl"
 layout(local_size_x = SIM_GROUP_X, local_size_y = SIM_GROUP_Y) in;
 layout(std430, binding = SLOT_BED) readonly buffer Bed { float bed[]; };
 layout(std430, binding = SLOT_STATE_IN) readonly buffer StateIn { vec4 state[]; };
@@ -13,7 +14,6 @@ layout(std430, binding = SLOT_STAGE) buffer Stage { vec4 stage[]; };
 layout(std430, binding = SLOT_FACE_X) readonly buffer FaceX { vec4 faceX[]; };
 layout(std430, binding = SLOT_FACE_Y) readonly buffer FaceY { vec4 faceY[]; };
 layout(std430, binding = SLOT_TILT) writeonly buffer Tilt { float tilt[]; };
-layout(std430, binding = SLOT_FV_LIMIT) readonly buffer Limit { float limit_[]; };  // W25, from fv_limit.comp
 layout(std430, binding = SLOT_MANNING) readonly buffer Manning { float manningN2[]; };  // n^2 per cell; < 0: P.manningN
 uniform int final_;
 vec4 stateAt(int which, int i) { return which == 0 ? state[i] : stage[i]; }
@@ -28,13 +28,6 @@ vec2 bedSource(int which, ivec2 p) {
   const float sy = -g * 0.5 * (N.h + S.h) * ((S.eta - N.eta) - (S.h - N.h)) * (0.5 * (wN + wS)) +
                    0.5 * g * (0.5 * (N.h * N.h + S.h * S.h)) * (wS - wN);
   return vec2(sx, sy);
-}
-
-// W25: the share of a face's mass flux its upwind cell can give (l: left / top cell, r: right /
-// bottom); only outflow crosses an edge, so an upwind cell outside the grid never limits.
-float limitOfFace(float massFlux, ivec2 l, ivec2 r) {
-  const ivec2 up = massFlux > 0.0 ? l : r;
-  return insideGrid(up) ? limit_[cellOf(up)] : 1.0;
 }
 
 // Volume rate leaving cell q through its four faces (m^3/s), with W25's limits (corrector only).

@@ -5,20 +5,13 @@
 // of its two faces' on each axis; what leaves through an open edge into the outflow sum (W20).
 #include "sim.glsl"
 #include "sim_accum.glsl"
+#include "sim_limit.glsl"
 layout(local_size_x = SIM_GROUP_X, local_size_y = SIM_GROUP_Y) in;
 layout(std430, binding = SLOT_STATE_IN) readonly buffer StateIn { vec4 state[]; };
 layout(std430, binding = SLOT_STATE_OUT) writeonly buffer StateOut { vec4 stateOut[]; };
 layout(std430, binding = SLOT_FACE_X) readonly buffer FaceX { vec4 faceX[]; };
 layout(std430, binding = SLOT_FACE_Y) readonly buffer FaceY { vec4 faceY[]; };
-layout(std430, binding = SLOT_FV_LIMIT) readonly buffer Limit { float limit_[]; };  // W25, from fv_limit.comp
 layout(std430, binding = SLOT_FLUX) writeonly buffer Flux { vec4 flux[]; };
-
-// The share of a face's discharge its upwind cell gives (l: left / top cell, r: right / bottom);
-// an upwind cell outside the grid never limits.
-float limitOfFace(float q, ivec2 l, ivec2 r) {
-  const ivec2 up = q > 0.0 ? l : r;
-  return insideGrid(up) ? limit_[cellOf(up)] : 1.0;
-}
 
 void main() {
   const ivec2 p = ivec2(gl_GlobalInvocationID.xy);

@@ -108,7 +108,8 @@ TEST(SimInertialCpu, KinematicPlaneHoldsTheSameWaterAtEveryStepAndCellSize) {
   for (double cell : {20.0, 5.0}) {
     const auto r = runInertialPlane(cell, 30.0f);
     report("cells (m)", cell, r);
-    EXPECT_NEAR(r.stored / ref, 1.0, 0.02) << cell;
+    EXPECT_NEAR(r.stored / ref, 1.0, 0.02) << cell;  // measured +0.08 / +0.02 %
+    // The half-cell shift above is +10 % at 55 m on 20 m cells ((80 / 70)^0.6): measured 4.7 / 1.1 %.
     EXPECT_LT(r.worstDepth, 0.1) << cell;
   }
 }
