@@ -61,20 +61,23 @@ namespace ts = strata::sim;
 //    flops (primitives 3, sides 72, HLL 2 x 68, bed source 25); updates (W18, W24): faces 32 B,
 //    state 16 B, sources 8 B in, 16 B out: 72 B / 56 flops, the corrector 4 B of limits more and
 //    W25 and W19 (one std::pow) 76 B / 76 flops; fv_limit (W25) 16 B / 15; the wave speed (W10)
-//    12 B / 10.
+//    12 B / 10. W34's depth error, read and written by the sources and the corrector: 8 B each;
+//    18 flops in the sources (rain and evaporation, 9 each), 24 more in the corrector (four
+//    TwoSums of 6 and the fold, against one add before).
 struct Work {
   double bytes, flops;
 };
 constexpr Work kPipes{24 + 40 + 40, 8 + 68 + 30};
 constexpr Work kErosion{kPipes.bytes + 8 + 68 + 40, kPipes.flops + 75 + 10 + 48 + 120};
-constexpr Work kFlood{24 + 59 + 72 + 99 + 16 + 76 + 12, 8 + 236 + 56 + 246 + 15 + 76 + 10};
+constexpr Work kFlood{32 + 59 + 72 + 99 + 16 + 84 + 12, 26 + 236 + 56 + 246 + 15 + 100 + 10};
 // Flood mode's local-inertial scheme (W30-W33): sources 24 B / 8; the face pass reads h, bed and
 // the cell's four applied face discharges (24 B; a neighbour's are cache hits) and writes its east
 // and south faces (8 B), 45 flops a face (W31 3, W1a 5, q* 4, h^(7/3) with its cube root 12, the
 // implicit friction 16, the tangential mean 4, the division); fv_limit 16 B / 15; the update reads
 // 3 faces, a limit, h and s (20 B) and writes h, s, hu, hv and the four applied faces (32 B), 17
-// flops; the wave speed h alone, 4 B / 2.
-constexpr Work kFloodInertial{24 + 32 + 16 + 52 + 4, 8 + 90 + 15 + 17 + 2};
+// flops; the wave speed h alone, 4 B / 2. W34 as in flood mode: the sources and the update read and
+// write the depth error (8 B each; 18 and 24 flops more).
+constexpr Work kFloodInertial{32 + 32 + 16 + 60 + 4, 26 + 90 + 15 + 41 + 2};
 // Flood mode with sediment (E5's denominators and transport: 12 B, 40 flops) and the erosion
 // passes above, by law.
 constexpr Work kFloodForceBased{kFlood.bytes + 12 + 8 + 68 + 40, kFlood.flops + 40 + 10 + 48 + 120};
@@ -281,7 +284,7 @@ void run(benchmark::State& state, const ts::SimParams& p, Work work, int threads
 }
 
 // A halo exchange's share of GL work: read an 8-cell strip down the east side of an n x n grid
-// (state, flux, four layers: kBlockHalo) and write it back on the west side, as a block on a rank
+// (state, flux, four layers, accumulators: kBlockHalo) and write it back on the west side, as a block on a rank
 // does for each neighbour every step. Wall time (host transfers, not GPU time).
 void glHaloStrip(benchmark::State& state) {
   if (!gContext) {
@@ -299,7 +302,7 @@ void glHaloStrip(benchmark::State& state) {
     b.rect.x = 0;
     sim->writeBlock(b);
   }
-  state.counters["bytes_per_strip"] = double(n) * 8 * (16 + 16 + 16);
+  state.counters["bytes_per_strip"] = double(n) * 8 * (16 + 16 + 16 + 4 * ts::kAccumPerCell);
 }
 
 // The flat-plain flood after the Environment Agency's test 4 (tests/support/flat_plain.hpp) run

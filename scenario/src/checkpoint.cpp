@@ -17,7 +17,7 @@
 namespace strata::scenario {
 namespace {
 
-constexpr char kMagic[8] = {'S', 'T', 'R', 'A', 'T', 'A', 'C', '7'};  // 7: infiltration (series, cells)
+constexpr char kMagic[8] = {'S', 'T', 'R', 'A', 'T', 'A', 'C', '8'};  // 8: the depth error (W34)
 
 }  // namespace
 

@@ -1,7 +1,8 @@
 #version 450
 // Flood mode: W18 conservative update from the face fluxes, W23 centred bed-slope source,
 // W24 force noise floor, W25 outflow limits (corrector). final = 0: Heun predictor U1 = U0 - dt L(U0) into `stage`;
-// final = 1: U0 - dt (L(U0) + L(U1)) / 2 into stateOut (W22), then W19 Manning friction,
+// final = 1: U0 - dt (L(U0) + L(U1)) / 2 into stateOut (W22; the depth with compensation, W34),
+// then W19 Manning friction,
 // E5 sediment transport, E0 tilt.
 #include "sim.glsl"
 #include "sim_accum.glsl"
@@ -64,7 +65,8 @@ void main() {
   vec2 src = bedSource(0, p);
   if (final_ != 0) src = 0.5 * (src + bedSource(1, p));
   const float k = dt / A;
-  float hNew = h - k * ((E.x - W.x) * dy + S.x * wS - N.x * wN);
+  float hNew = final_ != 0 ? addDepthFaces(h, i, k, W.x * dy, E.x * dy, N.x * wN, S.x * wS)
+                           : h - k * ((E.x - W.x) * dy + S.x * wS - N.x * wN);
   float fx = src.x - ((E.y - W.z) * dy + S.w * wS - N.w * wN);
   float fy = src.y - (S.y * wS - N.z * wN + (E.w - W.w) * dy);
   const float magX = abs(E.y * dy) + abs(W.z * dy) + abs(S.w * wS) + abs(N.w * wN) + abs(src.x);
@@ -100,8 +102,8 @@ void main() {
       const float moved = denI > 0.0 ? s * A * volOut / denI : 0.0;
       sNew -= moved / A;
       if (edge[d]) {
-        kahanAdd(ACCUM_PER_CELL * i + ACCUM_OUTFLOW, volOut);
-        kahanAdd(ACCUM_PER_CELL * i + ACCUM_SEDIMENT_OUT, moved);
+        kahanAdd(accumAt(i, ACCUM_OUTFLOW), volOut);
+        kahanAdd(accumAt(i, ACCUM_SEDIMENT_OUT), moved);
       }
     } else if (volOut < 0.0 && !edge[d]) {
       const ivec2 q = p + kDir[d];

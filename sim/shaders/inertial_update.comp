@@ -1,7 +1,8 @@
 #version 450
 // Flood mode, local-inertial scheme: the update (W18 with W30's faces, W25 final). Each face's
 // discharge scaled by its upwind cell's limit; the depth from their net inflow into stateOut; the
-// applied discharges into flux (W, E, N, S: the next step's q0); the cell's discharge the mean
+// applied discharges into flux (W, E, N, S: the next step's q0), the depth with compensation
+// (W34); the cell's discharge the mean
 // of its two faces' on each axis; what leaves through an open edge into the outflow sum (W20).
 #include "sim.glsl"
 #include "sim_accum.glsl"
@@ -25,10 +26,10 @@ void main() {
   fN *= limitOfFace(fN, p - ivec2(0, 1), p);
   fS *= limitOfFace(fS, p, p + ivec2(0, 1));
   const vec4 s = state[i];
-  const float hNew = s.x + dt / A * ((fW - fE) * dy + fN * wN - fS * wS);
-  stateOut[i] = vec4(max(hNew, 0.0), s.y, 0.5 * (fW + fE), 0.5 * (fN + fS));
+  const float hNew = addDepthFaces(s.x, i, dt / A, fW * dy, fE * dy, fN * wN, fS * wS);
+  stateOut[i] = vec4(hNew, s.y, 0.5 * (fW + fE), 0.5 * (fN + fS));
   flux[i] = vec4(fW, fE, fN, fS);
   const float leaving = ((p.x == 0 ? max(-fW, 0.0) : 0.0) + (p.x == w - 1 ? max(fE, 0.0) : 0.0)) * dy * dt +
                     (p.y == 0 ? max(-fN, 0.0) : 0.0) * wN * dt + (p.y == h - 1 ? max(fS, 0.0) : 0.0) * wS * dt;
-  if (leaving > 0.0) kahanAdd(ACCUM_PER_CELL * i + ACCUM_OUTFLOW, leaving);
+  if (leaving > 0.0) kahanAdd(accumAt(i, ACCUM_OUTFLOW), leaving);
 }

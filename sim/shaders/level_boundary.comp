@@ -3,8 +3,9 @@
 // erosion): each listed cell gets depth
 // max(0, stage - bed), its discharge scaled with the depth (the velocity kept); the volume put in
 // (< 0: taken out) is summed per cell, compensated (W20), in the accumulator pair at slot 6 (the
-// one pair free: a plain float sum loses the small late exchanges of a nearly full basin). One
-// invocation per entry, each cell listed once.
+// one pair free: a plain float sum loses the small late exchanges of a nearly full basin), from
+// what the cell held (h + its depth error, W34; the error is then 0). One invocation per entry,
+// each cell listed once.
 #include "sim.glsl"
 #include "sim_accum.glsl"
 layout(local_size_x = 64) in;
@@ -22,5 +23,7 @@ void main() {
   const float h1 = max(0.0, e.stageM - bed[i]);
   const float keep = s.x > P.dryDepthM ? h1 / s.x : 0.0;
   state[i] = vec4(h1, s.y, s.z * keep, s.w * keep);
-  kahanAdd(ACCUM_PER_CELL * i + ACCUM_LEVEL, (h1 - s.x) * cellArea(y));
+  const uint ke = accumAt(i, ACCUM_DEPTH_ERROR);
+  kahanAdd(accumAt(i, ACCUM_LEVEL), ((h1 - s.x) - accum[ke]) * cellArea(y));
+  accum[ke] = 0.0;
 }

@@ -50,8 +50,8 @@ void main() {
       inflow += inD[d];
       sIn += state[cellOf(q)].y * cellArea(q.y) * fraction(q, d ^ 1);
     } else if (f[d] > 0.0) {
-      kahanAdd(ACCUM_PER_CELL * i + ACCUM_OUTFLOW, f[d] * dt);
-      kahanAdd(ACCUM_PER_CELL * i + ACCUM_SEDIMENT_OUT, s * A * fr);
+      kahanAdd(accumAt(i, ACCUM_OUTFLOW), f[d] * dt);
+      kahanAdd(accumAt(i, ACCUM_SEDIMENT_OUT), s * A * fr);
     }
     sOut += fr;
   }

@@ -1,6 +1,8 @@
 #version 450
-// W12: inflow of springs and inflow lines; one invocation per entry, each cell listed once.
+// W12: inflow of springs and inflow lines, into the depth with compensation (W34); one
+// invocation per entry, each cell listed once.
 #include "sim.glsl"
+#include "sim_accum.glsl"
 layout(local_size_x = 64) in;
 layout(std430, binding = SLOT_STATE_IN) buffer StateIn { vec4 state[]; };
 layout(std430, binding = SLOT_SOURCES) readonly buffer Sources { SourceEntry entries[]; };
@@ -10,5 +12,5 @@ void main() {
   if (k >= entryCount) return;
   const SourceEntry e = entries[k];
   const int y = int(e.cell) / P.width;
-  state[e.cell].x += e.rateM3S * P.dtS / cellArea(y);
+  state[e.cell].x = addDepth(state[e.cell].x, int(e.cell), e.rateM3S * P.dtS / cellArea(y));
 }

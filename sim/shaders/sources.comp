@@ -1,6 +1,7 @@
 #version 450
 // W11: rain (uniform + raster) and evaporation, then W11b infiltration, per cell, in place (each
-// cell only its own): the CPU backend's sourcesRow and infiltrationRow (sim/src/cpu_water.cpp).
+// cell only its own), into the depth with compensation (W34): the CPU backend's sourcesRow and
+// infiltrationRow (sim/src/cpu_water.cpp).
 #include "sim.glsl"
 #include "sim_accum.glsl"
 layout(local_size_x = SIM_GROUP_X, local_size_y = SIM_GROUP_Y) in;
@@ -14,17 +15,17 @@ void main() {
   const int i = cellOf(p);
   const float dt = P.dtS;
   float h = state[i].x;
-  h += (rainMmH[i] + P.rainMmPerHour) * kMmPerHourToMS * dt;
+  h = addDepth(h, i, (rainMmH[i] + P.rainMmPerHour) * kMmPerHourToMS * dt);
   const float e = min(h, P.evaporationMmPerHour * kMmPerHourToMS * dt);
-  h -= e;
-  kahanAdd(ACCUM_PER_CELL * i + ACCUM_EVAPORATED, e * cellArea(p.y));
+  h = addDepth(h, i, -e);
+  kahanAdd(accumAt(i, ACCUM_EVAPORATED), e * cellArea(p.y));
   const vec2 soil = infiltration[min(i, infiltration.length() - 1)];
-  const int k = ACCUM_PER_CELL * i + ACCUM_INFILTRATED;
+  const uint k = accumAt(i, ACCUM_INFILTRATED);
   const float area = cellArea(p.y);
   const float ksDt = soil.x * dt;  // the capacity is at least this: less water soaks in whole
   const float f = h <= ksDt ? max(h, 0.0) : min(h, infiltrationCapacity(ksDt, soil.y, accum[k] / area));
   if (f > 0.0) {
-    h -= f;
+    h = addDepth(h, i, -f);
     kahanAdd(k, f * area);
   }
   state[i].x = h;

@@ -116,6 +116,42 @@ inline void kahanAdd(float& sum, float& err, float v) {
   sum = t;
 }
 
+// W34: a cell's depth held as h + err, two floats. twoSumInto adds v to h and the exact rounding
+// error of that sum to err (Knuth's TwoSum: six float operations, no branch); settleDepth folds
+// err into h (Fast2Sum: h the rounded sum, err exactly what it could not hold) and keeps the
+// depth at or above 0 (a result at or below 0, rounding where W25 empties a cell or a cell dried
+// by evaporation or the soil, is 0 with no error). The only rounding left is err's own, ~1e-7 of
+// an error that is itself below an ulp of h.
+inline void twoSumInto(float& h, float& err, float v) {
+  const float s = h + v;
+  const float b = s - h;
+  err += (h - (s - b)) + (v - b);
+  h = s;
+}
+inline void settleDepth(float& h, float& err) {
+  const float s = h + err;
+  err -= s - h;
+  h = s;
+  const bool wet = h > 0.0f;
+  h = wet ? h : 0.0f;
+  err = wet ? err : 0.0f;
+}
+inline void addDepth(float& h, float& err, float d) {
+  twoSumInto(h, err, d);
+  settleDepth(h, err);
+}
+// W34 for a flux update: the depth changed by what its four faces bring, each face's term
+// k (f w) (k = dt / A, f the face's flux, w its width; > 0 into the cell for W and N) added on its
+// own. The neighbour across a face computes the same float term, so what one cell gains the
+// other loses exactly (summed first, each cell's net would round on its own).
+inline void addDepthFaces(float& h, float& err, float k, float inW, float outE, float inN, float outS) {
+  twoSumInto(h, err, k * inW);
+  twoSumInto(h, err, -(k * outE));
+  twoSumInto(h, err, k * inN);
+  twoSumInto(h, err, -(k * outS));
+  settleDepth(h, err);
+}
+
 // W21 slopes from the backward and forward differences a, b (0 at an extremum): minmod, the
 // smaller one; van Leer's monotonised central (MC), sign * min(2|a|, 2|b|, |a + b| / 2).
 inline float minmod(float a, float b) {

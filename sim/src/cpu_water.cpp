@@ -22,23 +22,25 @@ constexpr int kDiagDy[4] = {-1, -1, 1, 1};
 // Sources
 
 // sim/shaders/sources.comp for a row: rain (raster, may be null, plus uniform) and evaporation,
-// the evaporated volume summed with compensation.
-STRATA_ROW_KERNEL void sourcesRow(float* h, float* sum, float* err, const float* rain, float area, int x0, int x1,
-                                  float uniform, float dtS, float evapMax) {
+// into the depth with compensation (W34, error in `herr`), the evaporated volume summed with
+// compensation.
+STRATA_ROW_KERNEL void sourcesRow(float* h, float* herr, float* sum, float* err, const float* rain, float area, int x0,
+                                  int x1, float uniform, float dtS, float evapMax) {
   auto cells = [=](auto kRaster) {
     const float uniformDepth = (0.0f + uniform) * kMmPerHourToMS * dtS;  // a raster of 0 mm/h
 #pragma omp simd
     for (int x = x0; x < x1; ++x) {
-      float hx = h[x];
+      float hx = h[x], ex = herr[x];
       if constexpr (decltype(kRaster)::value) {
-        hx += (rain[x] + uniform) * kMmPerHourToMS * dtS;
+        addDepth(hx, ex, (rain[x] + uniform) * kMmPerHourToMS * dtS);
       } else {
-        hx += uniformDepth;
+        addDepth(hx, ex, uniformDepth);
       }
       const float e = minOf(hx, evapMax);
-      hx -= e;
+      addDepth(hx, ex, -e);
       kahanAdd(sum[x], err[x], e * area);
       h[x] = hx;
+      herr[x] = ex;
     }
   };
   rain ? cells(std::true_type{}) : cells(std::false_type{});
@@ -47,8 +49,8 @@ STRATA_ROW_KERNEL void sourcesRow(float* h, float* sum, float* err, const float*
 // sim/shaders/sources.comp for a row, after rain and evaporation: each cell loses to the soil
 // what its infiltration capacity over the step allows of its water (W11b), the infiltrated
 // volume summed with compensation; that sum over the cell's area is the capacity's F.
-STRATA_ROW_KERNEL void infiltrationRow(float* h, float* sum, float* err, const float* ks, const float* g, float area,
-                                       int x0, int x1, float dtS) {
+STRATA_ROW_KERNEL void infiltrationRow(float* h, float* herr, float* sum, float* err, const float* ks, const float* g,
+                                       float area, int x0, int x1, float dtS) {
   for (int x = x0; x < x1; ++x) {
     const float hx = h[x];
     if (!(hx > 0.0f)) continue;  // dry: nothing to lose
@@ -56,7 +58,7 @@ STRATA_ROW_KERNEL void infiltrationRow(float* h, float* sum, float* err, const f
     const float ksDt = ks[x] * dtS;
     const float f = hx <= ksDt ? hx : minOf(hx, infiltrationCapacity(ksDt, g[x], sum[x] / area));
     if (f > 0.0f) {
-      h[x] -= f;
+      addDepth(h[x], herr[x], -f);
       kahanAdd(sum[x], err[x], f * area);
     }
   }
@@ -68,17 +70,18 @@ void Impl::sourcesPass(const std::vector<SourceEntry>& entries) {
   forRuns(sources, [&](const Run& r, int) {
     const float evapMax = p.evaporationMmPerHour * kMmPerHourToMS * dt;
     for (int y = r.y0; y < r.y1; ++y) {
-      sourcesRow(now().h.row(y), accum[kAccumEvaporated].row(y), accum[kAccumEvaporated + 1].row(y),
+      float* herr = accum[kAccumDepthError].row(y);
+      sourcesRow(now().h.row(y), herr, accum[kAccumEvaporated].row(y), accum[kAccumEvaporated + 1].row(y),
                  rain.empty() ? nullptr : rain.row(y), rowArea[size_t(y)], r.x0, r.x1, p.rainMmPerHour, dt, evapMax);
       if (!infilKs.empty()) {
-        infiltrationRow(now().h.row(y), accum[kAccumInfiltrated].row(y), accum[kAccumInfiltrated + 1].row(y),
+        infiltrationRow(now().h.row(y), herr, accum[kAccumInfiltrated].row(y), accum[kAccumInfiltrated + 1].row(y),
                         infilKs.row(y), infilG.row(y), rowArea[size_t(y)], r.x0, r.x1, dt);
       }
     }
   });
   for (const auto& e : entries) {
     const int y = int(e.cell / uint32_t(w)), x = int(e.cell % uint32_t(w));
-    now().h.at(x, y) += e.rateM3S * dt / rowArea[size_t(y)];
+    addDepth(now().h.at(x, y), accum[kAccumDepthError].at(x, y), e.rateM3S * dt / rowArea[size_t(y)]);
   }
 }
 
@@ -618,6 +621,7 @@ struct FvRow {
   const float *h, *s, *hu, *hv, *sN, *sS;
   const float *srcX, *srcY;
   float *oh, *os, *ohu, *ohv;
+  float* herr;  // the depth's error (W34), read and written by the corrector
 };
 
 namespace {
@@ -649,6 +653,12 @@ inline void fvUpdateCell(const FvConst& c, const FvRow& r, int x, FaceFlux* limi
   const float sx = r.srcX[x], sy = r.srcY[x];
   const float k = c.dt / r.A;
   float hNew = h - k * ((E.mass - W.mass) * dy + S.mass * wS - N.mass * wN);
+  if constexpr (kFinal) {  // W34: the step's depth with compensation, face by face
+    float e = r.herr[x];
+    hNew = h;
+    addDepthFaces(hNew, e, k, W.mass * dy, E.mass * dy, N.mass * wN, S.mass * wS);
+    r.herr[x] = e;
+  }
   // W24: a net force below float32 resolution of the forces it sums is rounding, not a
   // pressure gradient (the momentum analogue of W1a): a lake at rest stays at rest.
   float fx = sx - ((E.nL - W.nR) * dy + S.t * wS - N.t * wN);
@@ -773,7 +783,8 @@ void Impl::fvUpdatePass(bool final) {
                     o.h.row(y),
                     o.s.row(y),
                     o.hu.row(y),
-                    o.hv.row(y)};
+                    o.hv.row(y),
+                    accum[kAccumDepthError].row(y)};
       auto edgeCell = [&](int x) {
         FaceFlux limited[4];
         if (final) {
@@ -964,6 +975,7 @@ struct InertialRow {
   const float *lim, *limN, *limS;  // W25 limits of rows y, y - 1, y + 1 (row y at an edge)
   const float* h;
   float *oh, *ohu, *ohv, *qW, *qE, *qN, *qS;
+  float* herr;  // the depth's error (W34)
 };
 
 namespace {
@@ -982,8 +994,10 @@ inline float inertialUpdateCell(const InertialRow& r, int x, bool inW, bool inE,
   fE *= fE > 0.0f ? kc : ke;
   fN *= fN > 0.0f ? kn : kc;
   fS *= fS > 0.0f ? kc : ks;
-  const float hNew = r.h[x] + r.dt / r.A * ((fW - fE) * r.dy + fN * r.wN - fS * r.wS);
-  r.oh[x] = maxOf(hNew, 0.0f);
+  float hNew = r.h[x], e = r.herr[x];
+  addDepthFaces(hNew, e, r.dt / r.A, fW * r.dy, fE * r.dy, fN * r.wN, fS * r.wS);  // W34
+  r.oh[x] = hNew;
+  r.herr[x] = e;
   r.ohu[x] = 0.5f * (fW + fE);
   r.ohv[x] = 0.5f * (fN + fS);
   r.qW[x] = fW, r.qE[x] = fE, r.qN[x] = fN, r.qS[x] = fS;
@@ -1025,7 +1039,8 @@ void Impl::inertialUpdatePass() {
                           flux[0].row(y),
                           flux[1].row(y),
                           flux[2].row(y),
-                          flux[3].row(y)};
+                          flux[3].row(y),
+                          accum[kAccumDepthError].row(y)};
       std::copy(u.s.row(y) + run.x0, u.s.row(y) + run.x1, o.s.row(y) + run.x0);
       auto edgeCell = [&](int x) {
         const float out = inertialUpdateCell<true>(r, x, x > 0, x<w - 1, y> 0, y < h - 1);
@@ -1050,10 +1065,12 @@ void Impl::levelPass(const std::vector<LevelEntry>& entries) {
     const int y = int(e.cell / uint32_t(w)), x = int(e.cell % uint32_t(w));
     const float h0 = u.h.at(x, y), h1 = maxOf(0.0f, e.stageM - bed.at(x, y));
     const float keep = h0 > p.dryDepthM ? h1 / h0 : 0.0f;
+    float& err = accum[kAccumDepthError].at(x, y);  // the cell held h0 + err (W34); it holds h1
     u.h.at(x, y) = h1;
     u.hu.at(x, y) *= keep;
     u.hv.at(x, y) *= keep;
-    kahanAdd(accum[kAccumLevel].at(x, y), accum[kAccumLevel + 1].at(x, y), (h1 - h0) * rowArea[size_t(y)]);
+    kahanAdd(accum[kAccumLevel].at(x, y), accum[kAccumLevel + 1].at(x, y), ((h1 - h0) - err) * rowArea[size_t(y)]);
+    err = 0.0f;
   }
 }
 

@@ -319,7 +319,9 @@ void Solver::restartAt(double timeS) {
 }
 
 void Solver::clearAccumulators() {
-  static_assert(kAccumInfiltrated + 2 == kAccumPerCell, "the infiltration pair is a cell's last");
+  // The infiltration pair (the soil's state) and the depth error (the water's) are kept.
+  static_assert(kAccumInfiltrated + 2 == kAccumDepthError && kAccumDepthError + 1 == kAccumPerCell,
+                "the infiltration pair and the depth error are a cell's last");
   CellBlock b = readBlock(0, 0, grid_.width, grid_.height, kBlockAccum);
   for (size_t i = 0; i < b.accum.size(); i += kAccumPerCell) {
     std::fill_n(&b.accum[i], kAccumInfiltrated, 0.0f);  // the sums before the infiltration pair

@@ -9,7 +9,7 @@
 namespace strata::sim {
 namespace {
 
-constexpr char kMagic[8] = {'S', 'T', 'R', 'A', 'T', 'A', 'S', '2'};  // 2: 10 accumulator floats per cell
+constexpr char kMagic[8] = {'S', 'T', 'R', 'A', 'T', 'A', 'S', '3'};  // 3: 11 accumulator floats per cell
 
 struct Writer : ByteWriter {
   void state(const SolverState& s) {

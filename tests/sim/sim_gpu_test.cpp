@@ -135,6 +135,24 @@ TEST_F(GlTest, SimRainAndSourcesBalance) {
   EXPECT_LT(std::abs(st.waterBalanceM3()), 1e-5 * moved);
 }
 
+// W34, issue 35, on the GL backend: the CPU test's 150,000 float32 steps (SimWaterCpu.
+// BalanceHoldsOver150kFloat32Steps) close the budget to 1e-5 of the water with either scheme.
+TEST_F(GlTest, SimBalanceHoldsOver150kFloat32Steps) {
+  for (auto scheme : {strata::sim::FloodScheme::kFiniteVolume, strata::sim::FloodScheme::kLocalInertial}) {
+    auto sim = GlSolver::create(test::sloshingBox(16), test::longRainParams(scheme));
+    ASSERT_TRUE(sim) << sim.message();
+    ASSERT_TRUE(sim->addSource(test::longRainSpring()));
+    const auto t0 = std::chrono::steady_clock::now();
+    sim->step(int(test::kLongRainSteps));
+    const auto st = sim->stats();
+    const double water = st.initialWaterM3 + st.rainM3 + st.inflowM3;
+    std::printf("GL, scheme %d: %lld steps in %.1f s, stored %.2f -> %.2f m3, balance %.2e\n", int(scheme), st.steps,
+                seconds(t0), st.initialWaterM3, st.storedWaterM3, st.waterBalanceM3() / water);
+    EXPECT_EQ(st.steps, test::kLongRainSteps);
+    EXPECT_LT(std::abs(st.waterBalanceM3()), 1e-5 * water) << int(scheme);
+  }
+}
+
 // W11b on the GL backend and on tiles of 4 x 3 cells: Green-Ampt under ponding on the flat basin
 // (tests/sim/sim_infiltration_test.cpp) follows its analytic curve at any step, as on the CPU,
 // and each cell's soil state is its own (tiles take the same answer).

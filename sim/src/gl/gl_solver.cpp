@@ -32,7 +32,8 @@ std::vector<gl::ShaderDefine> slots::kernelDefines() {
                      {"ACCUM_EVAPORATED", kAccumEvaporated},
                      {"ACCUM_SEDIMENT_OUT", kAccumSedimentOut},
                      {"ACCUM_LEVEL", kAccumLevel},
-                     {"ACCUM_INFILTRATED", kAccumInfiltrated}});
+                     {"ACCUM_INFILTRATED", kAccumInfiltrated},
+                     {"ACCUM_DEPTH_ERROR", kAccumDepthError}});
   return d;
 }
 
@@ -403,6 +404,17 @@ template <class Impl>
 std::array<gl::Buffer*, 5> partBuffers(Impl& s, bool diag) {
   return {&s.curMut(), &s.flux, diag ? &s.fluxDiag : nullptr, &s.layerBuf, &s.accum};
 }
+
+// The accumulators of `cells` cells between the GPU's plane-major order (kAccumPerCell planes)
+// and CellBlock's cell-major one: toCells from planes to cells, else back.
+void transposeAccum(const std::vector<float>& from, std::vector<float>& to, size_t cells, bool toCells) {
+  for (size_t c = 0; c < cells; ++c) {
+    for (size_t k = 0; k < size_t(kAccumPerCell); ++k) {
+      const size_t planar = k * cells + c, cellMajor = c * size_t(kAccumPerCell) + k;
+      to[toCells ? cellMajor : planar] = from[toCells ? planar : cellMajor];
+    }
+  }
+}
 }  // namespace
 
 CellBlock GlSolver::readBlock(int x0, int y0, int width, int height, unsigned parts) const {
@@ -419,6 +431,12 @@ CellBlock GlSolver::readBlock(int x0, int y0, int width, int height, unsigned pa
     gl::Buffer* buf = buffers[k++];
     if (!(parts & bit) || !buf) return;
     out.resize(per * planes * b.cells());
+    if (&out == &b.accum) {  // plane-major on the GPU (sim_accum.glsl), cell-major in the block
+      std::vector<float> planar(out.size());
+      s.downloadRect(*buf, Impl::Rect{1, per, x0, y0, width, height}, planar.data());
+      transposeAccum(planar, out, b.cells(), true);
+      return;
+    }
     s.downloadRect(*buf, Impl::Rect{per, planes, x0, y0, width, height}, out.data());
   });
   return b;
@@ -434,7 +452,14 @@ void GlSolver::writeBlock(const CellBlock& b) {
   size_t k = 0;
   CellBlock::forEachPart(b, L, [&](unsigned, const std::vector<float>& in, size_t per, size_t planes) {
     gl::Buffer* buf = buffers[k++];
-    if (!in.empty() && buf) s.uploadRect(*buf, Impl::Rect{per, planes, r.x, r.y, r.width, r.height}, in.data());
+    if (in.empty() || !buf) return;
+    if (&in == &b.accum) {  // cell-major in the block, plane-major on the GPU
+      std::vector<float> planar(in.size());
+      transposeAccum(in, planar, b.cells(), false);
+      s.uploadRect(*buf, Impl::Rect{1, per, r.x, r.y, r.width, r.height}, planar.data());
+      return;
+    }
+    s.uploadRect(*buf, Impl::Rect{per, planes, r.x, r.y, r.width, r.height}, in.data());
   });
   if (!b.layers.empty()) s.recomputeBed(r.x, r.y, r.width, r.height);
 }

@@ -277,9 +277,10 @@ struct DistributedSolver::Impl {
     const CellRect li = b.local(b.interior);
     const CellBlock a = b.solver->readBlock(li.x, li.y, li.width, li.height, kBlockAccum);
     for (size_t i = 0; i < a.cells(); ++i) {
-      for (int k = 1; k < kAccumPerCell; k += 2) {
+      for (int k = 1; k < kAccumDepthError; k += 2) {  // the sums' errors
         if (!allZeroBits(&a.accum[kAccumPerCell * i + size_t(k)], 1)) return false;
       }
+      if (!allZeroBits(&a.accum[kAccumPerCell * i + kAccumDepthError], 1)) return false;
     }
     return true;
   }

@@ -59,16 +59,19 @@ struct SimStats {
   }
 };
 
-/// Each cell's compensated (Kahan) sums (W20), a (sum, error) pair of floats each, m^3: the
-/// offsets into a cell's kAccumPerCell floats of CellBlock::accum and SolverState::accum. The GL
-/// kernels get the same numbers as #defines (ACCUM_PER_CELL, ACCUM_OUTFLOW, ...).
+/// Each cell's compensated (Kahan) sums (W20), a (sum, error) pair of floats each, m^3, and the
+/// error of its compensated depth (W34): the offsets into a cell's kAccumPerCell floats of
+/// CellBlock::accum and SolverState::accum. The GL kernels get the same numbers as #defines
+/// (ACCUM_PER_CELL, ACCUM_OUTFLOW, ...).
 enum AccumOffset : int {
   kAccumOutflow = 0,      ///< water out through open edges
   kAccumEvaporated = 2,   ///< evaporated (W11)
   kAccumSedimentOut = 4,  ///< suspended sediment out through open edges
   kAccumLevel = 6,        ///< gained (> 0) or lost at a fixed level (W26)
   kAccumInfiltrated = 8,  ///< lost to the soil (W11b)
-  kAccumPerCell = 10,
+  /// Not a sum: what the float depth h could not hold, m; the cell holds h + this (W34).
+  kAccumDepthError = 10,
+  kAccumPerCell = 11,
 };
 
 /// Which parts of a rectangle of cells readBlock() reads (bits).
@@ -77,7 +80,9 @@ enum BlockParts : unsigned {
   kBlockFlux = 2u,    ///< pipe outflows (and diagonal ones when the solver has them)
   kBlockLayers = 4u,  ///< layer thicknesses
   kBlockAccum = 8u,   ///< compensated budget sums
-  kBlockHalo = 7u,    ///< what a halo exchange carries: state, fluxes, layers
+  /// What a halo exchange carries: state, fluxes, layers and the accumulators, whose depth error
+  /// (W34) the next steps' halo updates read (the sums there are the owner's, summed by it alone).
+  kBlockHalo = 15u,
   kBlockAll = 15u,
 };
 
@@ -89,7 +94,7 @@ struct CellBlock {
   std::vector<float> flux;      ///< 4 per cell: pipe outflows W, E, N, S (m^3/s)
   std::vector<float> fluxDiag;  ///< 4 per cell: diagonal pipes NW, NE, SW, SE (with them)
   std::vector<float> layers;    ///< layer-major: layers[l * cells + cell] (m)
-  std::vector<float> accum;     ///< kAccumPerCell per cell: compensated sums (AccumOffset)
+  std::vector<float> accum;     ///< kAccumPerCell per cell: compensated sums, depth error (AccumOffset)
   size_t cells() const { return size_t(rect.width) * size_t(rect.height); }
 
   /// The one list of a block's parts: f(part's BlockParts bit, its values, floats per cell of a
