@@ -239,6 +239,7 @@ Status writeReport(const fs::path& runDir, const ReportInput& in) {
     md += "Run " + std::string(date) + " on " + in.backend + ": " + formatDuration(sum.simulatedS) + " simulated in " +
           formatDuration(sum.wallS) + " of wall time, " + std::to_string(sum.steps) + " steps";
     if (sum.steps > 0) md += fmt(" (mean step %.2f s)", sum.simulatedS / double(sum.steps));
+    if (sum.spinUp.steps > 0) md += ", after the spin-up's " + std::to_string(sum.spinUp.steps) + " (in the wall time)";
     md += ".";
     if (!sum.completed) md += " **The run was stopped before the end; the numbers are those of the last interval.**";
     md += "\n\n";

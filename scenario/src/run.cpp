@@ -1214,7 +1214,7 @@ class Session {
   Result<RunSummary> finish() {
     const auto st = run_->solver().stats();
     summary_.simulatedS = st.timeS;
-    summary_.steps = st.steps;
+    summary_.steps = st.steps - spinUp_.steps;  // the run's own: the solver counts the spin-up's too
     summary_.wallS = wallSoFar();
     summary_.spinUp = spinUp_;
     summary_.files = {"scenario.toml", "series.csv"};

@@ -251,8 +251,12 @@ TEST(ScenarioRun, SpinUpStartsTheRunWithTheBaseFlowInItsBed) {
     EXPECT_LT(std::abs(in - out - (stored - u.storedM3)), 1e-4 * (in + u.storedM3)) << "t = " << r[0];
     EXPECT_LT(std::abs(r[9]), 1e-4) << "the CSV's own balance column, t = " << r[0];
   }
+  // The run's steps are its own (the series counts the solver's, the spin-up's included), and so
+  // is its mean step.
+  EXPECT_EQ(summary->steps + u.steps, (long long)rows.back()[1]);
   const std::string report = slurp(opt.outDir / "report.md");
   EXPECT_NE(report.find("| base flow | 400 m³/s"), std::string::npos) << report;
+  EXPECT_NE(report.find(std::to_string(summary->steps) + " steps (mean step"), std::string::npos) << report;
 
   // A dam break starts at t = 0, before which the spin-up runs: refused, naming the key.
   std::string dam = text +

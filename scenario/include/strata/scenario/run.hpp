@@ -116,11 +116,11 @@ struct ProbeSummary {
 };
 
 struct RunSummary {
-  bool completed = false;  ///< false: stopped by Ctrl-C or stopAfterIntervals
-  std::string backend;     ///< what ran it (Solver::backendName)
-  int ranks = 1;           ///< MPI ranks it ran on (1: one process)
-  double simulatedS = 0, wallS = 0;
-  long long steps = 0;
+  bool completed = false;            ///< false: stopped by Ctrl-C or stopAfterIntervals
+  std::string backend;               ///< what ran it (Solver::backendName)
+  int ranks = 1;                     ///< MPI ranks it ran on (1: one process)
+  double simulatedS = 0, wallS = 0;  ///< from t = 0; the wall time includes a spin-up's
+  long long steps = 0;               ///< from t = 0 (a spin-up's are SpinUpSummary::steps)
   std::vector<SeriesRow> series;
   std::vector<std::string> files;          ///< written, relative to the run folder
   std::optional<MaterialBudget> material;  ///< erosion runs
