@@ -30,7 +30,7 @@ cd "$root"
 data=$root/../shared/data
 programs=(bench/strata_bench_sim bench/strata_bench_gl bench/strata_bench_render
   tests/sim/strata_sim_gpu_tests tests/gl/strata_gl_gpu_tests tests/render/strata_render_terrain_tests
-  tests/render/strata_render_tests tests/procgen/strata_procgen_gpu_tests)
+  tests/render/strata_render_tests tests/procgen/strata_procgen_gpu_tests apps/strata)
 for p in "${programs[@]}"; do [[ -x $build/$p ]] || { echo "gpu-carry: $build/$p is not built" >&2; exit 1; }; done
 mkdir -p .git/info
 for d in .gl .gpu .gpub .gpur .gpua; do grep -qx "/$d/" .git/info/exclude 2>/dev/null || echo "/$d/" >>.git/info/exclude; done
