@@ -652,12 +652,13 @@ inline void fvUpdateCell(const FvConst& c, const FvRow& r, int x, FaceFlux* limi
   const float h = r.h[x], s = r.s[x], hu = r.hu[x], hv = r.hv[x];
   const float sx = r.srcX[x], sy = r.srcY[x];
   const float k = c.dt / r.A;
-  float hNew = h - k * ((E.mass - W.mass) * dy + S.mass * wS - N.mass * wN);
+  float hNew = h;
   if constexpr (kFinal) {  // W34: the step's depth with compensation, face by face
     float e = r.herr[x];
-    hNew = h;
     addDepthFaces(hNew, e, k, W.mass * dy, E.mass * dy, N.mass * wN, S.mass * wS);
     r.herr[x] = e;
+  } else {  // the predictor's stage: read by the corrector's faces only
+    hNew -= k * ((E.mass - W.mass) * dy + S.mass * wS - N.mass * wN);
   }
   // W24: a net force below float32 resolution of the forces it sums is rounding, not a
   // pressure gradient (the momentum analogue of W1a): a lake at rest stays at rest.
