@@ -31,6 +31,7 @@
 #include "flat_plain.hpp"
 
 #include <strata/gl/context.hpp>
+#include <strata/gl/objects.hpp>
 #include <strata/gl/state.hpp>
 #include <strata/sim/cpu_solver.hpp>
 #include <strata/sim/gl/gl_solver.hpp>
@@ -259,6 +260,7 @@ void run(benchmark::State& state, const ts::SimParams& p, Work work, int threads
   finish();
   const int steps = n >= 1024 ? 1 : 4;
   double seconds = 0;
+  const gl::CallCounts calls0 = gl::callCounts();
   for (auto _ : state) {
     const auto t0 = std::chrono::steady_clock::now();
     sim->step(steps);
@@ -272,6 +274,11 @@ void run(benchmark::State& state, const ts::SimParams& p, Work work, int threads
   state.counters["B/cell"] = work.bytes;
   state.counters["flop/cell"] = work.flops;
   if (threads == 0) {
+    // What a step asks of the host: dispatches, and reads back (each a wait for the GPU).
+    const gl::CallCounts calls1 = gl::callCounts();
+    const double stepsRun = double(state.iterations()) * steps;
+    state.counters["dispatches/step"] = double(calls1.dispatches - calls0.dispatches) / stepsRun;
+    state.counters["reads/step"] = double(calls1.hostReads - calls0.hostReads) / stepsRun;
     // GL: the floor is the device's own shader-copy bandwidth (no GPU peak-flop figure is measured).
     if (gFloors.glCopyGBs > 0)
       state.counters["x_bw_floor"] = perStep / (work.bytes * cells / (gFloors.glCopyGBs * 1e9));
@@ -325,14 +332,20 @@ void flatPlain(benchmark::State& state, ts::FloodScheme scheme, bool gl) {
     }
     if (!sim || !sim->addSource(plain.breach)) return state.SkipWithError("the solver could not be created");
     const auto t0 = std::chrono::steady_clock::now();
+    const gl::CallCounts calls0 = gl::callCounts();
     sim->advance(duration);
     if (gl) gl::finish();
+    const gl::CallCounts calls1 = gl::callCounts();
     state.SetIterationTime(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
     const auto st = sim->stats();
     state.counters["steps"] = double(st.steps);
     state.counters["balance"] = st.waterBalanceM3() / st.inflowM3;
     state.counters["cell_steps/s"] = benchmark::Counter(double(st.steps) * double(plain.input.baseM.size()),
                                                         benchmark::Counter::kIsIterationInvariantRate);
+    if (gl) {
+      state.counters["dispatches/step"] = double(calls1.dispatches - calls0.dispatches) / double(st.steps);
+      state.counters["reads/step"] = double(calls1.hostReads - calls0.hostReads) / double(st.steps);
+    }
     state.SetLabel(sim->backendName());
   }
 }

@@ -3,6 +3,7 @@
 #include <epoxy/gl.h>
 
 #include <cstdio>
+#include <string_view>
 #include <type_traits>
 
 #include <glm/gtc/type_ptr.hpp>
@@ -22,6 +23,12 @@ void deleteProgram(uint32_t id) { glDeleteProgram(id); }
 void deleteShader(uint32_t id) { glDeleteShader(id); }
 void deleteQuery(uint32_t id) { glDeleteQueries(1, &id); }
 }  // namespace detail
+
+namespace {
+thread_local CallCounts tCounts;
+}  // namespace
+
+const CallCounts& callCounts() { return tCounts; }
 
 // ---- Buffer ----------------------------------------------------------------------------------
 
@@ -51,6 +58,8 @@ void Buffer::upload(size_t offset, size_t bytes, const void* data) {
 
 void Buffer::download(size_t offset, size_t bytes, void* out) const {
   STRATA_CHECK(offset + bytes <= bytes_) << "download of " << bytes << " bytes at " << offset << " past " << bytes_;
+  ++tCounts.hostReads;
+  tCounts.hostReadBytes += bytes;
   glGetNamedBufferSubData(id(), GLintptr(offset), GLsizeiptr(bytes), out);
 }
 
@@ -177,12 +186,16 @@ void Texture::clear(int level) {
 void Texture::download(void* out, size_t bytes, int level) const {
   const auto f = detail::glFormat(format_);
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  ++tCounts.hostReads;
+  tCounts.hostReadBytes += bytes;
   glGetTextureImage(id(), level, f.format, f.type, GLsizei(bytes), out);
 }
 
 void Texture::downloadRegion(void* out, size_t bytes, int x, int y, int w, int h, int level, int layer) const {
   const auto f = detail::glFormat(format_);
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  ++tCounts.hostReads;
+  tCounts.hostReadBytes += bytes;
   glGetTextureSubImage(id(), level, x, y, layer, w, h, 1, f.format, f.type, GLsizei(bytes), out);
 }
 
@@ -381,6 +394,19 @@ Result<Program::Stage> loadStage(ShaderStage stage, const std::string& name) {
 
 }  // namespace
 
+namespace {
+// The name of a program's active resource (program interface query).
+std::string resourceName(GLuint program, GLenum interface, GLuint index) {
+  GLint length = 0;
+  const GLenum prop = GL_NAME_LENGTH;
+  glGetProgramResourceiv(program, interface, index, 1, &prop, 1, nullptr, &length);
+  std::string s(size_t(std::max(length, 1)), '\0');
+  glGetProgramResourceName(program, interface, index, GLsizei(s.size()), nullptr, s.data());
+  while (!s.empty() && s.back() == '\0') s.pop_back();
+  return s;
+}
+}  // namespace
+
 Result<Program> Program::link(const std::vector<Stage>& stages, const std::string& label,
                               std::span<const ShaderDefine> defines) {
   std::vector<Object<detail::deleteShader>> shaders;
@@ -407,6 +433,24 @@ Result<Program> Program::link(const std::vector<Stage>& stages, const std::strin
   glGetProgramiv(p.id(), GL_LINK_STATUS, &ok);
   if (!ok) return fail("gl: program '" + label + "' does not link:\n" + infoLog(p.id(), true));
   glObjectLabel(GL_PROGRAM, p.id(), GLsizei(label.size()), label.c_str());
+  const bool compute =
+      std::any_of(stages.begin(), stages.end(), [](const Stage& s) { return s.stage == ShaderStage::kCompute; });
+  if (compute) {
+    GLint g[3] = {1, 1, 1};
+    glGetProgramiv(p.id(), GL_COMPUTE_WORK_GROUP_SIZE, g);
+    p.groupSize_ = {g[0], g[1], g[2]};
+  }
+  GLint count = 0;
+  glGetProgramInterfaceiv(p.id(), GL_UNIFORM, GL_ACTIVE_RESOURCES, &count);
+  for (GLint i = 0; i < count; ++i) {
+    const GLenum prop = GL_LOCATION;
+    GLint loc = -1;
+    glGetProgramResourceiv(p.id(), GL_UNIFORM, GLuint(i), 1, &prop, 1, nullptr, &loc);
+    if (loc < 0) continue;  // in a uniform block
+    std::string name = resourceName(p.id(), GL_UNIFORM, GLuint(i));
+    if (name.size() > 3 && name.ends_with("[0]")) p.locations_.emplace_back(name.substr(0, name.size() - 3), loc);
+    p.locations_.emplace_back(std::move(name), loc);
+  }
   return p;
 }
 
@@ -423,7 +467,16 @@ Result<Program> Program::graphics(const std::string& vertexName, const std::stri
 }
 
 void Program::use() const { glUseProgram(id()); }
-int Program::location(const char* name) const { return glGetUniformLocation(id(), name); }
+int Program::location(const char* name) const {
+  const std::string_view key(name);
+  for (const auto& [n, loc] : locations_) {
+    if (n == key) return loc;
+  }
+  ++tCounts.queries;
+  const int loc = glGetUniformLocation(id(), name);
+  locations_.emplace_back(name, loc);
+  return loc;
+}
 void Program::set(const char* name, float v) const { glProgramUniform1f(id(), location(name), v); }
 void Program::set(const char* name, int v) const { glProgramUniform1i(id(), location(name), v); }
 void Program::set(const char* name, unsigned v) const { glProgramUniform1ui(id(), location(name), v); }
@@ -446,29 +499,18 @@ void Program::set(const char* name, const glm::mat4& v) const {
   glProgramUniformMatrix4fv(id(), location(name), 1, GL_FALSE, glm::value_ptr(v));
 }
 
-glm::ivec3 Program::workGroupSize() const {
-  GLint s[3] = {1, 1, 1};
-  glGetProgramiv(id(), GL_COMPUTE_WORK_GROUP_SIZE, s);
-  return {s[0], s[1], s[2]};
-}
+glm::ivec3 Program::workGroupSize() const { return groupSize_; }
 
 void Program::dispatchCovering(int x, int y, int z) const {
-  const glm::ivec3 g = workGroupSize();
+  const glm::ivec3 g = groupSize_;
   use();
+  ++tCounts.dispatches;
   glDispatchCompute(GLuint((x + g.x - 1) / g.x), GLuint((y + g.y - 1) / g.y), GLuint((z + g.z - 1) / g.z));
 }
 
 std::vector<ProgramResource> Program::resources() const {
   std::vector<ProgramResource> out;
-  auto name = [&](GLenum interface, GLuint index) {
-    GLint length = 0;
-    const GLenum prop = GL_NAME_LENGTH;
-    glGetProgramResourceiv(id(), interface, index, 1, &prop, 1, nullptr, &length);
-    std::string s(size_t(std::max(length, 1)), '\0');
-    glGetProgramResourceName(id(), interface, index, GLsizei(s.size()), nullptr, s.data());
-    while (!s.empty() && s.back() == '\0') s.pop_back();
-    return s;
-  };
+  auto name = [&](GLenum interface, GLuint index) { return resourceName(id(), interface, index); };
   // Buffer blocks carry their binding; samplers and images hold theirs as the uniform's value.
   for (const auto& [interface, kind] : {std::pair{GLenum(GL_SHADER_STORAGE_BLOCK), ResourceKind::kStorageBuffer},
                                         std::pair{GLenum(GL_UNIFORM_BLOCK), ResourceKind::kUniformBuffer}}) {

@@ -109,6 +109,39 @@ TEST_F(GlTest, GridParamsLayoutAgreesBetweenCppAndGlsl) {
             (std::vector<float>{1001, 1002, 3.5f, 4.25f, 2000.5f, -9999.0f, 7, 9, 0.25f, 0.5f, 0.75f, 2.0f}));
 }
 
+// The counts of what the host asks of GL (callCounts): a linked program knows its work-group
+// size and its uniforms' locations, so dispatching and setting uniforms query nothing (an array's
+// element other than the first is asked once, then remembered); a read counts with its bytes.
+TEST_F(GlTest, DispatchesAndUniformsQueryNothingAfterLink) {
+  const std::string source =
+      "#version 450\nlayout(local_size_x = 4) in;\nlayout(std430, binding = 0) buffer Out { float v[]; };\n"
+      "uniform uint count;\nuniform float scale[3];\n"
+      "void main() { const uint i = gl_GlobalInvocationID.x; if (i < count) v[i] = scale[i % 3u] * float(i); }\n";
+  auto prog = Program::link({{ShaderStage::kCompute, source, {"inline.comp"}}}, "inline.comp");
+  ASSERT_TRUE(prog) << prog.message();
+  EXPECT_EQ(prog->workGroupSize(), glm::ivec3(4, 1, 1));
+  Buffer out(6 * sizeof(float));
+  out.bindStorage(0);
+  const CallCounts c0 = callCounts();
+  prog->set("count", 6u);
+  prog->set("scale", 2.0f);  // the array's first element, by its name
+  prog->set("scale[2]", 5.0f);
+  prog->set("scale[1]", 3.0f);
+  prog->set("scale[1]", 3.0f);  // remembered
+  prog->dispatchCovering(6);
+  prog->dispatchCovering(6);
+  memoryBarrier(Barrier::kBufferUpdate);
+  const CallCounts c1 = callCounts();
+  EXPECT_EQ(c1.queries - c0.queries, 2u);  // scale[2] and scale[1], once each
+  EXPECT_EQ(c1.dispatches - c0.dispatches, 2u);
+  EXPECT_EQ(c1.hostReads, c0.hostReads);
+  EXPECT_EQ(out.read<float>(), (std::vector<float>{0, 3, 10, 6, 12, 25}));
+  const CallCounts c2 = callCounts();
+  EXPECT_EQ(c2.hostReads - c1.hostReads, 1u);
+  EXPECT_EQ(c2.hostReadBytes - c1.hostReadBytes, 6 * sizeof(float));
+  EXPECT_EQ(c2.queries, c1.queries);
+}
+
 TEST_F(GlTest, BrokenShaderErrorNamesTheRealFileAndLine) {
   // A shader folder with a typo on line 3 of an included file; loaded the way a developer
   // editing shaders would (STRATA_SHADER_DIR), and the message must say "common/bad.glsl:3".

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 
+#include <strata/gl/objects.hpp>
 #include <strata/sim/cpu_solver.hpp>
 #include <strata/sim/gl/gl_solver.hpp>
 #include <strata/sim/gl/shader_slots.hpp>
@@ -150,6 +151,50 @@ TEST_F(GlTest, SimBalanceHoldsOver150kFloat32Steps) {
                 seconds(t0), st.initialWaterM3, st.storedWaterM3, st.waterBalanceM3() / water);
     EXPECT_EQ(st.steps, test::kLongRainSteps);
     EXPECT_LT(std::abs(st.waterBalanceM3()), 1e-5 * water) << int(scheme);
+  }
+}
+
+// Issue 35: what a GL step asks of the host (gl::callCounts). Flood mode's adaptive step (W10)
+// reads back the 4-byte wave speed, the only wait a step has; pipe mode's fixed step reads
+// nothing; neither queries GL. The dispatches a step: sources, point sources (a spring here), then
+// the finite-volume scheme's predictor faces and update, corrector faces, W25 limits, update and
+// the wave speed; the local-inertial scheme's faces, limits, update and wave speed; the pipes'
+// fluxes and update.
+TEST_F(GlTest, SimStepReadsBackOnlyTheWaveSpeed) {
+  constexpr int kSteps = 10;
+  struct Case {
+    const char* what;
+    strata::sim::WaterModel model;
+    strata::sim::FloodScheme scheme;
+    uint64_t dispatches, reads;  // a step
+  };
+  for (const Case& c :
+       {Case{"finite volume", WaterModel::kFiniteVolume, strata::sim::FloodScheme::kFiniteVolume, 8, 1},
+        Case{"local inertial", WaterModel::kFiniteVolume, strata::sim::FloodScheme::kLocalInertial, 6, 1},
+        Case{"pipes", WaterModel::kVirtualPipes, strata::sim::FloodScheme::kFiniteVolume, 4, 0}}) {
+    auto in = test::sloshingBox(32);
+    for (int y = 0; y < 32; ++y) {
+      for (int x = 0; x < 32; ++x) in.waterDepthM.at(x, y) = x < 10 ? 2.0f : 0.0f;
+    }
+    auto p = c.model == WaterModel::kVirtualPipes ? pipeParams() : floodParams();
+    p.floodScheme = c.scheme;
+    auto sim = GlSolver::create(in, p);
+    ASSERT_TRUE(sim) << sim.message();
+    ASSERT_TRUE(sim->addSource(test::valleySpring(32)));
+    sim->step(2);  // the first uses of each program
+    const gl::CallCounts before = gl::callCounts();
+    sim->step(kSteps);
+    const gl::CallCounts after = gl::callCounts();
+    std::printf("GL %s: %llu dispatches, %llu reads (%llu B), %llu queries in %d steps\n", c.what,
+                (unsigned long long)(after.dispatches - before.dispatches),
+                (unsigned long long)(after.hostReads - before.hostReads),
+                (unsigned long long)(after.hostReadBytes - before.hostReadBytes),
+                (unsigned long long)(after.queries - before.queries), kSteps);
+    EXPECT_EQ(after.hostReads - before.hostReads, c.reads * kSteps) << c.what;
+    EXPECT_EQ(after.hostReadBytes - before.hostReadBytes, 4 * c.reads * kSteps) << c.what;
+    EXPECT_EQ(after.queries - before.queries, 0u) << c.what;
+    EXPECT_EQ(after.dispatches - before.dispatches, c.dispatches * kSteps) << c.what;
+    EXPECT_EQ(sim->stats().steps, kSteps + 2);
   }
 }
 

@@ -59,6 +59,20 @@ void deleteShader(uint32_t id);
 void deleteQuery(uint32_t id);
 }  // namespace detail
 
+/// What this thread's GL calls asked of the driver so far (gl/src counts them). A read makes the
+/// host wait for the GPU to finish the commands before it; a query of a program's state waits
+/// for a threaded driver's worker (NVIDIA's "threaded optimisation") to catch up: a loop that
+/// only feeds the GPU should make neither (sim::GlSolver's step makes one 4-byte read when its
+/// time step is adaptive, none when it is fixed; tests/gl and tests/sim count them).
+struct CallCounts {
+  uint64_t dispatches = 0;     ///< compute dispatches (Program::dispatchCovering)
+  uint64_t hostReads = 0;      ///< Buffer::download and Texture::download / downloadRegion
+  uint64_t hostReadBytes = 0;  ///< the bytes those read
+  uint64_t queries = 0;        ///< program state asked of GL after linking (an uncached uniform location)
+};
+/// This thread's counts since it started.
+const CallCounts& callCounts();
+
 /// Whether a buffer's contents may change after creation through upload().
 enum class BufferStorage {
   kDynamic,    ///< upload() allowed (GL_DYNAMIC_STORAGE_BIT)
@@ -270,6 +284,13 @@ class Program : public Object<detail::deleteProgram> {
   /// The active buffer blocks, samplers and images with their bindings (program interface
   /// query), in GL's order.
   std::vector<ProgramResource> resources() const;
+
+ private:
+  // Asked of GL once, at link, so that dispatches and uniform updates query nothing: the
+  // work-group size (compute programs) and the active uniforms' locations by name (an array's
+  // as "a" and "a[0]"; a name not among them is asked of GL once and remembered).
+  glm::ivec3 groupSize_{1, 1, 1};
+  mutable std::vector<std::pair<std::string, int>> locations_;
 };
 
 /// Checks a linked program against a library's binding table: every active block, sampler and
