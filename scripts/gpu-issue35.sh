@@ -5,7 +5,10 @@
 #     nvidia-smi's name and memory; strata_bench_sim's GL kernels at 4096^2 (flood by scheme and
 #     pipes: cell-steps/s, bytes a cell-step and the share of the measured copy bandwidth) and
 #     the flat plain after EA test 4 at 2 m (5 h) and 1 m (1 h) with both schemes (steps, seconds,
-#     balance); GPU SimBalanceHoldsOver150kFloat32Steps (issue 35's 1e-5 after 150k steps).
+#     balance; the flat plain's steps chosen on the GPU, W35, and for the inertial scheme at 2 m
+#     beside them chosen on the host, with their reads a step); GPU
+#     SimBalanceHoldsOver150kFloat32Steps (issue 35's 1e-5 after 150k steps), and the tests that
+#     count a step's host reads (W35) on NVIDIA's driver.
 #   run(carry [.gl .gpu .gpua], timeout 300): scripts/gpu-issue35.sh job
 #     the main job (`strata flood scenarios/grand_canyon_flood.toml`, GL backend, no plots: the
 #     device has no matplotlib), timed; its
@@ -24,9 +27,10 @@ if [ -f .gpub/programs.tar.xz ]; then ./.gpu/unpack-programs.sh >/dev/null; fi
 nvidia-smi --query-gpu=name,memory.total,clocks.max.memory --format=csv >"$out/gpu-$mode.txt" 2>&1 || true
 case $mode in
 sim)
-  /tmp/tb/strata_bench_sim --benchmark_filter='^(flood|flood_inertial|pipes)/gl/4096|^flat_plain/.*/gl/(2|1)/' \
+  /tmp/tb/strata_bench_sim --benchmark_filter='^(flood|flood_inertial|pipes)/gl/4096|^flat_plain/.*/gl/(2|1)/|^flat_plain/inertial/gl_host_steps/2/' \
     --benchmark_out="$out/bench_sim.json" --benchmark_out_format=json 2>&1 | tee "$out/bench_sim.txt"
-  /tmp/tb/strata_sim_gpu_tests --gtest_filter='GlTest.SimBalanceHoldsOver150kFloat32Steps' 2>&1 |
+  /tmp/tb/strata_sim_gpu_tests \
+    --gtest_filter='GlTest.SimBalanceHoldsOver150kFloat32Steps:GlTest.SimDeviceStepsReadOnlyTheirClock:GlTest.SimStepReadsBackOnlyTheWaveSpeed' 2>&1 |
     tee "$out/balance.txt"
   ;;
 job)

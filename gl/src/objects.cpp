@@ -508,6 +508,14 @@ void Program::dispatchCovering(int x, int y, int z) const {
   glDispatchCompute(GLuint((x + g.x - 1) / g.x), GLuint((y + g.y - 1) / g.y), GLuint((z + g.z - 1) / g.z));
 }
 
+void Program::dispatchIndirect(const Buffer& args, size_t offset) const {
+  STRATA_CHECK(offset % 4 == 0 && offset + 12 <= args.size()) << "indirect arguments at " << offset;
+  use();
+  ++tCounts.dispatches;
+  glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, args.id());
+  glDispatchComputeIndirect(GLintptr(offset));
+}
+
 std::vector<ProgramResource> Program::resources() const {
   std::vector<ProgramResource> out;
   auto name = [&](GLenum interface, GLuint index) { return resourceName(id(), interface, index); };

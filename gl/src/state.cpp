@@ -14,6 +14,7 @@ void memoryBarrier(Barrier barrier) {
       {Barrier::kPixelBuffer, GL_PIXEL_BUFFER_BARRIER_BIT},
       {Barrier::kUniform, GL_UNIFORM_BARRIER_BIT},
       {Barrier::kVertexAttrib, GL_VERTEX_ATTRIB_ARRAY_BARRIER_BIT | GL_ELEMENT_ARRAY_BARRIER_BIT},
+      {Barrier::kCommand, GL_COMMAND_BARRIER_BIT},
   };
   GLbitfield bits = 0;
   for (const auto& [b, gl] : kBits) {

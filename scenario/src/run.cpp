@@ -406,7 +406,8 @@ class Run {
   // interval is then abandoned: a resumed run replays it from the last checkpoint, bit for bit).
   // The last step before `endS` (and before a rain edge) is shortened to land on it; the step W10
   // chose is kept apart (chosenDtS), since a shortened one says nothing about the flow.
-  // `tick`, when given, runs after every step (progress: it must be cheap and not collective).
+  // `tick`, when given, runs after every step or run of steps (progress: it must be cheap and not
+  // collective).
   Result<bool> advanceTo(double endS, const std::function<void()>& tick = {}) {
     auto& sv = solver();
     // One rule for "t has reached a time": within 1e-9 of it, relative. (The edges were once
@@ -425,6 +426,20 @@ class Run {
         next = d_.rainFramesEndS;
       }
       STRATA_TRY_STATUS(setRain(sv.timeS()));
+      // Without gauges or sections to sum after every step, and on one process: runs of steps
+      // (advanceBatch; the GL backend chooses and takes them without waiting for the host, W35)
+      // of about 0.1-0.4 s of wall time each, so that progress and a Ctrl-C are seen as often.
+      while (!probes_ && !ranks_.distributed() && before(sv.timeS(), next)) {
+        const auto t0 = std::chrono::steady_clock::now();
+        const auto b = sv.advanceBatch(next, batchSteps_);
+        chosenDtS_ = b.lastChosenDtS;
+        minChosenDtS_ = std::min(minChosenDtS_, b.minChosenDtS);
+        const double wallS = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        if (b.steps == batchSteps_ && wallS < 0.1) batchSteps_ = std::min<int64_t>(2 * batchSteps_, int64_t(1) << 20);
+        if (wallS > 0.4) batchSteps_ = std::max<int64_t>(1, batchSteps_ / 2);
+        if (tick) tick();
+        if (ranks_.anyInterrupted()) return false;
+      }
       while (before(sv.timeS(), next)) {
         chosenDtS_ = sv.nextDt();
         minChosenDtS_ = std::min(minChosenDtS_, chosenDtS_);
@@ -886,7 +901,8 @@ class Run {
   detail::InputWindow input_;  // the model input of a window: what the solver started from
   std::optional<detail::Probes> probes_;
   double chosenDtS_ = 0, minChosenDtS_ = 1e300;
-  int frame_ = -2;  // the rain frame the solver has (setRain); -2: none set yet (a new or resumed run)
+  int64_t batchSteps_ = 16;  // what advanceTo asks of advanceBatch at a time (sized by its wall time)
+  int frame_ = -2;           // the rain frame the solver has (setRain); -2: none set yet (a new or resumed run)
 };
 
 }  // namespace

@@ -67,7 +67,11 @@ struct LevelEntry {
   float stageM;
 };
 
+#ifdef SIM_PARAMS_WRITABLE  // step_clock.comp sets P.dtS (W35)
+layout(std430, binding = SLOT_PARAMS) buffer SimParamsBlock { SimParams P; };
+#else
 layout(std430, binding = SLOT_PARAMS) readonly buffer SimParamsBlock { SimParams P; };
+#endif
 layout(std430, binding = SLOT_ROW_DX) readonly buffer RowDxBlock { float rowDx[]; };
 
 const ivec2 kDir[4] = ivec2[4](ivec2(-1, 0), ivec2(1, 0), ivec2(0, -1), ivec2(0, 1));  // W, E, N, S

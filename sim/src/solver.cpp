@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 namespace strata::sim {
@@ -97,7 +98,32 @@ void Solver::step(int n) {
 
 void Solver::advance(double seconds) {
   const double end = c_.timeS + seconds;
-  while (c_.timeS < end - 1e-9 * std::max(1.0, end)) stepWithDt(std::min(nextDt(), end - c_.timeS));
+  while (!reached(c_.timeS, end)) advanceBatch(end, std::numeric_limits<int64_t>::max());
+}
+
+Solver::Batch Solver::advanceBatch(double endS, int64_t maxSteps) {
+  Batch b;
+  if (maxSteps <= 0 || reached(c_.timeS, endS)) return b;
+  // W10's bound on the rain's depth rate, as sourceDepthRate adds it.
+  const double rainRateMS = (double(params_.rainMmPerHour) + maxRainRasterMmH_) / 3.6e6;
+  if (const auto d = runOnDevice(DeviceRequest{c_.timeS, endS, maxSteps, rainRateMS})) {
+    c_.rainM3 += rainRateM3S_ * (d->timeS - c_.timeS);
+    c_.inflowM3 += d->inflowM3;
+    c_.timeS = d->timeS;
+    c_.steps += d->steps;
+    if (d->steps > 0) c_.lastDtS = d->lastDtS;
+    return {d->steps, d->minChosenDtS, d->lastChosenDtS};
+  }
+  b.minChosenDtS = std::numeric_limits<double>::infinity();
+  while (b.steps < maxSteps && !reached(c_.timeS, endS)) {
+    const double chosen = nextDt();
+    b.minChosenDtS = std::min(b.minChosenDtS, chosen);
+    b.lastChosenDtS = chosen;
+    stepWithDt(std::min(chosen, endS - c_.timeS));
+    ++b.steps;
+  }
+  if (b.steps == 0) b.minChosenDtS = 0;
+  return b;
 }
 
 void Solver::stepWithDt(double dtS) { takeStep(dtS, true); }

@@ -13,9 +13,9 @@ namespace {
 // The GL backend's std430 blocks (sim/gl/gl_layout.hpp, sim/bookkeeping.hpp) against
 // sim/shaders/sim.glsl.
 template <class T>
-void expectSimLayout(const std::string& name, const std::vector<Field>& cpp) {
+void expectSimLayout(const std::string& name, const std::vector<Field>& cpp, const char* file = "sim.glsl") {
   size_t size = 0;
-  const auto fields = glslLayout(std::string(STRATA_SOURCE_DIR) + "/sim/shaders/sim.glsl", name, size);
+  const auto fields = glslLayout(std::string(STRATA_SOURCE_DIR) + "/sim/shaders/" + file, name, size);
   ASSERT_EQ(fields.size(), cpp.size()) << name;
   for (size_t i = 0; i < cpp.size(); ++i) {
     EXPECT_EQ(fields[i].name, cpp[i].name) << name;
@@ -26,6 +26,17 @@ void expectSimLayout(const std::string& name, const std::vector<Field>& cpp) {
 
 #define STRATA_FIELD(T, f) \
   Field { #f, offsetof(T, f) }
+
+// W35's per-source share of a point-source entry (sim_clock.glsl; GpuClock's offsets are pinned
+// by static_asserts in gl_layout.hpp).
+TEST(GpuLayouts, ClockTermMatchesGlsl) {
+  using strata::sim::GpuTerm;
+  expectSimLayout<GpuTerm>(
+      "Term",
+      {STRATA_FIELD(GpuTerm, entry), STRATA_FIELD(GpuTerm, first), STRATA_FIELD(GpuTerm, count),
+       STRATA_FIELD(GpuTerm, pad), STRATA_FIELD(GpuTerm, cellCount), STRATA_FIELD(GpuTerm, areaM2)},
+      "sim_clock.glsl");
+}
 
 TEST(GpuLayouts, SimParamsMatchesGlsl) {
   using SimParams = strata::sim::GpuSimParams;

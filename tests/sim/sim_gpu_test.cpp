@@ -45,7 +45,7 @@ TEST_F(GlTest, SimKernelsUseTheSlotsDeclaredInCpp) {
   std::vector<test::SlotProgram> programs;
   for (const char* k : {"sources", "point_sources", "wave_speed", "pipe_flux", "pipe_update", "fv_face", "fv_limit",
                         "fv_update", "inertial_face", "inertial_update", "erode", "thermal_flux", "thermal_apply",
-                        "flood_stats", "level_boundary", "copy_rect", "bed_rect"}) {
+                        "flood_stats", "level_boundary", "copy_rect", "bed_rect", "step_clock"}) {
     programs.push_back({{std::string("sim/shaders/") + k + ".comp"}});
   }
   test::expectProgramsMatchSlots("sim/shaders/", strata::sim::slots::kAll, programs,
@@ -196,6 +196,76 @@ TEST_F(GlTest, SimStepReadsBackOnlyTheWaveSpeed) {
     EXPECT_EQ(after.dispatches - before.dispatches, c.dispatches * kSteps) << c.what;
     EXPECT_EQ(sim->stats().steps, kSteps + 2);
   }
+}
+
+// W35 (issue 35): a GL run of steps chosen on the GPU reads back only its clock, once per run of
+// steps, where stepping from the host reads the wave speed at every step. A dam break with rain
+// and a spring whose hydrograph rises through the run, flood statistics on: advance() takes the
+// same steps to the same time as the host-stepped GL run, with the same budgets, depths and
+// arrival times, and both agree with the CPU.
+TEST_F(GlTest, SimDeviceStepsReadOnlyTheirClock) {
+  auto in = test::sloshingBox(32);
+  for (int y = 0; y < 32; ++y) {
+    for (int x = 0; x < 32; ++x) in.waterDepthM.at(x, y) = x < 10 ? 2.0f : 0.0f;
+  }
+  auto p = floodParams();
+  p.rainMmPerHour = 30.0f;
+  p.openEdges = strata::sim::kEdgeEast;
+  constexpr double kEndS = 300.0;
+  auto device = GlSolver::create(in, p);
+  auto host = GlSolver::create(in, p);
+  auto cpu = CpuSolver::create(in, p);
+  ASSERT_TRUE(device && host && cpu);
+  for (Solver* sv : std::initializer_list<Solver*>{&*device, &*host, &*cpu}) {
+    ASSERT_TRUE(sv->addSource(test::valleySpring(32)));
+    sv->enableFloodStats(0.05f);
+  }
+  const gl::CallCounts d0 = gl::callCounts();
+  device->advance(kEndS);
+  const gl::CallCounts d1 = gl::callCounts();
+  while (!Solver::reached(host->timeS(), kEndS)) host->stepWithDt(std::min(host->nextDt(), kEndS - host->timeS()));
+  const gl::CallCounts d2 = gl::callCounts();
+  cpu->advance(kEndS);
+  const auto a = device->stats(), b = host->stats(), c = cpu->stats();
+  std::printf(
+      "device steps: %lld steps to %.9f s, %llu reads (%llu B), %llu dispatches; host steps: %lld, %llu reads; "
+      "CPU %lld steps\n",
+      a.steps, a.timeS, (unsigned long long)(d1.hostReads - d0.hostReads),
+      (unsigned long long)(d1.hostReadBytes - d0.hostReadBytes), (unsigned long long)(d1.dispatches - d0.dispatches),
+      b.steps, (unsigned long long)(d2.hostReads - d1.hostReads), c.steps);
+  EXPECT_GT(a.steps, 100);
+  EXPECT_LE(d1.hostReads - d0.hostReads, 4u);                 // the clock, once per run of steps
+  EXPECT_EQ(d2.hostReads - d1.hostReads, uint64_t(b.steps));  // the wave speed, every step
+  EXPECT_EQ(a.steps, b.steps);
+  EXPECT_EQ(a.timeS, b.timeS);
+  EXPECT_EQ(a.lastDtS, b.lastDtS);
+  EXPECT_NEAR(a.inflowM3, b.inflowM3, 1e-12 * b.inflowM3);
+  EXPECT_NEAR(a.rainM3, b.rainM3, 1e-12 * b.rainM3);
+  EXPECT_EQ(a.storedWaterM3, b.storedWaterM3);
+  EXPECT_LT(std::abs(a.waterBalanceM3()), 1e-6 * (a.initialWaterM3 + a.inflowM3 + a.rainM3));
+  EXPECT_EQ(maxAbsDiff(device->readWaterDepth(), host->readWaterDepth()), 0.0);
+  EXPECT_EQ(maxAbsDiff(device->readFloodStats().arrivalS, host->readFloodStats().arrivalS), 0.0);
+  EXPECT_EQ(a.steps, c.steps);
+  EXPECT_LT(maxAbsDiff(device->readWaterDepth(), cpu->readWaterDepth()), 1e-4);
+  // A second advance continues the same clock (its sources and rain from where it stopped).
+  device->advance(60.0);
+  host->advance(60.0);
+  EXPECT_EQ(device->stats().timeS, host->stats().timeS);
+  EXPECT_LT(maxAbsDiff(device->readWaterDepth(), host->readWaterDepth()), 1e-6);
+
+  // Erosion, weathering and bank failure with their passes dispatched as the clock says: the
+  // banked channel of SimErosionBalanceClosesWithEverythingOn, 120 s, layers bit for bit.
+  const int w = 16, h = 32;
+  auto eDevice = GlSolver::create(test::bankedChannel(w, h, 20.0f, 4.0f), test::everythingOnParams());
+  auto eHost = GlSolver::create(test::bankedChannel(w, h, 20.0f, 4.0f), test::everythingOnParams());
+  ASSERT_TRUE(eDevice && eHost);
+  ASSERT_TRUE(eDevice->addSource(test::channelSpring(w)) && eHost->addSource(test::channelSpring(w)));
+  eDevice->advance(120.0);
+  while (!Solver::reached(eHost->timeS(), 120.0)) eHost->stepWithDt(std::min(eHost->nextDt(), 120.0 - eHost->timeS()));
+  EXPECT_EQ(eDevice->stats().steps, eHost->stats().steps);
+  const auto la = eDevice->readLayers(), lb = eHost->readLayers();
+  for (size_t l = 0; l < la.size(); ++l) EXPECT_EQ(maxAbsDiff(la[l], lb[l]), 0.0) << "layer " << l;
+  EXPECT_EQ(maxAbsDiff(eDevice->readSuspended(), eHost->readSuspended()), 0.0);
 }
 
 // W11b on the GL backend and on tiles of 4 x 3 cells: Green-Ampt under ponding on the flat basin

@@ -20,9 +20,9 @@ struct Field {
 // std430 base alignment and size of the scalar and vector types Strata uses in buffers.
 inline std::pair<size_t, size_t> alignAndSize(const std::string& type) {
   static const std::map<std::string, std::pair<size_t, size_t>> kTypes = {
-      {"float", {4, 4}},  {"int", {4, 4}},     {"uint", {4, 4}},    {"vec2", {8, 8}},
-      {"ivec2", {8, 8}},  {"uvec2", {8, 8}},   {"vec3", {16, 12}},  {"ivec3", {16, 12}},
-      {"vec4", {16, 16}}, {"ivec4", {16, 16}}, {"uvec4", {16, 16}}, {"mat4", {16, 64}}};
+      {"float", {4, 4}},   {"int", {4, 4}},    {"uint", {4, 4}},    {"vec2", {8, 8}},   {"ivec2", {8, 8}},
+      {"uvec2", {8, 8}},   {"vec3", {16, 12}}, {"ivec3", {16, 12}}, {"vec4", {16, 16}}, {"ivec4", {16, 16}},
+      {"uvec4", {16, 16}}, {"mat4", {16, 64}}, {"double", {8, 8}}};
   auto it = kTypes.find(type);
   if (it == kTypes.end()) ADD_FAILURE() << "type " << type << " not handled by the std430 test";
   return it == kTypes.end() ? std::pair<size_t, size_t>{4, 4} : it->second;

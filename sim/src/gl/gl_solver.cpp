@@ -8,6 +8,8 @@
 #include <cmath>
 #include <cstddef>
 #include <cstring>
+#include <limits>
+#include <map>
 #include <string>
 
 #include <strata/gl/context.hpp>
@@ -43,12 +45,16 @@ struct GlSolver::Impl {
   int layers = 0;
 
   gl::Buffer params, materials, rowDx, base, bed, layerBuf, stateA, stateB, stage, flux, fluxDiag, faceX, faceY, tilt,
-      accum, rain, manning, infiltration, thermal, scour, sourceEntries, maxSpeed, floodStats, fvLimit, levelEntries;
+      accum, rain, manning, infiltration, thermal, scour, sourceEntries, maxSpeed, floodStats, fvLimit, levelEntries,
+      clock, series, terms;  // W35's clock, the sources' samples and their shares of the entries
   bool aIsCurrent = true;
   gl::Program pSources, pPointSources, pWaveSpeed, pPipeFlux, pPipeUpdate, pFvFace, pFvLimit, pFvUpdate, pInertialFace,
-      pInertialUpdate, pErode, pThermalFlux, pThermalApply, pFloodStats, pLevel, pCopyRect, pBedRect;
-  gl::Buffer maxSpeedHost;  // maxSpeed copied to host memory, read every step (maxWaveSpeed)
-  gl::Buffer packed;        // copy_rect.comp's side of a rectangle moved to or from the host
+      pInertialUpdate, pErode, pThermalFlux, pThermalApply, pFloodStats, pLevel, pCopyRect, pBedRect, pClock;
+  // W35: a device step's passes dispatch the group counts step_clock.comp leaves in `clock`.
+  bool indirect = false;
+  double lastDeviceDtS = 0;  // the last device step, to size the next run of them
+  gl::Buffer maxSpeedHost;   // maxSpeed copied to host memory, read every step (maxWaveSpeed)
+  gl::Buffer packed;         // copy_rect.comp's side of a rectangle moved to or from the host
 
   const gl::Buffer& cur() const { return aIsCurrent ? stateA : stateB; }
   const gl::Buffer& next() const { return aIsCurrent ? stateB : stateA; }
@@ -78,6 +84,19 @@ struct GlSolver::Impl {
     sourceEntries.bind(slots::kSources);
     maxSpeed.bind(slots::kMaxSpeed);
     fvLimit.bind(slots::kFvLimit);
+    clock.bind(slots::kClock);
+    series.bind(slots::kSeries);
+    terms.bind(slots::kTerms);
+  }
+
+  // A pass over `x` x `y` invocations of `shape`: directly, or in a device step as step_clock.comp
+  // says (nothing once the clock has reached its end).
+  void run(const gl::Program& prog, ClockShape shape, int x, int y = 1) const {
+    if (indirect) {
+      prog.dispatchIndirect(clock, offsetof(GpuClock, dispatchNow) + 12 * size_t(shape));
+    } else {
+      prog.dispatchCovering(x, y);
+    }
   }
 
   double maxWaveSpeed() {
@@ -95,78 +114,200 @@ struct GlSolver::Impl {
     return double(v);
   }
 
+  // One step from the host: its length, sources and levels given (StepInputs).
   void takeStep(const StepInputs& step, bool hasLevels, float wetThresholdM) {
-    const int w = p.width, h = p.height;
     if (step.dtS != p.dtS) {
       p.dtS = step.dtS;
       params.upload(kParamsDtOffset, sizeof(float), &p.dtS);
     }
     bindAll();
-    pSources.dispatchCovering(w, h);
-    barrier();
     if (!step.sources.empty()) {
       const size_t bytes = step.sources.size() * sizeof(SourceEntry);
-      if (sourceEntries.size() < bytes) {
-        sourceEntries = gl::Buffer(bytes);
-        sourceEntries.bind(slots::kSources);
-      }
+      if (sourceEntries.size() < bytes) sourceEntries = gl::Buffer(bytes);
+      sourceEntries.bind(slots::kSources);
       sourceEntries.upload(0, bytes, step.sources.data());
       pPointSources.set("entryCount", unsigned(step.sources.size()));
-      pPointSources.dispatchCovering(int(step.sources.size()));
+    }
+    pFloodStats.set("timeS", float(step.startS + double(step.dtS)));
+    passes(step.sources.size(), hasLevels ? &step.levels : nullptr, wetThresholdM);
+  }
+
+  // The passes of a step after its sources' entries are in place (docs/sim-water.md, "One step").
+  void passes(size_t sourceEntryCount, const std::vector<LevelEntry>* levels, float wetThresholdM) {
+    const int w = p.width, h = p.height;
+    run(pSources, kShapeGrid, w, h);
+    barrier();
+    if (sourceEntryCount > 0) {
+      run(pPointSources, kShapeEntries, int(sourceEntryCount));
       barrier();
     }
     if (p.waterModel == int32_t(WaterModel::kVirtualPipes)) {
-      pPipeFlux.dispatchCovering(w, h);
+      run(pPipeFlux, kShapeGrid, w, h);
       barrier();
-      pPipeUpdate.dispatchCovering(w, h);
+      run(pPipeUpdate, kShapeGrid, w, h);
       barrier();
     } else if (p.floodScheme == int32_t(FloodScheme::kLocalInertial)) {
-      pInertialFace.dispatchCovering(w, h);
+      run(pInertialFace, kShapeGrid, w, h);
       barrier();
-      pFvLimit.dispatchCovering(w, h);
+      run(pFvLimit, kShapeGrid, w, h);
       barrier();
-      pInertialUpdate.dispatchCovering(w, h);
+      run(pInertialUpdate, kShapeGrid, w, h);
       barrier();
     } else {
       pFvFace.set("average", 0);
-      pFvFace.dispatchCovering(w, h);
+      run(pFvFace, kShapeGrid, w, h);
       barrier();
       pFvUpdate.set("final_", 0);
-      pFvUpdate.dispatchCovering(w, h);
+      run(pFvUpdate, kShapeGrid, w, h);
       barrier();
       stage.bind(slots::kStateIn);  // the corrector's faces come from U1
       pFvFace.set("average", 1);
-      pFvFace.dispatchCovering(w, h);
+      run(pFvFace, kShapeGrid, w, h);
       barrier();
       cur().bind(slots::kStateIn);
-      pFvLimit.dispatchCovering(w, h);
+      run(pFvLimit, kShapeGrid, w, h);
       barrier();
       pFvUpdate.set("final_", 1);
-      pFvUpdate.dispatchCovering(w, h);
+      run(pFvUpdate, kShapeGrid, w, h);
       barrier();
     }
     aIsCurrent = !aIsCurrent;
     cur().bind(slots::kStateIn);
     next().bind(slots::kStateOut);
-    if (hasLevels) levelPass(step.levels);
+    if (levels) levelPass(*levels);
     if (p.erosionEnabled) {
-      pErode.dispatchCovering(w, h);
+      run(pErode, kShapeGrid, w, h);
       barrier();
     }
     if (p.thermalEnabled) {
-      pThermalFlux.dispatchCovering(w, h);
+      run(pThermalFlux, kShapeGrid, w, h);
       barrier();
-      pThermalApply.dispatchCovering(w, h);
+      run(pThermalApply, kShapeGrid, w, h);
       barrier();
     }
     if (wetThresholdM >= 0) {
       cur().bind(slots::kStateIn);
       floodStats.bind(slots::kFloodStats);
-      pFloodStats.set("timeS", float(step.startS + double(step.dtS)));
       pFloodStats.set("wetThresholdM", wetThresholdM);
-      pFloodStats.dispatchCovering(int(n));
+      run(pFloodStats, kShapeCells, int(n));
       barrier();
     }
+  }
+
+  // W35: steps chosen and taken on the GPU towards r.endS, at most r.maxSteps, in runs of steps
+  // queued without reading anything back; one read of the clock after each run. The runs are
+  // sized from the last step (a run that overshoots the end dispatches no groups after it).
+  DeviceRun deviceRun(const DeviceRequest& r, const std::vector<Source>& sourceList, const SimParams& sp,
+                      const CellGrid& grid, float wetThresholdM) {
+    const size_t entryCount = uploadSourceTables(sourceList, grid);
+    GpuClock c;
+    c.timeS = r.timeS;
+    c.endS = r.endS;
+    c.minChosenDtS = std::numeric_limits<double>::infinity();
+    c.maxDtS = double(sp.maxDtS);
+    c.reachM = double(sp.cflAlpha) * grid.minCellM;
+    c.gravityMS2 = double(sp.gravityMS2);
+    c.rainRateMS = r.rainRateMS;
+    c.adaptive = sp.cflAlpha > 0 ? 1u : 0u;
+    c.entryCount = uint32_t(entryCount);
+    c.termCount = termCount;
+    auto groups = [](size_t cells, int per) { return uint32_t((cells + size_t(per) - 1) / size_t(per)); };
+    const uint32_t full[3 * kClockShapes] = {groups(size_t(p.width), 16),
+                                             groups(size_t(p.height), 16),
+                                             1,
+                                             groups(n, 256),
+                                             1,
+                                             1,
+                                             groups(entryCount, 64),
+                                             1,
+                                             1};
+    std::copy(std::begin(full), std::end(full), c.dispatchFull);
+    clock.upload(0, sizeof(GpuClock), &c);
+    pPointSources.set("entryCount", unsigned(entryCount));
+    pFloodStats.set("timeFromClock", 1u);
+    DeviceRun out;
+    out.timeS = r.timeS;
+    indirect = true;
+    // The state ping-pongs at every step queued; the steps queued after the clock reached its
+    // end run nothing, so the current buffer is the one of the last step that ran.
+    const bool startA = aIsCurrent;
+    bool done = false;
+    while (!done && out.steps < r.maxSteps) {
+      // Enough steps to reach the end at the last step's length, and a few more: a step queued
+      // past the end costs its dispatches (of no groups), a run too short another read.
+      const double left = r.endS - out.timeS;
+      const double estimate = lastDeviceDtS > 0 ? left / lastDeviceDtS * 1.02 + 2.0 : 16.0;
+      const int64_t queued =
+          std::max<int64_t>(1, std::min<int64_t>(r.maxSteps - out.steps, int64_t(std::min(estimate, 65536.0))));
+      for (int64_t k = 0; k < queued; ++k) deviceStep(entryCount, wetThresholdM);
+      readBarrier();
+      clock.download(0, offsetof(GpuClock, dispatchNow), &c);
+      out.steps = int64_t(c.steps);
+      out.timeS = c.timeS;
+      done = c.done != 0 || Solver::reached(c.timeS, r.endS);
+      aIsCurrent = c.steps % 2 == 0 ? startA : !startA;
+      if (c.steps > 0) lastDeviceDtS = double(c.lastDtS);
+    }
+    indirect = false;
+    p.dtS = -1.0f;  // the GPU's P.dtS is the last device step's: the next host step uploads its own
+    pFloodStats.set("timeFromClock", 0u);
+    out.inflowM3 = c.inflowM3;
+    out.lastDtS = double(c.lastDtS);
+    out.minChosenDtS = c.steps > 0 ? c.minChosenDtS : 0.0;
+    out.lastChosenDtS = c.lastChosenDtS;
+    return out;
+  }
+
+  // One device step: the wave speed, step_clock.comp, then the passes as it says.
+  void deviceStep(size_t entryCount, float wetThresholdM) {
+    bindAll();
+    if (p.cflAlpha > 0) {
+      maxSpeed.fill(0u);
+      pWaveSpeed.dispatchCovering(int(n));
+      barrier();
+    }
+    pClock.dispatchCovering(1);
+    gl::memoryBarrier(gl::Barrier::kStorage | gl::Barrier::kCommand);
+    passes(entryCount, nullptr, wetThresholdM);
+  }
+
+  // W35: the sources' samples and their shares of the point-source entries (one per cell, in
+  // cell order, as mergeSources lists them), for step_clock.comp. Returns the entry count.
+  uint32_t termCount = 0;
+  size_t uploadSourceTables(const std::vector<Source>& sourceList, const CellGrid& grid) {
+    std::map<uint32_t, uint32_t> entryOf;  // cell -> entry, in cell order
+    for (const auto& src : sourceList) {
+      for (auto [x, y] : src.cells) entryOf.emplace(uint32_t(y) * uint32_t(p.width) + uint32_t(x), 0u);
+    }
+    std::vector<SourceEntry> entries;
+    for (auto& [cell, index] : entryOf) {
+      index = uint32_t(entries.size());
+      entries.push_back({cell, 0.0f});
+    }
+    std::vector<double> samples;  // (t, q) pairs
+    std::vector<GpuTerm> termList;
+    for (const auto& src : sourceList) {
+      if (src.cells.empty()) continue;
+      const auto first = uint32_t(samples.size() / 2);
+      for (const auto& sample : src.dischargeM3S.samples()) samples.insert(samples.end(), {sample[0], sample[1]});
+      const auto count = uint32_t(samples.size() / 2) - first;
+      for (auto [x, y] : src.cells) {
+        const uint32_t cell = uint32_t(y) * uint32_t(p.width) + uint32_t(x);
+        termList.push_back({entryOf[cell], first, count, 0, double(src.cells.size()), grid.area(y)});
+      }
+    }
+    // Each entry's shares in the sources' order (mergeSources adds them in that order).
+    std::stable_sort(termList.begin(), termList.end(),
+                     [](const GpuTerm& a, const GpuTerm& b) { return a.entry < b.entry; });
+    termCount = uint32_t(termList.size());
+    auto put = [](gl::Buffer& buf, const void* data, size_t bytes) {
+      if (buf.size() < std::max<size_t>(bytes, 16)) buf = gl::Buffer(std::max<size_t>(bytes, 16));
+      if (bytes > 0) buf.upload(0, bytes, data);
+    };
+    put(sourceEntries, entries.data(), entries.size() * sizeof(SourceEntry));
+    put(series, samples.data(), samples.size() * sizeof(double));
+    put(terms, termList.data(), termList.size() * sizeof(GpuTerm));
+    return entries.size();
   }
 
   // W26: the fixed levels at the end of the step (sim/shaders/level_boundary.comp).
@@ -274,7 +415,8 @@ Result<GlSolver> GlSolver::create(const SimInput& input, const SimParams& params
         Kernel{&s.pThermalFlux, "sim/shaders/thermal_flux.comp"},
         Kernel{&s.pThermalApply, "sim/shaders/thermal_apply.comp"},
         Kernel{&s.pFloodStats, "sim/shaders/flood_stats.comp"}, Kernel{&s.pLevel, "sim/shaders/level_boundary.comp"},
-        Kernel{&s.pCopyRect, "sim/shaders/copy_rect.comp"}, Kernel{&s.pBedRect, "sim/shaders/bed_rect.comp"}}) {
+        Kernel{&s.pCopyRect, "sim/shaders/copy_rect.comp"}, Kernel{&s.pBedRect, "sim/shaders/bed_rect.comp"},
+        Kernel{&s.pClock, "sim/shaders/step_clock.comp"}}) {
     auto prog = gl::Program::compute(name, slots::kernelDefines());
     if (!prog) return fail("sim: " + prog.message());
     *program = std::move(prog).value();
@@ -343,6 +485,10 @@ Result<GlSolver> GlSolver::create(const SimInput& input, const SimParams& params
   s.maxSpeed = gl::Buffer(4);
   s.maxSpeedHost = gl::Buffer(4, nullptr, gl::BufferStorage::kReadback);
   s.floodStats = gl::Buffer(16 * n);
+  s.clock = gl::Buffer(sizeof(GpuClock));
+  s.clock.fill(0u);
+  s.series = gl::Buffer(16);
+  s.terms = gl::Buffer(sizeof(GpuTerm));
 
   GlSolver solver(input, params, std::move(impl));
   solver.recordInitialTotals();
@@ -355,6 +501,12 @@ std::string GlSolver::backendName() const {
 }
 
 void GlSolver::runStep(const StepInputs& step) { impl_->takeStep(step, !levels().empty(), floodThresholdM()); }
+
+std::optional<Solver::DeviceRun> GlSolver::runOnDevice(const DeviceRequest& request) {
+  // W26's fixed levels at each step's end are the host's (levelEntries): those runs step from it.
+  if (!levels().empty()) return std::nullopt;
+  return impl_->deviceRun(request, sources(), params(), grid(), floodThresholdM());
+}
 
 Status GlSolver::onRainRasterChanged(const gis::Grid<float>& mmPerHour) {
   Impl& s = *impl_;
@@ -389,9 +541,10 @@ size_t GlSolver::gpuBytes() const {
   const Impl& s = *impl_;
   size_t total = 0;
   for (const gl::Buffer* b :
-       {&s.params,  &s.materials,    &s.rowDx,    &s.base,  &s.bed,           &s.layerBuf, &s.stateA,     &s.stateB,
-        &s.stage,   &s.flux,         &s.fluxDiag, &s.faceX, &s.faceY,         &s.tilt,     &s.accum,      &s.rain,
-        &s.manning, &s.infiltration, &s.thermal,  &s.scour, &s.sourceEntries, &s.maxSpeed, &s.floodStats, &s.fvLimit}) {
+       {&s.params,   &s.materials,  &s.rowDx,   &s.base,         &s.bed,     &s.layerBuf, &s.stateA,
+        &s.stateB,   &s.stage,      &s.flux,    &s.fluxDiag,     &s.faceX,   &s.faceY,    &s.tilt,
+        &s.accum,    &s.rain,       &s.manning, &s.infiltration, &s.thermal, &s.scour,    &s.sourceEntries,
+        &s.maxSpeed, &s.floodStats, &s.fvLimit, &s.clock,        &s.series,  &s.terms}) {
     total += b->size();
   }
   return total;

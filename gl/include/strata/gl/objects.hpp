@@ -65,7 +65,7 @@ void deleteQuery(uint32_t id);
 /// only feeds the GPU should make neither (sim::GlSolver's step makes one 4-byte read when its
 /// time step is adaptive, none when it is fixed; tests/gl and tests/sim count them).
 struct CallCounts {
-  uint64_t dispatches = 0;     ///< compute dispatches (Program::dispatchCovering)
+  uint64_t dispatches = 0;     ///< compute dispatches (Program::dispatchCovering, dispatchIndirect)
   uint64_t hostReads = 0;      ///< Buffer::download and Texture::download / downloadRegion
   uint64_t hostReadBytes = 0;  ///< the bytes those read
   uint64_t queries = 0;        ///< program state asked of GL after linking (an uncached uniform location)
@@ -281,6 +281,10 @@ class Program : public Object<detail::deleteProgram> {
   glm::ivec3 workGroupSize() const;
   /// Dispatches enough groups to cover (x, y, z) invocations (compute programs).
   void dispatchCovering(int x, int y = 1, int z = 1) const;
+  /// Dispatches the group counts (3 uint32) that `args` holds at `offset` (a multiple of 4),
+  /// written there on the GPU (a compute shader before it, then Barrier::kCommand): 0 groups
+  /// run nothing.
+  void dispatchIndirect(const Buffer& args, size_t offset) const;
   /// The active buffer blocks, samplers and images with their bindings (program interface
   /// query), in GL's order.
   std::vector<ProgramResource> resources() const;

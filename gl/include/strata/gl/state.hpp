@@ -18,6 +18,7 @@ enum class Barrier : uint32_t {
   kPixelBuffer = 1u << 5,    ///< Texture::uploadFrom (a buffer as pixel source)
   kUniform = 1u << 6,        ///< uniform blocks
   kVertexAttrib = 1u << 7,   ///< vertex and index buffers
+  kCommand = 1u << 8,        ///< indirect dispatch arguments (Program::dispatchIndirect)
 };
 constexpr Barrier operator|(Barrier a, Barrier b) { return Barrier(uint32_t(a) | uint32_t(b)); }
 void memoryBarrier(Barrier barrier);

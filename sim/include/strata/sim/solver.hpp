@@ -8,9 +8,12 @@
 // Units: metres, seconds, m^3. Cells (x, y) = (column, row), row 0 north; per-cell arrays are
 // row-major. docs/sim-water.md and docs/sim-erosion.md hold the equations.
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -186,8 +189,23 @@ class Solver {
 
   /// Takes `n` steps, each of the W10 length.
   void step(int n = 1);
-  /// Steps until `seconds` more have been simulated (the last step is shortened to land on it).
+  /// Steps until `seconds` more have been simulated (the last step is shortened to land on it):
+  /// advanceBatch to the end.
   void advance(double seconds);
+  /// What advanceBatch did: the steps taken, and the shortest and the last step W10 chose for
+  /// them (before the last was shortened to land on the end; 0 without a step).
+  struct Batch {
+    int64_t steps = 0;
+    double minChosenDtS = 0, lastChosenDtS = 0;
+  };
+  /// Steps of the W10 length towards `endS`, the last one shortened to land on it, until it is
+  /// reached() or `maxSteps` were taken. A backend that chooses its steps itself takes them
+  /// without waiting for the host between steps (the GL backend, W35: one read of its clock per
+  /// run of steps); otherwise nextDt() and stepWithDt() for each.
+  Batch advanceBatch(double endS, int64_t maxSteps);
+  /// Whether time `t` has reached `target` (within 1e-9 of it, relative): the one rule of
+  /// advance, advanceBatch and the runs of scenarios.
+  static bool reached(double t, double target) { return !(t < target - 1e-9 * std::max(1.0, std::abs(target))); }
   /// One step of exactly `dtS` seconds (runners that hold several solvers choose one step for all).
   void stepWithDt(double dtS);
   /// Advances the clock (time, steps, budgets) by one step of `dtS` without running the passes:
@@ -292,6 +310,22 @@ class Solver {
   /// Runs the passes of one step (docs/sim-water.md, "One step"), and updates the flood
   /// statistics when floodThresholdM() >= 0.
   virtual void runStep(const StepInputs& step) = 0;
+  /// W35: what advanceBatch asks of a backend that chooses its steps itself.
+  struct DeviceRequest {
+    double timeS = 0, endS = 0;
+    int64_t maxSteps = 0;
+    double rainRateMS = 0;  ///< the rain's bound on a cell's depth rate (W10's r without sources)
+  };
+  /// What it did: the steps, the clock after them, the sources' volume, the last step taken and
+  /// the shortest and last step W10 chose.
+  struct DeviceRun {
+    int64_t steps = 0;
+    double timeS = 0, inflowM3 = 0, lastDtS = 0, minChosenDtS = 0, lastChosenDtS = 0;
+  };
+  /// Steps towards request.endS chosen and taken by the backend itself, with sources() and the
+  /// flood statistics as stepWithDt takes them; nullopt: it cannot (advanceBatch steps from the
+  /// host). The base class accounts for the result (clock, steps, budgets).
+  virtual std::optional<DeviceRun> runOnDevice(const DeviceRequest& /*request*/) { return std::nullopt; }
   /// params() changed (setParams).
   virtual void onParamsChanged() {}
   /// The rain raster is to change (setRainRaster, the grid checked); by default refused.

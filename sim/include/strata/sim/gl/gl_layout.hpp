@@ -70,6 +70,32 @@ static_assert(sizeof(GpuMaterial) == 48);
 static_assert(offsetof(GpuMaterial, tanTalus) == 8);
 static_assert(offsetof(GpuMaterial, cohesionHeightM) == 40);
 
+/// W35: the shapes of the passes a device step dispatches indirectly (sim_clock.glsl's
+/// CLOCK_SHAPE_*): 16 x 16 groups over the grid, 256 cells a group, 64 source entries a group.
+enum ClockShape : int { kShapeGrid = 0, kShapeCells = 1, kShapeEntries = 2, kClockShapes = 3 };
+
+/// std430 mirror of sim_clock.glsl's ClockBlock: the GPU's clock of a run of device steps.
+struct GpuClock {
+  double timeS = 0, endS = 0, inflowM3 = 0, minChosenDtS = 0, lastChosenDtS = 0;
+  double maxDtS = 0, reachM = 0, gravityMS2 = 0, rainRateMS = 0, pad0 = 0;
+  float lastDtS = 0;
+  uint32_t steps = 0, done = 0, adaptive = 0, entryCount = 0, termCount = 0, pad1 = 0, pad2 = 0;
+  uint32_t dispatchNow[3 * kClockShapes] = {};
+  uint32_t dispatchFull[3 * kClockShapes] = {};
+};
+static_assert(offsetof(GpuClock, lastDtS) == 80);
+static_assert(offsetof(GpuClock, steps) == 84);
+static_assert(offsetof(GpuClock, dispatchNow) == 112);
+static_assert(offsetof(GpuClock, dispatchFull) == 148);
+static_assert(sizeof(GpuClock) == 184);
+
+/// std430 mirror of sim_clock.glsl's Term: one source's share of one point-source entry.
+struct GpuTerm {
+  uint32_t entry = 0, first = 0, count = 0, pad = 0;
+  double cellCount = 1, areaM2 = 1;
+};
+static_assert(sizeof(GpuTerm) == 32);
+
 /// The block the kernels read, from the parameters, the grid and the current step.
 GpuSimParams gpuParams(const SimParams& params, const CellGrid& grid, float dtS);
 GpuMaterial gpuMaterial(const MaterialConstants& m);

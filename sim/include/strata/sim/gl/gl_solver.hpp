@@ -40,6 +40,7 @@ class GlSolver final : public Solver {
   struct Impl;
   GlSolver(const SimInput& input, const SimParams& params, std::unique_ptr<Impl> impl);
   void runStep(const StepInputs& step) override;
+  std::optional<DeviceRun> runOnDevice(const DeviceRequest& request) override;
   void onParamsChanged() override;
   Status onRainRasterChanged(const gis::Grid<float>& mmPerHour) override;
   bool keepsFloodStats() const override { return true; }

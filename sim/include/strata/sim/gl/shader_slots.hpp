@@ -42,10 +42,14 @@ inline constexpr gl::Binding kManning{"SLOT_MANNING", kBuf, 25, "Manning"};     
 inline constexpr gl::Binding kInfiltration{"SLOT_INFILTRATION", kBuf, 26,
                                            "Infiltration"};  ///< (Ks, psi dtheta) per cell
 
-inline constexpr gl::Binding kAll[] = {kParams,   kMaterials, kRowDx,      kBase,     kBed,      kLayers,      kStateIn,
-                                       kStateOut, kStage,     kFlux,       kFaceX,    kFaceY,    kTilt,        kAccum,
-                                       kRain,     kThermal,   kSources,    kMaxSpeed, kFluxDiag, kFloodStats,  kFvLimit,
-                                       kLevels,   kCopyGrid,  kCopyPacked, kScour,    kManning,  kInfiltration};
+inline constexpr gl::Binding kClock{"SLOT_CLOCK", kBuf, 27, "ClockBlock"};  ///< W35: GpuClock, the GPU's clock
+inline constexpr gl::Binding kSeries{"SLOT_SERIES", kBuf, 28, "Series"};    ///< W35: the sources' samples (t, q)
+inline constexpr gl::Binding kTerms{"SLOT_TERMS", kBuf, 29, "Terms"};       ///< W35: GpuTerm per source and entry
+
+inline constexpr gl::Binding kAll[] = {
+    kParams,  kMaterials, kRowDx,    kBase,       kBed,   kLayers,  kStateIn,      kStateOut, kStage,    kFlux,
+    kFaceX,   kFaceY,     kTilt,     kAccum,      kRain,  kThermal, kSources,      kMaxSpeed, kFluxDiag, kFloodStats,
+    kFvLimit, kLevels,    kCopyGrid, kCopyPacked, kScour, kManning, kInfiltration, kClock,    kSeries,   kTerms};
 
 /// What the kernels compile with: this table's slots and the accumulators' layout as
 /// ACCUM_PER_CELL, ACCUM_OUTFLOW, ... (sim::AccumOffset).
