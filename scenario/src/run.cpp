@@ -1190,6 +1190,12 @@ class Session {
   // The output intervals: each advanced to its end with progress, then closed (its row, maps,
   // pictures and checkpoint). Stops early when interrupted or asked to.
   Status runIntervals() {
+    // Resumed at a peak so far (the run may have been killed before it drew it): keep its state.
+    if (opt_.pictures && opt_.resume && !summary_.series.empty() && isPeak(summary_.series.back())) {
+      auto pieces = run_->pieces();
+      STRATA_TRY_STATUS(ranks_.agree(statusOf(pieces)));
+      peakPicture_ = run_->pictureState(*pieces, stride_);
+    }
     Progress progress(opt_.command + " " + name_, s_.durationS);
     // RunOptions::onProgress at most every 0.2 s; a false answer stops the run as a Ctrl-C does.
     auto nextCallback = std::chrono::steady_clock::now();
@@ -1213,6 +1219,9 @@ class Session {
       STRATA_TRY_STATUS(closeInterval());
       if (opt_.stopAfterIntervals >= 0 && interval_ >= opt_.stopAfterIntervals && interval_ < intervals_) break;
     }
+    // A run that stops early draws the peak it has kept (a resumed run keeps its state again
+    // below, where the interval it resumes at was the peak so far).
+    STRATA_TRY_STATUS(drawPeakPicture());
     summary_.completed = interval_ >= intervals_;
     if (summary_.completed) {
       progress.finish(std::to_string(run_->solver().stats().steps) + " steps");
@@ -1328,12 +1337,22 @@ class Session {
     summary_.series.push_back(row);
     ++interval_;
     if (opt_.pictures) {
-      // The peak picture is redrawn whenever the stored water reaches a new high at an interval.
-      const bool peak = std::all_of(summary_.series.begin(), summary_.series.end(),
-                                    [&](const SeriesRow& r) { return r.waterM3 <= row.waterM3; });
-      if (peak) STRATA_TRY_STATUS(drawPicture(*pieces, "peak.png"));
+      // The peak picture is of the last interval at which the stored water reached a new high:
+      // its state is kept, and drawn once the water has fallen from it (or the run ends or
+      // stops), not at every new high (a rising flood drew it at nearly every interval: 10 of the
+      // main job's 12, 2-3 s each on llvmpipe).
+      if (isPeak(row)) {
+        peakPicture_ = run_->pictureState(*pieces, stride_);
+      } else {
+        STRATA_TRY_STATUS(drawPeakPicture());
+      }
       if (interval_ == intervals_) {
+        // A peak at the last interval is the "after" picture itself: drawn once, copied.
+        const bool peakIsLast = peakPicture_ && isPeak(row);
+        if (peakIsLast) peakPicture_.reset();
+        STRATA_TRY_STATUS(drawPeakPicture());
         STRATA_TRY_STATUS(drawPicture(*pieces, "after.png"));
+        if (peakIsLast) STRATA_TRY_STATUS(copyPicture("after.png", "peak.png"));
         const auto maxDepth = run_->maxDepthStrided(*pieces, stride_);
         STRATA_TRY_STATUS(ranks_.agree(pictures_ ? pictures_->drawMaxDepth(maxDepth, pictures_->georef(),
                                                                            opt_.outDir / "pictures" / "max_depth.png")
@@ -1369,6 +1388,34 @@ class Session {
   Status drawPicture(const std::vector<detail::Piece>& pieces, const char* file) {
     auto state = run_->pictureState(pieces, stride_);
     return ranks_.agree(pictures_ ? pictures_->draw(std::move(state), opt_.outDir / "pictures" / file) : Status{});
+  }
+
+  // pictures/`to` as a copy of pictures/`from` (written atomically, by the lead).
+  Status copyPicture(const char* from, const char* to) {
+    Status status;
+    if (pictures_) {
+      const fs::path dir = opt_.outDir / "pictures";
+      const fs::path tmp = temporaryPathFor(dir / to);
+      std::error_code ec;
+      fs::copy_file(dir / from, tmp, ec);
+      status = ec ? fail((dir / to).string() + ": cannot write it: " + ec.message()) : commitTemporary(tmp, dir / to);
+    }
+    return ranks_.agree(status);
+  }
+
+  // Whether `row` (the last of the series) holds as much water as any interval before it.
+  bool isPeak(const SeriesRow& row) const {
+    return std::all_of(summary_.series.begin(), summary_.series.end(),
+                       [&](const SeriesRow& r) { return r.waterM3 <= row.waterM3; });
+  }
+
+  // peak.png from the kept state, if there is one not drawn yet.
+  Status drawPeakPicture() {
+    if (!peakPicture_) return {};
+    PictureState state = std::move(*peakPicture_);
+    peakPicture_.reset();
+    return ranks_.agree(pictures_ ? pictures_->draw(std::move(state), opt_.outDir / "pictures" / "peak.png")
+                                  : Status{});
   }
 
   std::string maxDepthLegend() const {
@@ -1417,6 +1464,7 @@ class Session {
   std::string scenarioText_;
   std::optional<Run> run_;
   std::optional<Pictures> pictures_;
+  std::optional<PictureState> peakPicture_;  // the last new high's, not drawn yet
   int stride_ = 1;
   SpinUpSummary spinUp_;
   RunSummary summary_;

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 
 #include <strata/core/files.hpp>
@@ -148,18 +149,24 @@ TEST_F(GlTest, InterruptedAndResumedRunEqualsAnUninterruptedOne) {
   }
 }
 
-// W26 end to end: no inflow, only a fixed level across the canyon whose stage rises 50 m in
-// 10 minutes and falls 30 m in the next 10: water pours in through the level, then part of it
-// drains back out through it. The CSV's balance (in - out - stored) closes as for inflows.
-TEST_F(GlTest, FloodScenarioWithARisingAndFallingLevelBalances) {
-  const auto dir = test::tempDir("flood-level");
+// The test scenario with a fixed level across the canyon instead of its inflow, whose stage rises
+// 50 m in 10 minutes and falls 30 m in the next 10, written to dir/level.toml.
+std::filesystem::path writeLevelScenario(const std::filesystem::path& dir) {
   std::string text = scenarioText();
   const auto from = text.find("[[water.inflow]]"), to = text.find("[time]");
   text.replace(from, to - from,
                "[[water.level]]\nname = \"river stage\"\nline_lonlat = [[-112.0225, 36.063], [-112.0225, 36.08]]\n"
                "stage = [[0, 800], [10, 850], [20, 820]]\nstage_units = [\"min\", \"m\"]\n");
   std::ofstream(dir / "level.toml") << text;
-  auto scenario = strata::scenario::loadScenario(dir / "level.toml");
+  return dir / "level.toml";
+}
+
+// W26 end to end: no inflow, only the rising and falling level: water pours in through the
+// level, then part of it drains back out through it. The CSV's balance (in - out - stored)
+// closes as for inflows.
+TEST_F(GlTest, FloodScenarioWithARisingAndFallingLevelBalances) {
+  const auto dir = test::tempDir("flood-level");
+  auto scenario = strata::scenario::loadScenario(writeLevelScenario(dir));
   ASSERT_TRUE(scenario) << scenario.message();
   RunOptions opt;
   opt.outDir = dir / "run";
@@ -193,6 +200,46 @@ TEST_F(GlTest, FloodScenarioWithARisingAndFallingLevelBalances) {
     // float32 depths relative to a datum ~800 m: 1 mm.
     EXPECT_NEAR(depth->values.at(x, y), expect, 1e-3) << x << ", " << y;
   }
+}
+
+// pictures/peak.png is the last interval at which the stored water reached a new high, drawn
+// once (when the water falls from it, or the run ends or stops), not at every new high. The
+// rising and falling level peaks at the third of four intervals: run whole, and stopped at the
+// peak (which draws it) and resumed (which keeps the state it resumes from as the peak, and
+// draws it when the water falls), the peak pictures are the same image. (This view of the
+// canyon shows no change between the last two intervals: 'after' is the same image as 'peak'.)
+TEST_F(GlTest, PeakPictureIsTheHighestIntervalsAcrossAResume) {
+  const auto dir = test::tempDir("peak-picture");
+  auto scenario = strata::scenario::loadScenario(writeLevelScenario(dir));
+  ASSERT_TRUE(scenario) << scenario.message();
+  RunOptions whole;
+  whole.outDir = dir / "whole";
+  whole.plots = false;
+  auto a = runScenario(*scenario, whole);
+  ASSERT_TRUE(a) << a.message();
+  RunOptions part = whole;
+  part.outDir = dir / "part";
+  part.stopAfterIntervals = 3;
+  auto b = runScenario(*scenario, part);
+  ASSERT_TRUE(b) << b.message();
+  EXPECT_FALSE(b->completed);
+  EXPECT_TRUE(std::filesystem::exists(part.outDir / "pictures" / "peak.png"));  // drawn when it stopped
+  part.stopAfterIntervals = -1;
+  part.resume = true;
+  auto c = runScenario(*scenario, part);
+  ASSERT_TRUE(c) << c.message();
+  const auto rows = readCsv(whole.outDir / "series.csv");
+  ASSERT_EQ(rows.size(), 4u);
+  EXPECT_LT(rows[3][3], rows[2][3]);  // the peak is the third interval's
+  EXPECT_GT(rows[2][3], rows[1][3]);
+  auto bytes = [](const std::filesystem::path& f) {
+    std::ifstream in(f, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  const std::string peakWhole = bytes(whole.outDir / "pictures" / "peak.png");
+  EXPECT_FALSE(peakWhole.empty());
+  EXPECT_EQ(peakWhole, bytes(part.outDir / "pictures" / "peak.png"));
+  EXPECT_EQ(bytes(whole.outDir / "pictures" / "after.png"), bytes(part.outDir / "pictures" / "after.png"));
 }
 
 TEST_F(GlTest, ResumeRefusesACheckpointOfAnotherScenario) {
