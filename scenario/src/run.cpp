@@ -432,6 +432,7 @@ class Run {
       while (!probes_ && !ranks_.distributed() && before(sv.timeS(), next)) {
         const auto t0 = std::chrono::steady_clock::now();
         const auto b = sv.advanceBatch(next, batchSteps_);
+        if (b.steps == 0) break;  // (not expected) the steps below take it from here
         chosenDtS_ = b.lastChosenDtS;
         minChosenDtS_ = std::min(minChosenDtS_, b.minChosenDtS);
         const double wallS = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -1219,8 +1220,8 @@ class Session {
       STRATA_TRY_STATUS(closeInterval());
       if (opt_.stopAfterIntervals >= 0 && interval_ >= opt_.stopAfterIntervals && interval_ < intervals_) break;
     }
-    // A run that stops early draws the peak it has kept (a resumed run keeps its state again
-    // below, where the interval it resumes at was the peak so far).
+    // A run that stops early draws the peak it has kept (resumed at that interval, a run keeps
+    // its state again: the start of this function).
     STRATA_TRY_STATUS(drawPeakPicture());
     summary_.completed = interval_ >= intervals_;
     if (summary_.completed) {
@@ -1339,8 +1340,8 @@ class Session {
     if (opt_.pictures) {
       // The peak picture is of the last interval at which the stored water reached a new high:
       // its state is kept, and drawn once the water has fallen from it (or the run ends or
-      // stops), not at every new high (a rising flood drew it at nearly every interval: 10 of the
-      // main job's 12, 2-3 s each on llvmpipe).
+      // stops), not at every new high (a rising flood drew it at every interval: all 12 of the
+      // main job's, 2-3 s each on llvmpipe).
       if (isPeak(row)) {
         peakPicture_ = run_->pictureState(*pieces, stride_);
       } else {
