@@ -1079,10 +1079,11 @@ class Session {
     return {};
   }
 
-  // The solver on the built domain, with its flood statistics.
+  // The solver on the built domain, with its flood statistics (a fresh run with a spin-up starts
+  // them at its end, Run::spinUp: kept through it they would be reset unread, 3 % of its time).
   Status startSolver() {
     STRATA_TRY_STATUS(scenario::startSolver(engine_, domain_, ranks_, opt_.outDir));
-    engine_.solver->enableFloodStats(float(s_.outputs.wetThresholdM));
+    if (!(s_.spinUpS > 0 && !opt_.resume)) engine_.solver->enableFloodStats(float(s_.outputs.wetThresholdM));
     run_.emplace(s_, opt_, ranks_, std::move(domain_), std::move(engine_));
     installInterruptHandler();  // before "running on": from that line on a Ctrl-C stops the run cleanly
     log::info(opt_.command) << "running on " << run_->backendName();
