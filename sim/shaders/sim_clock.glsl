@@ -34,10 +34,10 @@ layout(std430, binding = SLOT_CLOCK) CLOCK_QUALIFIER buffer ClockBlock {
   uint steps;            // taken since the host last read the clock
   uint done;             // 1 once timeS reached endS: the passes dispatch no group
   uint adaptive;         // cflAlpha > 0 (W10); else every step is maxDtS
-  uint entryCount;       // point-source entries
-  uint termCount;
+  uint termCount;        // Terms (the point-source entries' shares of the sources)
   uint pad1;
   uint pad2;
+  uint pad3;
   uint dispatchNow[3 * CLOCK_SHAPES];   // what the passes dispatch this step
   uint dispatchFull[3 * CLOCK_SHAPES];  // the same while the clock runs
 } C;

@@ -11,6 +11,7 @@
 #include <limits>
 #include <map>
 #include <string>
+#include <utility>
 
 #include <strata/gl/context.hpp>
 #include <strata/gl/objects.hpp>
@@ -199,7 +200,7 @@ struct GlSolver::Impl {
   // sized from the last step (a run that overshoots the end dispatches no groups after it).
   DeviceRun deviceRun(const DeviceRequest& r, const std::vector<Source>& sourceList, const SimParams& sp,
                       const CellGrid& grid, float wetThresholdM) {
-    const size_t entryCount = uploadSourceTables(sourceList, grid);
+    const auto [entryCount, termCount] = uploadSourceTables(sourceList, grid);
     GpuClock c;
     c.timeS = r.timeS;
     c.endS = r.endS;
@@ -209,8 +210,7 @@ struct GlSolver::Impl {
     c.gravityMS2 = double(sp.gravityMS2);
     c.rainRateMS = r.rainRateMS;
     c.adaptive = sp.cflAlpha > 0 ? 1u : 0u;
-    c.entryCount = uint32_t(entryCount);
-    c.termCount = termCount;
+    c.termCount = uint32_t(termCount);
     auto groups = [](size_t cells, int per) { return uint32_t((cells + size_t(per) - 1) / size_t(per)); };
     const uint32_t full[3 * kClockShapes] = {groups(size_t(p.width), 16),
                                              groups(size_t(p.height), 16),
@@ -272,9 +272,8 @@ struct GlSolver::Impl {
   }
 
   // W35: the sources' samples and their shares of the point-source entries (one per cell, in
-  // cell order, as mergeSources lists them), for step_clock.comp. Returns the entry count.
-  uint32_t termCount = 0;
-  size_t uploadSourceTables(const std::vector<Source>& sourceList, const CellGrid& grid) {
+  // cell order, as mergeSources lists them), for step_clock.comp: the entries and the terms.
+  std::pair<size_t, size_t> uploadSourceTables(const std::vector<Source>& sourceList, const CellGrid& grid) {
     std::map<uint32_t, uint32_t> entryOf;  // cell -> entry, in cell order
     for (const auto& src : sourceList) {
       for (auto [x, y] : src.cells) entryOf.emplace(uint32_t(y) * uint32_t(p.width) + uint32_t(x), 0u);
@@ -299,7 +298,6 @@ struct GlSolver::Impl {
     // Each entry's shares in the sources' order (mergeSources adds them in that order).
     std::stable_sort(termList.begin(), termList.end(),
                      [](const GpuTerm& a, const GpuTerm& b) { return a.entry < b.entry; });
-    termCount = uint32_t(termList.size());
     auto put = [](gl::Buffer& buf, const void* data, size_t bytes) {
       if (buf.size() < std::max<size_t>(bytes, 16)) buf = gl::Buffer(std::max<size_t>(bytes, 16));
       if (bytes > 0) buf.upload(0, bytes, data);
@@ -307,7 +305,7 @@ struct GlSolver::Impl {
     put(sourceEntries, entries.data(), entries.size() * sizeof(SourceEntry));
     put(series, samples.data(), samples.size() * sizeof(double));
     put(terms, termList.data(), termList.size() * sizeof(GpuTerm));
-    return entries.size();
+    return {entries.size(), termList.size()};
   }
 
   // W26: the fixed levels at the end of the step (sim/shaders/level_boundary.comp).
