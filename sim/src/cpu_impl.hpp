@@ -26,14 +26,21 @@ namespace strata::sim::cpu {
 
 struct ThermalConst;  // cpu_erosion.cpp
 
-/// Side of the square blocks of cells the passes skip or run (cells). At least what one step
-/// reaches (8 cells: flood mode's stencils and the thermal passes after it), so water that is
-/// more than one block away cannot reach a cell within a step; no larger, so that a river a few
-/// cells wide runs few dry cells beside it (16: the Grand Canyon job's 192 h spin-up took 1.4x
-/// as long).
+/// Side of the square blocks of cells whose quiet, rain and evaporation flags are kept (cells).
+/// The water passes run on the cells within a step's reach of a block's cells that are not quiet
+/// (Impl::reachCells), so the block only sets how often the flags are looked at.
 constexpr int kBlock = 8;
+/// Rows of the water passes' runs: a run is a rectangle of at most this many rows (the face
+/// pass computes each run's rows of primitives and sides with a row more above and two below).
+/// Fewer rows trim a winding river's runs closer but cost more rows of primitives: the Grand
+/// Canyon job without pictures took 36.7 / 33.2 s with 4 and 38.9 / 36.0 s with 8 on OpenMP's
+/// default threads (one thread: 42.6 / 46.4 s against 40.7 / 42.2 s; docs/benchmarks.md).
+constexpr int kRunRows = 4;
 /// A pass over fewer cells runs on one thread: forking costs more than it saves.
 constexpr size_t kMinParallelCells = 16384;
+/// A pass over fewer active cells runs on one thread. A grid large enough for threads may run
+/// few cells (the Grand Canyon river: ~6,200 a step), which the tuner then times on both counts.
+constexpr size_t kMinParallelPassCells = 4096;
 
 /// `rows` rows of `width` floats (zero), each row starting on a 64-byte boundary; the row stride
 /// is a multiple of 16 floats.
@@ -71,12 +78,13 @@ struct Faces {
   Plane mass, nL, nR, t;
 };
 
-/// Rows [y0, y1) x columns [x0, x1): the cells of one block row's run of consecutive active blocks.
+/// Rows [y0, y1) x columns [x0, x1): a rectangle of active cells a pass walks row by row.
 struct Run {
   int y0, y1, x0, x1;
 };
 
-/// A set of blocks and the runs of cells it covers, in row order.
+/// A set of blocks and the runs of cells it covers, in row order. The water passes' set runs
+/// on cells, not whole blocks: `on` marks the blocks its runs touch.
 struct BlockSet {
   std::vector<uint8_t> on;  ///< per block, row-major
   std::vector<Run> runs;
@@ -164,8 +172,14 @@ struct Impl {
   float wetThresholdM = 0.0f;
 
   // ---- active blocks (cpu_solver.cpp) ----
-  std::vector<uint8_t> quiet;          // per block: every cell's water state (and pipe outflows) +0
-  std::vector<uint8_t> needPrev;       // the blocks last step needed
+  std::vector<uint8_t> quiet;         // per block: every cell's water state (and pipe outflows) +0
+  std::vector<Run> extent;            // per block: the smallest rectangle of its cells that are not quiet
+  std::vector<uint8_t> needCell;      // per cell (w x h, row-major): the water passes run here this step
+  std::vector<uint8_t> needPrevCell;  // per cell: what last step needed (it runs once more)
+  std::vector<uint8_t> columns;       // scratch: a row group's columns with a cell to run
+  // Per row, the columns [first, second) outside which needCell (spanRun) and needPrevCell
+  // (spanPrev) are 0; spanNeed: this step's marks while they are made.
+  std::vector<std::pair<int, int>> spanRun, spanPrev, spanNeed;
   std::vector<uint8_t> forced;         // written from outside since the last step (writeBlock)
   std::vector<uint8_t> evapResidual;   // some cell's evaporation sum has a nonzero compensation term
   std::vector<uint8_t> rainBlock;      // some cell has raster rain
@@ -190,7 +204,7 @@ struct Impl {
   template <class F>
   void forRuns(const BlockSet& set, F&& f) const {
     const int n = int(set.runs.size());
-    const bool parallel = passThreads > 1 && n > 1 && set.cells >= kMinParallelCells;
+    const bool parallel = passThreads > 1 && n > 1 && set.cells >= kMinParallelPassCells;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(passThreads) if (parallel)
     for (int k = 0; k < n; ++k) f(set.runs[size_t(k)], omp_get_thread_num());
   }
@@ -200,8 +214,12 @@ struct Impl {
   void planStep(const std::vector<SourceEntry>& sources, const std::vector<LevelEntry>& levels);
   void finishStep();
   void fillRuns(BlockSet& set) const;
+  void fillWaterRuns();
   void dilate(std::vector<uint8_t>& on);
-  bool blockQuiet(int bx, int by) const;
+  int reachCells() const;
+  void needCells(int x0, int x1, int y0, int y1, int margin);
+  void lookAt(int bx, int by);  // the block's quiet flag and extent from its cells
+  Run busyExtent(int bx, int by) const;
   bool blockEvapResidual(int bx, int by) const;
   void markAll();  // state replaced: all flags recomputed, every block runs for two steps
   void allocateFor(const SimParams& params);

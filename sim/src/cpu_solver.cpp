@@ -1,8 +1,9 @@
-// The CPU backend: storage, the order of the passes in a step, the choice of the blocks they run
+// The CPU backend: storage, the order of the passes in a step, the choice of the cells they run
 // on, and the conversions between its planes and the Solver interface's per-cell arrays.
 #include <strata/sim/cpu_solver.hpp>
 
 #include <algorithm>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -136,7 +137,12 @@ Impl::Impl(const SimInput& input, const SimParams& params, int threadCount, bool
     }
   }
   const size_t blocks = size_t(bw) * size_t(bh);
-  for (auto* v : {&quiet, &needPrev, &forced, &evapResidual, &rainBlock, &thermalMoving, &thermalForced, &work}) {
+  needCell.assign(cells(), 0);
+  needPrevCell.assign(cells(), 0);
+  columns.assign(size_t(w), 0);
+  for (auto* v : {&spanRun, &spanPrev, &spanNeed}) v->assign(size_t(h), {w, 0});
+  extent.assign(size_t(bw) * size_t(bh), Run{});
+  for (auto* v : {&quiet, &forced, &evapResidual, &rainBlock, &thermalMoving, &thermalForced, &work}) {
     v->assign(blocks, 0);
   }
   for (auto* set : {&water, &sources, &thermalEval, &thermalApply, &lastThermalApply}) {
@@ -198,7 +204,7 @@ void Impl::markAll() {
   thermalDirty = true;
   for (int by = 0; by < bh; ++by) {
     for (int bx = 0; bx < bw; ++bx) {
-      quiet[size_t(by * bw + bx)] = blockQuiet(bx, by);
+      lookAt(bx, by);
       evapResidual[size_t(by * bw + bx)] = blockEvapResidual(bx, by);
     }
   }
@@ -210,19 +216,48 @@ void Impl::markAll() {
 
 // A block is quiet when all its cells' water state (and pipe outflows) are +0: with quiet
 // neighbours, no rain, source or level, a step maps such a cell to itself, bit for bit
-// (docs/sim-water.md, "The CPU backend").
-bool Impl::blockQuiet(int bx, int by) const {
+// (docs/sim-water.md, "The CPU backend"). Its extent is the smallest rectangle of its cells that
+// are not (x1 <= x0 when it is quiet).
+void Impl::lookAt(int bx, int by) {
+  const size_t b = size_t(by * bw + bx);
+  extent[b] = busyExtent(bx, by);
+  quiet[b] = extent[b].x1 <= extent[b].x0;
+}
+
+Run Impl::busyExtent(int bx, int by) const {
   const int x0 = bx * kBlock, x1 = std::min(w, x0 + kBlock), y0 = by * kBlock, y1 = std::min(h, y0 + kBlock);
   const Water& u = now();
-  // Depth first: a wet block is found on its first row.
-  for (const Plane* plane : {&u.h, &u.hu, &u.hv, &u.s}) {
-    if (anyBits(*plane, x0, x1, y0, y1)) return false;
-  }
+  const Plane* planes[12] = {&u.h, &u.hu, &u.hv, &u.s};
+  int n = 4;
   for (int d = 0; d < 4; ++d) {
-    if (!flux[d].empty() && anyBits(flux[d], x0, x1, y0, y1)) return false;
-    if (!fluxDiag[d].empty() && anyBits(fluxDiag[d], x0, x1, y0, y1)) return false;
+    if (!flux[d].empty()) planes[n++] = &flux[d];
+    if (!fluxDiag[d].empty()) planes[n++] = &fluxDiag[d];
   }
-  return true;
+  // A row's kBlock columns are read whole (a plane's rows are padded to 16 floats, and x0 is a
+  // multiple of kBlock, so they are inside the row); those past the grid's edge are masked.
+  static_assert(kBlock <= 16 && 16 % kBlock == 0);
+  const uint32_t inside = x1 - x0 == kBlock ? ~0u : (1u << (x1 - x0)) - 1u;
+  uint32_t columnsSet = 0;
+  Run box{y1, y0, x1, x0};
+  for (int y = y0; y < y1; ++y) {
+    uint32_t bits[kBlock] = {};
+    for (int k = 0; k < n; ++k) {
+      const float* row = planes[k]->row(y) + x0;
+#pragma omp simd
+      for (int i = 0; i < kBlock; ++i) bits[i] |= bitsOf(row[i]);
+    }
+    uint32_t set = 0;
+    for (int i = 0; i < kBlock; ++i) set |= uint32_t(bits[i] != 0) << i;
+    set &= inside;
+    if (set == 0) continue;
+    columnsSet |= set;
+    box.y0 = std::min(box.y0, y);
+    box.y1 = y + 1;
+  }
+  if (columnsSet == 0) return box;
+  box.x0 = x0 + std::countr_zero(columnsSet);
+  box.x1 = x0 + 32 - std::countl_zero(columnsSet);
+  return box;
 }
 
 // Adding 0 to a compensated sum with a nonzero error term may change it (W20), so the sources
@@ -264,12 +299,81 @@ void Impl::fillRuns(BlockSet& set) const {
   }
 }
 
-// The blocks this step's passes run on. A block is busy when a cell of it is not quiet or it
-// gets rain, a source or a level this step; the water passes run on the busy blocks and their
-// neighbours (a step reaches less than a block), and on last step's such blocks too, so a block
-// that falls idle runs once more with quiet surroundings, which leaves both state buffers and
-// its faces, limits and predictor at the values every later step would give them. The sources
-// pass runs on the busy blocks and where an evaporation sum carries an error term.
+// How far one step reaches (cells): a cell further than this from every cell that is not quiet,
+// gets rain, a source or a level keeps its state and intermediates bit for bit. Flood mode's
+// finite volumes: W21's limited slope of a dry cell beside a dry cell is 0 (minmod and MC are 0
+// when either difference is), and a face whose two reconstructed depths are 0 carries nothing
+// (W13-W16: no flux, no hydrostatic term), so the predictor wets at most the cells beside water
+// and the corrector the cells beside those: 2. A cell further away keeps its predictor (its
+// state), faces (0), limit (1) and bed source at a dry neighbourhood's values.
+// (SimCpu.SkippingQuietBlocksChangesNoBit fails with 1.) The other models (pipes, the inertial
+// faces' cross terms, erosion's bank failure and the thermal passes after the water) keep the
+// 8 cells the blocks gave them before (not analysed further).
+int Impl::reachCells() const {
+  const bool finiteVolume = p.waterModel == WaterModel::kFiniteVolume && !inertial();
+  return finiteVolume && !p.erosionEnabled && !p.thermalEnabled ? 2 : kBlock;
+}
+
+// Marks the cells [x0 - margin, x1 + margin) x [y0 - margin, y1 + margin) (clipped) to run.
+void Impl::needCells(int x0, int x1, int y0, int y1, int margin) {
+  x0 = std::max(x0 - margin, 0), x1 = std::min(x1 + margin, w);
+  y0 = std::max(y0 - margin, 0), y1 = std::min(y1 + margin, h);
+  if (x1 <= x0) return;
+  for (int y = y0; y < y1; ++y) {
+    std::fill_n(needCell.begin() + ptrdiff_t(size_t(y) * size_t(w) + size_t(x0)), x1 - x0, uint8_t(1));
+    auto& s = spanNeed[size_t(y)];
+    s = {std::min(s.first, x0), std::max(s.second, x1)};
+  }
+}
+
+// The water passes' runs from `needCell` (within `spanRun`): per group of kRunRows rows, each span
+// of columns with a cell to run in the group, its rows trimmed to those that have one.
+void Impl::fillWaterRuns() {
+  water.runs.clear();
+  water.cells = 0;
+  std::fill(water.on.begin(), water.on.end(), 0);
+  const uint8_t* need = needCell.data();
+  uint8_t* col = columns.data();
+  for (int g0 = 0; g0 < h; g0 += kRunRows) {
+    const int g1 = std::min(h, g0 + kRunRows);
+    int a = w, b = 0;  // the group's columns with a mark
+    for (int y = g0; y < g1; ++y) a = std::min(a, spanRun[size_t(y)].first), b = std::max(b, spanRun[size_t(y)].second);
+    if (b <= a) continue;
+    std::fill(col + a, col + b, uint8_t(0));
+    for (int y = g0; y < g1; ++y) {
+      const uint8_t* row = need + size_t(y) * size_t(w);
+#pragma omp simd
+      for (int x = a; x < b; ++x) col[x] |= row[x];
+    }
+    for (int x = a; x < b;) {
+      const auto* hit = static_cast<const uint8_t*>(std::memchr(col + x, 1, size_t(b - x)));
+      if (!hit) break;
+      const int x0 = int(hit - col);
+      const auto* end = static_cast<const uint8_t*>(std::memchr(col + x0, 0, size_t(b - x0)));
+      const int x1 = end ? int(end - col) : b;
+      x = x1;
+      auto rowHas = [&](int y) {
+        return std::memchr(need + size_t(y) * size_t(w) + size_t(x0), 1, size_t(x1 - x0)) != nullptr;
+      };
+      int y0 = g0, y1 = g1;
+      while (!rowHas(y0)) ++y0;
+      while (!rowHas(y1 - 1)) --y1;
+      water.runs.push_back(Run{y0, y1, x0, x1});
+      water.cells += size_t(y1 - y0) * size_t(x1 - x0);
+      for (int by = y0 / kBlock; by <= (y1 - 1) / kBlock; ++by) {
+        for (int bx = x0 / kBlock; bx <= (x1 - 1) / kBlock; ++bx) water.on[size_t(by * bw + bx)] = 1;
+      }
+    }
+  }
+}
+
+// The cells and blocks this step's passes run on. A block is busy when a cell of it is not quiet
+// or it gets rain, a source or a level this step; the water passes run on the cells within a
+// step's reach (reachCells) of such cells (of the whole block for rain), on blocks written from
+// outside, and on the cells last step ran for these reasons, so a cell that falls idle runs once
+// more with quiet surroundings, which leaves both state buffers and its faces, limits and
+// predictor at the values every later step would give them. The sources pass runs on the busy
+// blocks and where an evaporation sum carries an error term.
 void Impl::planStep(const std::vector<SourceEntry>& entries, const std::vector<LevelEntry>& levels) {
   const size_t blocks = quiet.size();
   auto all = [&](BlockSet& set) {
@@ -290,16 +394,53 @@ void Impl::planStep(const std::vector<SourceEntry>& entries, const std::vector<L
   };
   for (const auto& e : entries) busy[blockOf(e.cell)] = 1;
   for (const auto& e : levels) busy[blockOf(e.cell)] = 1;
-  water.on = busy;
-  dilate(water.on);
-  for (size_t b = 0; b < blocks; ++b) water.on[b] = water.on[b] || forced[b] || dirty;
-  for (size_t b = 0; b < blocks; ++b) {
-    const uint8_t need = water.on[b];
-    water.on[b] = need || needPrev[b];
-    needPrev[b] = need;
-    busy[b] = busy[b] || evapResidual[b] || forced[b] || dirty;
+  // Last step's marks are cleared where they were (row spans), this step's made.
+  for (int y = 0; y < h; ++y) {
+    const auto [a, b] = spanRun[size_t(y)];
+    if (b > a) std::fill_n(needCell.begin() + ptrdiff_t(size_t(y) * size_t(w) + size_t(a)), b - a, uint8_t(0));
   }
-  fillRuns(water);
+  std::fill(spanNeed.begin(), spanNeed.end(), std::pair{w, 0});
+  if (dirty || rainEverywhere) {
+    needCells(0, w, 0, h, 0);
+  } else {
+    const int reach = reachCells();
+    for (int by = 0; by < bh; ++by) {
+      for (int bx = 0; bx < bw; ++bx) {
+        const size_t b = size_t(by * bw + bx);
+        const int x0 = bx * kBlock, y0 = by * kBlock, x1 = std::min(w, x0 + kBlock), y1 = std::min(h, y0 + kBlock);
+        if (rainBlock[b]) {
+          needCells(x0, x1, y0, y1, reach);
+        } else if (!quiet[b]) {
+          const Run& e = extent[b];
+          if (e.x1 > e.x0) needCells(e.x0, e.x1, e.y0, e.y1, reach);
+        }
+        if (forced[b]) needCells(x0, x1, y0, y1, 0);
+      }
+    }
+    auto cellAt = [&](uint32_t cell) {
+      const int x = int(cell % uint32_t(w)), y = int(cell / uint32_t(w));
+      needCells(x, x + 1, y, y + 1, reach);
+    };
+    for (const auto& e : entries) cellAt(e.cell);
+    for (const auto& e : levels) cellAt(e.cell);
+  }
+  // The cells to run: this step's and last step's marks; this step's are kept for the next.
+  for (int y = 0; y < h; ++y) {
+    const auto now = spanNeed[size_t(y)], prev = spanPrev[size_t(y)];
+    const int a = std::min(now.first, prev.first), b = std::max(now.second, prev.second);
+    uint8_t* cell = needCell.data() + size_t(y) * size_t(w);
+    uint8_t* last = needPrevCell.data() + size_t(y) * size_t(w);
+#pragma omp simd
+    for (int x = a; x < b; ++x) {
+      const uint8_t need = cell[x];
+      cell[x] = need | last[x];
+      last[x] = need;
+    }
+    spanRun[size_t(y)] = {a, b};
+    spanPrev[size_t(y)] = now;
+  }
+  for (size_t b = 0; b < blocks; ++b) busy[b] = busy[b] || evapResidual[b] || forced[b] || dirty;
+  fillWaterRuns();
   fillRuns(sources);
   if (p.thermalEnabled) {
     // The thermal flux of a block changes only when the bed, layers or water of it or its
@@ -327,7 +468,10 @@ void Impl::finishStep() {
   const bool rainEverywhere = p.rainMmPerHour != 0.0f;
 #pragma omp parallel for schedule(dynamic, 8) num_threads(passThreads) if (parallel)
   for (int b = 0; b < blocks; ++b) {
-    if (water.on[size_t(b)]) quiet[size_t(b)] = !rainEverywhere && blockQuiet(b % bw, b / bw);
+    if (water.on[size_t(b)]) {
+      lookAt(b % bw, b / bw);
+      quiet[size_t(b)] = quiet[size_t(b)] && !rainEverywhere;
+    }
     if (sources.on[size_t(b)]) evapResidual[size_t(b)] = blockEvapResidual(b % bw, b / bw);
   }
   std::fill(forced.begin(), forced.end(), 0);
@@ -483,7 +627,10 @@ void CpuSolver::onParamsChanged() {
       next.erosionEnabled != m.p.erosionEnabled) {
     m.thermalDirty = true;
   }
+  const int reach = m.reachCells();
   m.p = next;
+  // Cells the old reach left out may hold intermediates the new model reads: all run twice.
+  if (m.reachCells() != reach) m.dirty = true;
   m.allocateFor(next);
   // No erosion, no toe scour (E8): what the last erosion pass left must not bring banks down.
   if (!next.erosionEnabled && !m.scour.empty()) m.scour = cpu::Plane(m.w, m.h);
@@ -730,7 +877,7 @@ void CpuSolver::writeBlock(const CellBlock& b) {
       const size_t k = size_t(by * m.bw + bx);
       m.forced[k] = 1;
       m.thermalForced[k] = 1;
-      m.quiet[k] = m.blockQuiet(bx, by);
+      m.lookAt(bx, by);
       m.evapResidual[k] = m.blockEvapResidual(bx, by);
     }
   }

@@ -73,6 +73,21 @@ SimParams floodCase() {
   return p;
 }
 
+// Flood mode with the MC limiter and open west and south edges (W27 extrapolates there), and
+// the local-inertial scheme: the reaches of the other slopes, the open edges and the other faces.
+SimParams floodCaseMC() {
+  SimParams p = floodCase();
+  p.slopeLimiter = SlopeLimiter::kMonotonizedCentral;
+  p.openEdges = kEdgeSouth | kEdgeWest;
+  return p;
+}
+
+SimParams inertialCase() {
+  SimParams p = floodCase();
+  p.floodScheme = FloodScheme::kLocalInertial;
+  return p;
+}
+
 SimParams erosionCase(bool diagonal) {
   SimParams p = test::erosionParams();
   p.rainMmPerHour = 0.0f;  // the raster's patch only: most blocks stay dry
@@ -133,8 +148,8 @@ int wetCells(const CpuSolver& s) {
   return n;
 }
 
-// The three cases: flood mode, and pipes + erosion + thermal weathering without and with
-// diagonal pipes, with their step counts.
+// The cases: flood mode (minmod; MC with open edges; local inertial), and pipes + erosion +
+// thermal weathering without and with diagonal pipes, with their step counts.
 struct Case {
   const char* name;
   SimParams params;
@@ -142,6 +157,8 @@ struct Case {
 };
 std::vector<Case> cases() {
   return {{"flood", floodCase(), 80},
+          {"flood, MC limiter, open west edge", floodCaseMC(), 80},
+          {"local inertial", inertialCase(), 80},
           {"pipes + erosion + thermal", erosionCase(false), 150},
           {"diagonal pipes + erosion + thermal", erosionCase(true), 150}};
 }
