@@ -90,9 +90,9 @@ void writeCpuScenario(const fs::path& dir) {
 
 // The dam break at 60 m cells on the CPU (~5 s of stepping), an output every `interval`
 // ("1 min", "20 min"), as dir/dam.toml.
-void writeLongDamBreak(const fs::path& dir, const std::string& interval) {
+void writeLongDamBreak(const fs::path& dir, const std::string& interval, const std::string& cell = "60 m") {
   std::string text = damBreakText();
-  text.replace(text.find("cell_size = \"600 m\""), 19, "cell_size = \"60 m\"");
+  text.replace(text.find("cell_size = \"600 m\""), 19, "cell_size = \"" + cell + "\"");
   text.replace(text.find("output_interval = \"5 min\""), 25, "output_interval = \"" + interval + "\"");
   text.replace(text.find("kind = \"flood\""), 14, "kind = \"flood\"\nbackend = \"cpu\"");
   std::ofstream(dir / "dam.toml") << text;
@@ -345,11 +345,14 @@ TEST(StrataCli, CtrlCWhilePlotsAreDrawnKeepsTheReport) {
 // starts: the report is written, marked stopped, and --resume runs it to the end.
 TEST(StrataCli, CtrlCBeforeTheFirstOutputLeavesAResumableRun) {
   const auto dir = strata::test::tempDir("cli-ctrl-c-early");
-  writeLongDamBreak(dir, "20 min");
+  // The interval must outlast the wait before the signal many times over: at 60 m cells it took
+  // 0.4 s on this 2-core machine once the CPU backend ran only the cells a step reaches, and the
+  // run ended before a Ctrl-C sent 0.5 s after it started. At 30 m: 1.8 s (2,391 steps).
+  writeLongDamBreak(dir, "20 min", "30 m");
   const pid_t pid = spawn({"flood", "dam.toml", "-o", "run", "--no-pictures"}, dir, dir / "run.log");
   ASSERT_TRUE(waitUntil([&] { return slurp(dir / "run.log").find("running on") != std::string::npos; }, 120))
       << slurp(dir / "run.log");
-  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
   ASSERT_EQ(::kill(-pid, SIGINT), 0);
   const int code = waitFor(pid);
   const std::string log = slurp(dir / "run.log");
