@@ -464,13 +464,16 @@ void Impl::finishStep() {
   const int blocks = bw * bh;
   const bool parallel = passThreads > 1 && water.cells >= kMinParallelCells;
   // While rain falls everywhere every block is busy anyway: the blocks that ran count as not
-  // quiet (which is always safe) without a look at their cells.
+  // quiet, their whole block as their extent (which is always safe), without a look at their cells.
   const bool rainEverywhere = p.rainMmPerHour != 0.0f;
 #pragma omp parallel for schedule(dynamic, 8) num_threads(passThreads) if (parallel)
   for (int b = 0; b < blocks; ++b) {
-    if (water.on[size_t(b)]) {
+    if (water.on[size_t(b)] && rainEverywhere) {
+      const int x0 = (b % bw) * kBlock, y0 = (b / bw) * kBlock;
+      extent[size_t(b)] = {y0, std::min(h, y0 + kBlock), x0, std::min(w, x0 + kBlock)};
+      quiet[size_t(b)] = 0;
+    } else if (water.on[size_t(b)]) {
       lookAt(b % bw, b / bw);
-      quiet[size_t(b)] = quiet[size_t(b)] && !rainEverywhere;
     }
     if (sources.on[size_t(b)]) evapResidual[size_t(b)] = blockEvapResidual(b % bw, b / bw);
   }
