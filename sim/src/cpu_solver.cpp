@@ -305,13 +305,14 @@ void Impl::fillRuns(BlockSet& set) const {
 // when either difference is), and a face whose two reconstructed depths are 0 carries nothing
 // (W13-W16: no flux, no hydrostatic term), so the predictor wets at most the cells beside water
 // and the corrector the cells beside those: 2. A cell further away keeps its predictor (its
-// state), faces (0), limit (1) and bed source at a dry neighbourhood's values.
-// (SimCpu.SkippingQuietBlocksChangesNoBit fails with 1.) The other models (pipes, the inertial
-// faces' cross terms, erosion's bank failure and the thermal passes after the water) keep the
-// 8 cells the blocks gave them before (not analysed further).
+// state), faces (0), limit (1) and bed source at a dry neighbourhood's values. The local-inertial
+// scheme: a face between two dry cells has hf = 0 (W31) and carries nothing whatever the faces
+// across it carried, and an open edge's ghost never lets water in (W32): 1.
+// (SimCpu.SkippingQuietBlocksChangesNoBit fails with 1 and 0.) Pipes, erosion's bank failure and
+// the thermal passes after the water keep the 8 cells the blocks gave them (not analysed).
 int Impl::reachCells() const {
-  const bool finiteVolume = p.waterModel == WaterModel::kFiniteVolume && !inertial();
-  return finiteVolume && !p.erosionEnabled && !p.thermalEnabled ? 2 : kBlock;
+  if (p.waterModel != WaterModel::kFiniteVolume || p.erosionEnabled || p.thermalEnabled) return kBlock;
+  return inertial() ? 1 : 2;
 }
 
 // Marks the cells [x0 - margin, x1 + margin) x [y0 - margin, y1 + margin) (clipped) to run.
