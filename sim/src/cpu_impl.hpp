@@ -172,8 +172,9 @@ struct Impl {
   float wetThresholdM = 0.0f;
 
   // ---- active blocks (cpu_solver.cpp) ----
-  std::vector<uint8_t> quiet;         // per block: every cell's water state (and pipe outflows) +0
-  std::vector<Run> extent;            // per block: the smallest rectangle of its cells that are not quiet
+  // Per block: the smallest rectangle of its cells that are not quiet (water state or pipe
+  // outflows not +0); empty (x1 <= x0) when the block is quiet.
+  std::vector<Run> extent;
   std::vector<uint8_t> needCell;      // per cell (w x h, row-major): the water passes run here this step
   std::vector<uint8_t> needPrevCell;  // per cell: what last step needed (it runs once more)
   std::vector<uint8_t> columns;       // scratch: a row group's columns with a cell to run
@@ -218,8 +219,8 @@ struct Impl {
   void dilate(std::vector<uint8_t>& on);
   int reachCells() const;
   void needCells(int x0, int x1, int y0, int y1, int margin);
-  void lookAt(int bx, int by);  // the block's quiet flag and extent from its cells
   Run busyExtent(int bx, int by) const;
+  bool quiet(size_t block) const { return extent[block].x1 <= extent[block].x0; }
   bool blockEvapResidual(int bx, int by) const;
   void markAll();  // state replaced: all flags recomputed, every block runs for two steps
   void allocateFor(const SimParams& params);

@@ -142,7 +142,7 @@ Impl::Impl(const SimInput& input, const SimParams& params, int threadCount, bool
   columns.assign(size_t(w), 0);
   for (auto* v : {&spanRun, &spanPrev, &spanNeed}) v->assign(size_t(h), {w, 0});
   extent.assign(size_t(bw) * size_t(bh), Run{});
-  for (auto* v : {&quiet, &forced, &evapResidual, &rainBlock, &thermalMoving, &thermalForced, &work}) {
+  for (auto* v : {&forced, &evapResidual, &rainBlock, &thermalMoving, &thermalForced, &work}) {
     v->assign(blocks, 0);
   }
   for (auto* set : {&water, &sources, &thermalEval, &thermalApply, &lastThermalApply}) {
@@ -204,7 +204,7 @@ void Impl::markAll() {
   thermalDirty = true;
   for (int by = 0; by < bh; ++by) {
     for (int bx = 0; bx < bw; ++bx) {
-      lookAt(bx, by);
+      extent[size_t(by * bw + bx)] = busyExtent(bx, by);
       evapResidual[size_t(by * bw + bx)] = blockEvapResidual(bx, by);
     }
   }
@@ -214,16 +214,9 @@ void Impl::markAll() {
   allocateFor(p);
 }
 
-// A block is quiet when all its cells' water state (and pipe outflows) are +0: with quiet
-// neighbours, no rain, source or level, a step maps such a cell to itself, bit for bit
-// (docs/sim-water.md, "The CPU backend"). Its extent is the smallest rectangle of its cells that
-// are not (x1 <= x0 when it is quiet).
-void Impl::lookAt(int bx, int by) {
-  const size_t b = size_t(by * bw + bx);
-  extent[b] = busyExtent(bx, by);
-  quiet[b] = extent[b].x1 <= extent[b].x0;
-}
-
+// A cell is quiet when its water state (and pipe outflows) are +0: with quiet neighbours, no
+// rain, source or level, a step maps it to itself, bit for bit (docs/sim-water.md, "The CPU
+// backend"). The smallest rectangle of block (bx, by)'s cells that are not (x1 <= x0: none).
 Run Impl::busyExtent(int bx, int by) const {
   const int x0 = bx * kBlock, x1 = std::min(w, x0 + kBlock), y0 = by * kBlock, y1 = std::min(h, y0 + kBlock);
   const Water& u = now();
@@ -376,7 +369,7 @@ void Impl::fillWaterRuns() {
 // predictor at the values every later step would give them. The sources pass runs on the busy
 // blocks and where an evaporation sum carries an error term.
 void Impl::planStep(const std::vector<SourceEntry>& entries, const std::vector<LevelEntry>& levels) {
-  const size_t blocks = quiet.size();
+  const size_t blocks = extent.size();
   auto all = [&](BlockSet& set) {
     std::fill(set.on.begin(), set.on.end(), 1);
     fillRuns(set);
@@ -389,7 +382,7 @@ void Impl::planStep(const std::vector<SourceEntry>& entries, const std::vector<L
   }
   std::vector<uint8_t>& busy = sources.on;
   const bool rainEverywhere = p.rainMmPerHour != 0.0f;
-  for (size_t b = 0; b < blocks; ++b) busy[b] = !quiet[b] || rainBlock[b] || rainEverywhere;
+  for (size_t b = 0; b < blocks; ++b) busy[b] = !quiet(b) || rainBlock[b] || rainEverywhere;
   auto blockOf = [&](uint32_t cell) {
     return size_t(int(cell / uint32_t(w)) / kBlock * bw + int(cell % uint32_t(w)) / kBlock);
   };
@@ -411,7 +404,7 @@ void Impl::planStep(const std::vector<SourceEntry>& entries, const std::vector<L
         const int x0 = bx * kBlock, y0 = by * kBlock, x1 = std::min(w, x0 + kBlock), y1 = std::min(h, y0 + kBlock);
         if (rainBlock[b]) {
           needCells(x0, x1, y0, y1, reach);
-        } else if (!quiet[b]) {
+        } else if (!quiet(b)) {
           const Run& e = extent[b];
           if (e.x1 > e.x0) needCells(e.x0, e.x1, e.y0, e.y1, reach);
         }
@@ -472,9 +465,8 @@ void Impl::finishStep() {
     if (water.on[size_t(b)] && rainEverywhere) {
       const int x0 = (b % bw) * kBlock, y0 = (b / bw) * kBlock;
       extent[size_t(b)] = {y0, std::min(h, y0 + kBlock), x0, std::min(w, x0 + kBlock)};
-      quiet[size_t(b)] = 0;
     } else if (water.on[size_t(b)]) {
-      lookAt(b % bw, b / bw);
+      extent[size_t(b)] = busyExtent(b % bw, b / bw);
     }
     if (sources.on[size_t(b)]) evapResidual[size_t(b)] = blockEvapResidual(b % bw, b / bw);
   }
@@ -881,7 +873,7 @@ void CpuSolver::writeBlock(const CellBlock& b) {
       const size_t k = size_t(by * m.bw + bx);
       m.forced[k] = 1;
       m.thermalForced[k] = 1;
-      m.lookAt(bx, by);
+      m.extent[k] = m.busyExtent(bx, by);
       m.evapResidual[k] = m.blockEvapResidual(bx, by);
     }
   }

@@ -1128,11 +1128,11 @@ float Impl::maxWaveSpeed() const {
   float m = 0.0f;
   const int blocks = bw * bh;
   size_t wetBlocks = 0;
-  for (int b = 0; b < blocks; ++b) wetBlocks += !(skip && quiet[size_t(b)]);
+  for (int b = 0; b < blocks; ++b) wetBlocks += !(skip && quiet(size_t(b)));
   const bool parallel = passThreads > 1 && wetBlocks * kBlock * kBlock >= kMinParallelCells;
 #pragma omp parallel for schedule(dynamic, 8) num_threads(passThreads) if (parallel) reduction(max : m)
   for (int b = 0; b < blocks; ++b) {
-    if (skip && quiet[size_t(b)]) continue;
+    if (skip && quiet(size_t(b))) continue;
     const int bx = b % bw, by = b / bw;
     const int x0 = bx * kBlock, x1 = std::min(x0 + kBlock, w), y0 = by * kBlock, y1 = std::min(y0 + kBlock, h);
     for (int y = y0; y < y1; ++y) {
