@@ -35,7 +35,7 @@ layout(std430, binding = SLOT_CLOCK) CLOCK_QUALIFIER buffer ClockBlock {
   uint done;             // 1 once timeS reached endS: the passes dispatch no group
   uint adaptive;         // cflAlpha > 0 (W10); else every step is maxDtS
   uint termCount;        // Terms (the point-source entries' shares of the sources)
-  uint pad1;
+  uint inertial;         // the local-inertial scheme: W10's sqrt(S^2 + g r dt) (W33)
   uint pad2;
   uint pad3;
   uint dispatchNow[3 * CLOCK_SHAPES];   // what the passes dispatch this step

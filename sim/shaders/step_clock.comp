@@ -49,16 +49,20 @@ double seriesMaxOver(uint first, uint count, double t0, double t1) {
   return m;
 }
 
-// W10 (bookkeeping.cpp's stepDt): the longest dt <= maxDtS with dt (S + sqrt(g r dt)) <= reach.
+// W10 (bookkeeping.cpp's stepDt): the longest dt <= maxDtS with dt (S + sqrt(g r dt)) <= reach,
+// or dt sqrt(S^2 + g r dt) <= reach for the local-inertial scheme (W33).
+double travel(double dt, double s, double k) {
+  return C.inertial != 0u ? dt * sqrt(s * s + k * k * dt) : dt * (s + k * sqrt(dt));
+}
 double stepDt(double s, double r) {
   const double cap = C.maxDtS;
   if (C.adaptive == 0u || (s <= 0.0lf && r <= 0.0lf)) return cap;
   const double k = sqrt(C.gravityMS2 * max(r, 0.0lf));
-  if (cap * (s + k * sqrt(cap)) <= C.reachM) return cap;
+  if (travel(cap, s, k) <= C.reachM) return cap;
   double lo = 0.0lf, hi = cap;
   for (int i = 0; i < 60; ++i) {
     const double mid = 0.5lf * (lo + hi);
-    if (mid * (s + k * sqrt(mid)) <= C.reachM) {
+    if (travel(mid, s, k) <= C.reachM) {
       lo = mid;
     } else {
       hi = mid;

@@ -64,8 +64,13 @@ double stepDt(const SimParams& params, double maxWaveSpeedMS, double minCellM, d
   const double cap = params.maxDtS, reach = double(params.cflAlpha) * minCellM;
   if (params.cflAlpha <= 0 || (maxWaveSpeedMS <= 0 && sourceDepthRateMS <= 0)) return cap;
   const double k = std::sqrt(double(params.gravityMS2) * std::max(sourceDepthRateMS, 0.0));
-  // W10: dt (S + k sqrt(dt)) grows with dt; bisect for where it reaches alpha * min cell.
-  auto travel = [&](double dt) { return dt * (maxWaveSpeedMS + k * std::sqrt(dt)); };
+  // W10: dt (S + k sqrt(dt)), or dt sqrt(S^2 + k^2 dt) for the local-inertial scheme (W33), grows
+  // with dt; bisect for where it reaches alpha * min cell.
+  const bool inertial = params.floodScheme == FloodScheme::kLocalInertial;
+  auto travel = [&](double dt) {
+    return inertial ? dt * std::sqrt(maxWaveSpeedMS * maxWaveSpeedMS + k * k * dt)
+                    : dt * (maxWaveSpeedMS + k * std::sqrt(dt));
+  };
   if (travel(cap) <= reach) return cap;
   double lo = 0.0, hi = cap;
   for (int i = 0; i < 60; ++i) {

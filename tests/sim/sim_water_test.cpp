@@ -226,6 +226,15 @@ TEST(SimWaterCpu, StepCountsItsSources) {
   const double both = stepDt(p, 4.0, L, r);  // dt (S + sqrt(g r dt)) = alpha L
   EXPECT_NEAR(both * (4.0 + std::sqrt(g * r * both)), 0.5 * L, 1e-9);
   EXPECT_EQ(stepDt(p, 0.0, L, 0.0), 1000.0);  // still and unfed: the cap
+  // The local-inertial scheme (S = max sqrt(g h), W33): dt sqrt(S^2 + g r dt) = alpha L, longer
+  // than the bound above and the same without a source or on a dry domain.
+  SimParams in = p;
+  in.floodScheme = FloodScheme::kLocalInertial;
+  const double inertial = stepDt(in, 4.0, L, r);
+  EXPECT_NEAR(inertial * std::sqrt(16.0 + g * r * inertial), 0.5 * L, 1e-9);
+  EXPECT_GT(inertial, 1.2 * both);
+  EXPECT_EQ(stepDt(in, 4.0, L), stepDt(p, 4.0, L));
+  EXPECT_NEAR(stepDt(in, 0.0, L, r), stepDt(p, 0.0, L, r), 1e-12);
   // The rate bound: the hydrograph's peak inside the window, shared by the source's cells, over
   // the cell area; plus rain (uniform + the raster's maximum).
   Source s;

@@ -210,6 +210,7 @@ struct GlSolver::Impl {
     c.gravityMS2 = double(sp.gravityMS2);
     c.rainRateMS = r.rainRateMS;
     c.adaptive = sp.cflAlpha > 0 ? 1u : 0u;
+    c.inertial = sp.floodScheme == FloodScheme::kLocalInertial ? 1u : 0u;
     c.termCount = uint32_t(termCount);
     auto groups = [](size_t cells, int per) { return uint32_t((cells + size_t(per) - 1) / size_t(per)); };
     const uint32_t full[3 * kClockShapes] = {groups(size_t(p.width), 16),

@@ -41,7 +41,9 @@ std::vector<SourceEntry> mergeSources(const std::vector<Source>& sources, int wi
 /// dt <= maxDtS with dt * (S + sqrt(g r dt)) <= alpha * minCellM, S = `maxWaveSpeedMS` =
 /// max(|u| + sqrt(g h)) before the step and r = `sourceDepthRateMS`, a bound on the depth per
 /// second the step's sources add to any one cell (sourceDepthRate()): the wave speed after they
-/// pour in is at most S + sqrt(g r dt), so the step is not too long for the water it adds.
+/// pour in is at most S + sqrt(g r dt), so the step is not too long for the water it adds. The
+/// local-inertial scheme's S is max sqrt(g h) (W33), and sqrt(g (h + r dt)) <= sqrt(S^2 + g r dt):
+/// its step is the longest with dt * sqrt(S^2 + g r dt) <= alpha * minCellM.
 double stepDt(const SimParams& params, double maxWaveSpeedMS, double minCellM, double sourceDepthRateMS = 0.0);
 
 /// Bound on the depth per second (m/s) rain and sources add to any one cell over [t0S, t1S]:
