@@ -3,10 +3,12 @@
 // W24 force noise floor, W25 outflow limits (corrector). final = 0: Heun predictor U1 = U0 - dt L(U0) into `stage`;
 // final = 1: U0 - dt (L(U0) + L(U1)) / 2 into stateOut (W22; the depth with compensation, W34),
 // then W19 Manning friction,
-// E5 sediment transport, E0 tilt.
+// E5 sediment transport, E0 tilt; the corrector ends with the step's tail when fused (W36,
+// sim_tail.glsl).
 #include "sim.glsl"
 #include "sim_accum.glsl"
 #include "sim_limit.glsl"
+#include "sim_tail.glsl"
 layout(local_size_x = SIM_GROUP_X, local_size_y = SIM_GROUP_Y) in;
 layout(std430, binding = SLOT_BED) readonly buffer Bed { float bed[]; };
 layout(std430, binding = SLOT_STATE_IN) readonly buffer StateIn { vec4 state[]; };
@@ -43,9 +45,8 @@ float outflowTotal(ivec2 q) {
   return (max(-fW, 0.0) + max(fE, 0.0)) * P.dyM + max(-fN, 0.0) * faceWidthY(q.y) + max(fS, 0.0) * faceWidthY(q.y + 1);
 }
 
-void main() {
-  const ivec2 p = ivec2(gl_GlobalInvocationID.xy);
-  if (!insideGrid(p)) return;
+// The cell's update; true when it wrote the step's final state (the corrector) into `sOut`.
+bool updateCell(ivec2 p, out vec4 sOut) {
   const int i = cellOf(p), w = P.width;
   const float dt = P.dtS, g = P.gravityMS2, dry = P.dryDepthM;
   const float n2 = manningN2[i] >= 0.0 ? manningN2[i] : P.manningN * P.manningN;
@@ -89,7 +90,7 @@ void main() {
   }
   if (final_ == 0) {
     stage[i] = vec4(hNew, s, huNew, hvNew);
-    return;
+    return false;
   }
   // E5: suspended sediment moves with the water volume crossing each face, upwind.
   const float denI = max(h * A, outflowTotal(p) * dt);
@@ -113,6 +114,15 @@ void main() {
       if (denJ > 0.0) sNew += state[j].y * Aj * (-volOut) / denJ / A;
     }
   }
-  stateOut[i] = vec4(hNew, sNew, huNew, hvNew);
+  sOut = vec4(hNew, sNew, huNew, hvNew);
+  stateOut[i] = sOut;
   tilt[i] = sinTilt(p);
+  return true;
+}
+
+void main() {
+  const ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+  vec4 s = vec4(0.0);
+  const bool wrote = insideGrid(p) && updateCell(p, s);
+  stepTail(p, wrote, s);
 }

@@ -3,10 +3,12 @@
 // discharge scaled by its upwind cell's limit; the depth from their net inflow into stateOut; the
 // applied discharges into flux (W, E, N, S: the next step's q0), the depth with compensation
 // (W34); the cell's discharge the mean
-// of its two faces' on each axis; what leaves through an open edge into the outflow sum (W20).
+// of its two faces' on each axis; what leaves through an open edge into the outflow sum (W20);
+// the step's tail when fused (W36, sim_tail.glsl).
 #include "sim.glsl"
 #include "sim_accum.glsl"
 #include "sim_limit.glsl"
+#include "sim_tail.glsl"
 layout(local_size_x = SIM_GROUP_X, local_size_y = SIM_GROUP_Y) in;
 layout(std430, binding = SLOT_STATE_IN) readonly buffer StateIn { vec4 state[]; };
 layout(std430, binding = SLOT_STATE_OUT) writeonly buffer StateOut { vec4 stateOut[]; };
@@ -14,9 +16,7 @@ layout(std430, binding = SLOT_FACE_X) readonly buffer FaceX { vec4 faceX[]; };
 layout(std430, binding = SLOT_FACE_Y) readonly buffer FaceY { vec4 faceY[]; };
 layout(std430, binding = SLOT_FLUX) writeonly buffer Flux { vec4 flux[]; };
 
-void main() {
-  const ivec2 p = ivec2(gl_GlobalInvocationID.xy);
-  if (!insideGrid(p)) return;
+vec4 updateCell(ivec2 p) {
   const int i = cellOf(p), w = P.width, h = P.height;
   const float dt = P.dtS, A = cellArea(p.y), wN = faceWidthY(p.y), wS = faceWidthY(p.y + 1), dy = P.dyM;
   float fW = faceX[p.y * (w + 1) + p.x].x, fE = faceX[p.y * (w + 1) + p.x + 1].x;
@@ -27,9 +27,19 @@ void main() {
   fS *= limitOfFace(fS, p, p + ivec2(0, 1));
   const vec4 s = state[i];
   const float hNew = addDepthFaces(s.x, i, dt / A, fW * dy, fE * dy, fN * wN, fS * wS);
-  stateOut[i] = vec4(hNew, s.y, 0.5 * (fW + fE), 0.5 * (fN + fS));
+  const vec4 sNew = vec4(hNew, s.y, 0.5 * (fW + fE), 0.5 * (fN + fS));
+  stateOut[i] = sNew;
   flux[i] = vec4(fW, fE, fN, fS);
   const float leaving = ((p.x == 0 ? max(-fW, 0.0) : 0.0) + (p.x == w - 1 ? max(fE, 0.0) : 0.0)) * dy * dt +
                     (p.y == 0 ? max(-fN, 0.0) : 0.0) * wN * dt + (p.y == h - 1 ? max(fS, 0.0) : 0.0) * wS * dt;
   if (leaving > 0.0) kahanAdd(accumAt(i, ACCUM_OUTFLOW), leaving);
+  return sNew;
+}
+
+void main() {
+  const ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+  const bool inside = insideGrid(p);
+  vec4 s = vec4(0.0);
+  if (inside) s = updateCell(p);
+  stepTail(p, inside, s);
 }

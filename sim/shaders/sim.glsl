@@ -92,6 +92,12 @@ float faceWidthY(int yFace) {
   return 0.5 * (rowDx[yFace - 1] + rowDx[yFace]);
 }
 float velocityOf(float h, float q) { return h > P.dryDepthM ? q / h : 0.0; }
+// W10: a cell's wave speed |u| + sqrt(g h) (W33: sqrt(g h) with the local-inertial scheme, whose
+// step has no advection in it).
+float waveSpeedOf(vec4 s) {
+  const float u = velocityOf(s.x, s.z), w = velocityOf(s.x, s.w);
+  return (P.floodScheme == 1 ? 0.0 : sqrt(u * u + w * w)) + sqrt(P.gravityMS2 * s.x);
+}
 
 // W11b: u - ln(1 + u) for u >= 0, a series below 0.1 (sim/src/cpu_kernels.hpp's uMinusLog1p).
 float uMinusLog1p(float u) {

@@ -11,7 +11,7 @@
 #include "sim.glsl"
 #include "sim_clock.glsl"
 layout(local_size_x = 1) in;
-layout(std430, binding = SLOT_MAX_SPEED) readonly buffer MaxSpeed { uint maxSpeedBits; };
+layout(std430, binding = SLOT_MAX_SPEED) buffer MaxSpeed { uint maxSpeedBits; };
 layout(std430, binding = SLOT_SOURCES) buffer Sources { SourceEntry entries[]; };
 layout(std430, binding = SLOT_SERIES) readonly buffer Series { dvec2 samples[]; };
 layout(std430, binding = SLOT_TERMS) readonly buffer Terms { Term terms[]; };
@@ -95,6 +95,7 @@ void main() {
     return;
   }
   const double s = double(uintBitsToFloat(maxSpeedBits));
+  maxSpeedBits = 0u;  // W36: a fused water update adds the next step's wave speed to it
   double chosen = C.maxDtS;
   if (C.adaptive != 0u) {
     const double window = stepDt(s, 0.0lf);

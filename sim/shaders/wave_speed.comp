@@ -1,5 +1,6 @@
 #version 450
-// W10: max over cells of |u| + sqrt(g h) (W33: sqrt(g h) with the local-inertial scheme), as float bits (non-negative floats order like uints).
+// W10: max over cells of waveSpeedOf (|u| + sqrt(g h); W33: sqrt(g h) with the local-inertial
+// scheme), as float bits (non-negative floats order like uints).
 #include "sim.glsl"
 layout(local_size_x = 256) in;
 layout(std430, binding = SLOT_STATE_IN) readonly buffer StateIn { vec4 state[]; };
@@ -8,12 +9,7 @@ shared float sMax[256];
 void main() {
   const uint i = gl_GlobalInvocationID.x, l = gl_LocalInvocationID.x;
   float v = 0.0;
-  if (i < uint(P.width * P.height)) {
-    const vec4 s = state[i];
-    const float u = velocityOf(s.x, s.z), w = velocityOf(s.x, s.w);
-    // The local-inertial scheme's step has no advection in it (W33): sqrt(g h) alone.
-    v = (P.floodScheme == 1 ? 0.0 : sqrt(u * u + w * w)) + sqrt(P.gravityMS2 * s.x);
-  }
+  if (i < uint(P.width * P.height)) v = waveSpeedOf(state[i]);
   sMax[l] = v;
   barrier();
   for (uint stride = 128u; stride > 0u; stride >>= 1) {

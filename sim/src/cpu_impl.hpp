@@ -228,6 +228,11 @@ struct Impl {
 
   // ---- passes (cpu_water.cpp) ----
   void sourcesPass(const std::vector<SourceEntry>& entries);
+  void pointSources(const std::vector<SourceEntry>& entries);  // W12
+  // W11 or W11b can change a cell: rain (uniform or a raster), evaporation or infiltration.
+  bool rainOrLosses() const {
+    return p.rainMmPerHour != 0.0f || !rain.empty() || p.evaporationMmPerHour != 0.0f || !infilKs.empty();
+  }
   void pipeFluxPass();
   void pipeUpdatePass();
   void fvFacePass(const Water& u, bool average);

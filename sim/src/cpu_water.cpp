@@ -65,8 +65,13 @@ STRATA_ROW_KERNEL void infiltrationRow(float* h, float* herr, float* sum, float*
 }
 
 // sim/shaders/sources.comp: rain (W11), evaporation (W11), infiltration (W11b), then
-// point_sources.comp (W12).
+// point_sources.comp (W12). Without rain, evaporation or infiltration W11 and W11b change nothing
+// (adding 0 leaves a settled depth as it is) and are skipped, as the GL backend skips the pass.
 void Impl::sourcesPass(const std::vector<SourceEntry>& entries) {
+  if (!rainOrLosses()) {
+    pointSources(entries);
+    return;
+  }
   forRuns(sources, [&](const Run& r, int) {
     const float evapMax = p.evaporationMmPerHour * kMmPerHourToMS * dt;
     for (int y = r.y0; y < r.y1; ++y) {
@@ -79,6 +84,10 @@ void Impl::sourcesPass(const std::vector<SourceEntry>& entries) {
       }
     }
   });
+  pointSources(entries);
+}
+
+void Impl::pointSources(const std::vector<SourceEntry>& entries) {
   for (const auto& e : entries) {
     const int y = int(e.cell / uint32_t(w)), x = int(e.cell % uint32_t(w));
     addDepth(now().h.at(x, y), accum[kAccumDepthError].at(x, y), e.rateM3S * dt / rowArea[size_t(y)]);

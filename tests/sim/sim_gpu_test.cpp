@@ -156,28 +156,32 @@ TEST_F(GlTest, SimBalanceHoldsOver150kFloat32Steps) {
 
 // Issue 35: what a GL step asks of the host (gl::callCounts). Flood mode's adaptive step (W10)
 // reads back the 4-byte wave speed, the only wait a step has; pipe mode's fixed step reads
-// nothing; neither queries GL. The dispatches a step: sources, point sources (a spring here), then
-// the finite-volume scheme's predictor faces and update, corrector faces, W25 limits, update and
-// the wave speed; the local-inertial scheme's faces, limits, update and wave speed; the pipes'
-// fluxes and update.
+// nothing; neither queries GL. The dispatches a step: the rain (W11, only when it rains: without
+// rain, evaporation or infiltration it would add 0), point sources (a spring here), then the
+// finite-volume scheme's predictor faces and update, corrector faces, W25 limits, update and the
+// wave speed; the local-inertial scheme's faces, limits, update and wave speed; the pipes' fluxes
+// and update.
 TEST_F(GlTest, SimStepReadsBackOnlyTheWaveSpeed) {
   constexpr int kSteps = 10;
   struct Case {
     const char* what;
     strata::sim::WaterModel model;
     strata::sim::FloodScheme scheme;
+    float rainMmH;
     uint64_t dispatches, reads;  // a step
   };
   for (const Case& c :
-       {Case{"finite volume", WaterModel::kFiniteVolume, strata::sim::FloodScheme::kFiniteVolume, 8, 1},
-        Case{"local inertial", WaterModel::kFiniteVolume, strata::sim::FloodScheme::kLocalInertial, 6, 1},
-        Case{"pipes", WaterModel::kVirtualPipes, strata::sim::FloodScheme::kFiniteVolume, 4, 0}}) {
+       {Case{"finite volume", WaterModel::kFiniteVolume, strata::sim::FloodScheme::kFiniteVolume, 0.0f, 7, 1},
+        Case{"finite volume in rain", WaterModel::kFiniteVolume, strata::sim::FloodScheme::kFiniteVolume, 10.0f, 8, 1},
+        Case{"local inertial", WaterModel::kFiniteVolume, strata::sim::FloodScheme::kLocalInertial, 0.0f, 5, 1},
+        Case{"pipes", WaterModel::kVirtualPipes, strata::sim::FloodScheme::kFiniteVolume, 0.0f, 3, 0}}) {
     auto in = test::sloshingBox(32);
     for (int y = 0; y < 32; ++y) {
       for (int x = 0; x < 32; ++x) in.waterDepthM.at(x, y) = x < 10 ? 2.0f : 0.0f;
     }
     auto p = c.model == WaterModel::kVirtualPipes ? pipeParams() : floodParams();
     p.floodScheme = c.scheme;
+    p.rainMmPerHour = c.rainMmH;
     auto sim = GlSolver::create(in, p);
     ASSERT_TRUE(sim) << sim.message();
     ASSERT_TRUE(sim->addSource(test::valleySpring(32)));
@@ -202,56 +206,82 @@ TEST_F(GlTest, SimStepReadsBackOnlyTheWaveSpeed) {
 // steps, where stepping from the host reads the wave speed at every step. A dam break with rain
 // and a spring whose hydrograph rises through the run, flood statistics on: advance() takes the
 // same steps to the same time as the host-stepped GL run, with the same budgets, depths and
-// arrival times, and both agree with the CPU.
+// flood statistics, and both agree with the CPU; for both flood schemes. A device step fuses the
+// flood statistics and the next step's wave speed into its water update (W36): it dispatches
+// the clock, the sources, the point sources and the scheme's passes (finite volume 4, local
+// inertial 3), where a host step also dispatches the wave speed and the statistics.
 TEST_F(GlTest, SimDeviceStepsReadOnlyTheirClock) {
-  auto in = test::sloshingBox(32);
-  for (int y = 0; y < 32; ++y) {
-    for (int x = 0; x < 32; ++x) in.waterDepthM.at(x, y) = x < 10 ? 2.0f : 0.0f;
+  using strata::sim::FloodScheme;
+  for (const auto& [scheme, schemePasses] :
+       {std::pair{FloodScheme::kFiniteVolume, 5}, std::pair{FloodScheme::kLocalInertial, 3}}) {
+    SCOPED_TRACE(scheme == FloodScheme::kFiniteVolume ? "finite volume" : "local inertial");
+    auto in = test::sloshingBox(32);
+    for (int y = 0; y < 32; ++y) {
+      for (int x = 0; x < 32; ++x) in.waterDepthM.at(x, y) = x < 10 ? 2.0f : 0.0f;
+    }
+    auto p = floodParams();
+    p.floodScheme = scheme;
+    p.rainMmPerHour = 30.0f;
+    p.openEdges = strata::sim::kEdgeEast;
+    constexpr double kEndS = 300.0;
+    auto device = GlSolver::create(in, p);
+    auto host = GlSolver::create(in, p);
+    auto cpu = CpuSolver::create(in, p);
+    ASSERT_TRUE(device && host && cpu);
+    for (Solver* sv : std::initializer_list<Solver*>{&*device, &*host, &*cpu}) {
+      ASSERT_TRUE(sv->addSource(test::valleySpring(32)));
+      sv->enableFloodStats(0.05f);
+    }
+    const gl::CallCounts d0 = gl::callCounts();
+    device->advance(kEndS);
+    const gl::CallCounts d1 = gl::callCounts();
+    while (!Solver::reached(host->timeS(), kEndS)) host->stepWithDt(std::min(host->nextDt(), kEndS - host->timeS()));
+    const gl::CallCounts d2 = gl::callCounts();
+    cpu->advance(kEndS);
+    const auto a = device->stats(), b = host->stats(), c = cpu->stats();
+    const double hostDispatches = double(d2.dispatches - d1.dispatches) / double(b.steps);
+    std::printf(
+        "device steps: %lld steps to %.9f s, %llu reads (%llu B), %llu dispatches; host steps: %lld, %llu reads, "
+        "%.3f dispatches a step; CPU %lld steps\n",
+        a.steps, a.timeS, (unsigned long long)(d1.hostReads - d0.hostReads),
+        (unsigned long long)(d1.hostReadBytes - d0.hostReadBytes), (unsigned long long)(d1.dispatches - d0.dispatches),
+        b.steps, (unsigned long long)(d2.hostReads - d1.hostReads), hostDispatches, c.steps);
+    EXPECT_GT(a.steps, 100);
+    EXPECT_LE(d1.hostReads - d0.hostReads, 4u);                 // the clock, once per run of steps
+    EXPECT_EQ(d2.hostReads - d1.hostReads, uint64_t(b.steps));  // the wave speed, every step
+    EXPECT_EQ(hostDispatches, 2.0 + schemePasses + 2.0);        // + the wave speed and the statistics
+    EXPECT_EQ(a.steps, b.steps);
+    EXPECT_EQ(a.timeS, b.timeS);
+    EXPECT_EQ(a.lastDtS, b.lastDtS);
+    EXPECT_NEAR(a.inflowM3, b.inflowM3, 1e-12 * b.inflowM3);
+    EXPECT_NEAR(a.rainM3, b.rainM3, 1e-12 * b.rainM3);
+    EXPECT_EQ(a.storedWaterM3, b.storedWaterM3);
+    EXPECT_LT(std::abs(a.waterBalanceM3()), 1e-6 * (a.initialWaterM3 + a.inflowM3 + a.rainM3));
+    EXPECT_EQ(maxAbsDiff(device->readWaterDepth(), host->readWaterDepth()), 0.0);
+    const auto fa = device->readFloodStats(), fb = host->readFloodStats();
+    EXPECT_EQ(maxAbsDiff(fa.maxDepthM, fb.maxDepthM), 0.0);
+    EXPECT_EQ(maxAbsDiff(fa.maxSpeedMS, fb.maxSpeedMS), 0.0);
+    EXPECT_EQ(maxAbsDiff(fa.arrivalS, fb.arrivalS), 0.0);
+    EXPECT_EQ(maxAbsDiff(fa.wetDurationS, fb.wetDurationS), 0.0);
+    EXPECT_EQ(a.steps, c.steps);
+    EXPECT_LT(maxAbsDiff(device->readWaterDepth(), cpu->readWaterDepth()), 1e-4);
+    // A second advance continues the same clock (its sources and rain from where it stopped).
+    // Its run of steps is sized from a step that has settled: a device step dispatches the
+    // clock, the sources, the point sources and the passes, and the run the first step's wave
+    // speed and the steps queued past the end (2 % and 2 more).
+    const gl::CallCounts d3 = gl::callCounts();
+    device->advance(60.0);
+    const gl::CallCounts d4 = gl::callCounts();
+    const double steps = double(device->stats().steps - a.steps);
+    const double deviceDispatches = double(d4.dispatches - d3.dispatches) / steps;
+    std::printf("device steps, 60 s more: %.0f steps, %llu reads, %.3f dispatches a step\n", steps,
+                (unsigned long long)(d4.hostReads - d3.hostReads), deviceDispatches);
+    EXPECT_GE(deviceDispatches, 3.0 + schemePasses);
+    EXPECT_LT(deviceDispatches, 1.1 * (3.0 + schemePasses));
+    host->advance(60.0);
+    EXPECT_EQ(device->stats().timeS, host->stats().timeS);
+    EXPECT_LT(maxAbsDiff(device->readWaterDepth(), host->readWaterDepth()), 1e-6);
   }
-  auto p = floodParams();
-  p.rainMmPerHour = 30.0f;
-  p.openEdges = strata::sim::kEdgeEast;
-  constexpr double kEndS = 300.0;
-  auto device = GlSolver::create(in, p);
-  auto host = GlSolver::create(in, p);
-  auto cpu = CpuSolver::create(in, p);
-  ASSERT_TRUE(device && host && cpu);
-  for (Solver* sv : std::initializer_list<Solver*>{&*device, &*host, &*cpu}) {
-    ASSERT_TRUE(sv->addSource(test::valleySpring(32)));
-    sv->enableFloodStats(0.05f);
-  }
-  const gl::CallCounts d0 = gl::callCounts();
-  device->advance(kEndS);
-  const gl::CallCounts d1 = gl::callCounts();
-  while (!Solver::reached(host->timeS(), kEndS)) host->stepWithDt(std::min(host->nextDt(), kEndS - host->timeS()));
-  const gl::CallCounts d2 = gl::callCounts();
-  cpu->advance(kEndS);
-  const auto a = device->stats(), b = host->stats(), c = cpu->stats();
-  std::printf(
-      "device steps: %lld steps to %.9f s, %llu reads (%llu B), %llu dispatches; host steps: %lld, %llu reads; "
-      "CPU %lld steps\n",
-      a.steps, a.timeS, (unsigned long long)(d1.hostReads - d0.hostReads),
-      (unsigned long long)(d1.hostReadBytes - d0.hostReadBytes), (unsigned long long)(d1.dispatches - d0.dispatches),
-      b.steps, (unsigned long long)(d2.hostReads - d1.hostReads), c.steps);
-  EXPECT_GT(a.steps, 100);
-  EXPECT_LE(d1.hostReads - d0.hostReads, 4u);                 // the clock, once per run of steps
-  EXPECT_EQ(d2.hostReads - d1.hostReads, uint64_t(b.steps));  // the wave speed, every step
-  EXPECT_EQ(a.steps, b.steps);
-  EXPECT_EQ(a.timeS, b.timeS);
-  EXPECT_EQ(a.lastDtS, b.lastDtS);
-  EXPECT_NEAR(a.inflowM3, b.inflowM3, 1e-12 * b.inflowM3);
-  EXPECT_NEAR(a.rainM3, b.rainM3, 1e-12 * b.rainM3);
-  EXPECT_EQ(a.storedWaterM3, b.storedWaterM3);
-  EXPECT_LT(std::abs(a.waterBalanceM3()), 1e-6 * (a.initialWaterM3 + a.inflowM3 + a.rainM3));
-  EXPECT_EQ(maxAbsDiff(device->readWaterDepth(), host->readWaterDepth()), 0.0);
-  EXPECT_EQ(maxAbsDiff(device->readFloodStats().arrivalS, host->readFloodStats().arrivalS), 0.0);
-  EXPECT_EQ(a.steps, c.steps);
-  EXPECT_LT(maxAbsDiff(device->readWaterDepth(), cpu->readWaterDepth()), 1e-4);
-  // A second advance continues the same clock (its sources and rain from where it stopped).
-  device->advance(60.0);
-  host->advance(60.0);
-  EXPECT_EQ(device->stats().timeS, host->stats().timeS);
-  EXPECT_LT(maxAbsDiff(device->readWaterDepth(), host->readWaterDepth()), 1e-6);
 
   // Erosion, weathering and bank failure with their passes dispatched as the clock says: the
   // banked channel of SimErosionBalanceClosesWithEverythingOn, 120 s, layers bit for bit.

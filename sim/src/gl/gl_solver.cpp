@@ -49,13 +49,17 @@ struct GlSolver::Impl {
       accum, rain, manning, infiltration, thermal, scour, sourceEntries, maxSpeed, floodStats, fvLimit, levelEntries,
       clock, series, terms;  // W35's clock, the sources' samples and their shares of the entries
   bool aIsCurrent = true;
+  bool rasterRain = false;   // the rain raster has a cell that rains
+  bool infiltrates = false;  // W11b: the input gave infiltration rates
   gl::Program pSources, pPointSources, pWaveSpeed, pPipeFlux, pPipeUpdate, pFvFace, pFvLimit, pFvUpdate, pInertialFace,
       pInertialUpdate, pErode, pThermalFlux, pThermalApply, pFloodStats, pLevel, pCopyRect, pBedRect, pClock;
   // W35: a device step's passes dispatch the group counts step_clock.comp leaves in `clock`.
   bool indirect = false;
-  double lastDeviceDtS = 0;  // the last device step, to size the next run of them
-  gl::Buffer maxSpeedHost;   // maxSpeed copied to host memory, read every step (maxWaveSpeed)
-  gl::Buffer packed;         // copy_rect.comp's side of a rectangle moved to or from the host
+  // The step W10 chose last on the device (before the last one was shortened to land on a run's
+  // end), to size the next run of them.
+  double lastDeviceDtS = 0;
+  gl::Buffer maxSpeedHost;  // maxSpeed copied to host memory, read every step (maxWaveSpeed)
+  gl::Buffer packed;        // copy_rect.comp's side of a rectangle moved to or from the host
 
   const gl::Buffer& cur() const { return aIsCurrent ? stateA : stateB; }
   const gl::Buffer& next() const { return aIsCurrent ? stateB : stateA; }
@@ -84,6 +88,7 @@ struct GlSolver::Impl {
     scour.bind(slots::kScour);
     sourceEntries.bind(slots::kSources);
     maxSpeed.bind(slots::kMaxSpeed);
+    floodStats.bind(slots::kFloodStats);  // W36: a fused update writes them
     fvLimit.bind(slots::kFvLimit);
     clock.bind(slots::kClock);
     series.bind(slots::kSeries);
@@ -100,10 +105,16 @@ struct GlSolver::Impl {
     }
   }
 
-  double maxWaveSpeed() {
+  // W10's wave speed of the current state into maxSpeed (the buffers bound).
+  void waveSpeedPass() {
     maxSpeed.fill(0u);
-    bindAll();
     pWaveSpeed.dispatchCovering(int(n));
+    barrier();
+  }
+
+  double maxWaveSpeed() {
+    bindAll();
+    waveSpeedPass();
     readBarrier();
     // Through a host-memory buffer: NVIDIA moved maxSpeed itself between GPU and host memory at
     // every step's read (and warned each time) when it was read directly.
@@ -133,11 +144,36 @@ struct GlSolver::Impl {
     passes(step.sources.size(), hasLevels ? &step.levels : nullptr, wetThresholdM);
   }
 
+  // W36: a device step of flood mode whose water update is its last change of the state (no
+  // levels: device steps have none; no erosion or thermal weathering) ends that update with the
+  // flood statistics and the next step's wave speed (sim_tail.glsl) instead of their own passes.
+  bool fusedTail() const {
+    return indirect && p.waterModel != int32_t(WaterModel::kVirtualPipes) && p.erosionEnabled == 0 &&
+           p.thermalEnabled == 0;
+  }
+
+  // The tail's uniforms of the update program that ends the step (both 0 in every other pass).
+  static void setTail(const gl::Program& update, bool speed, bool stats) {
+    update.set("tailSpeed", speed ? 1u : 0u);
+    update.set("tailStats", stats ? 1u : 0u);
+  }
+
+  // W11 or W11b can change a cell (the CPU backend's Impl::rainOrLosses): otherwise sources.comp
+  // adds 0 to settled depths and is not dispatched.
+  bool rainOrLosses() const {
+    return p.rainMmPerHour != 0.0f || rasterRain || p.evaporationMmPerHour != 0.0f || infiltrates;
+  }
+
   // The passes of a step after its sources' entries are in place (docs/sim-water.md, "One step").
   void passes(size_t sourceEntryCount, const std::vector<LevelEntry>* levels, float wetThresholdM) {
     const int w = p.width, h = p.height;
-    run(pSources, kShapeGrid, w, h);
-    barrier();
+    const bool fused = fusedTail() && levels == nullptr;
+    const bool tailSpeed = fused && p.cflAlpha > 0, tailStats = fused && wetThresholdM >= 0;
+    if (tailStats) pFloodStats.set("wetThresholdM", wetThresholdM);
+    if (rainOrLosses()) {
+      run(pSources, kShapeGrid, w, h);
+      barrier();
+    }
     if (sourceEntryCount > 0) {
       run(pPointSources, kShapeEntries, int(sourceEntryCount));
       barrier();
@@ -152,6 +188,8 @@ struct GlSolver::Impl {
       barrier();
       run(pFvLimit, kShapeGrid, w, h);
       barrier();
+      setTail(pInertialUpdate, tailSpeed, tailStats);
+      if (tailStats) pInertialUpdate.set("wetThresholdM", wetThresholdM);
       run(pInertialUpdate, kShapeGrid, w, h);
       barrier();
     } else {
@@ -159,6 +197,7 @@ struct GlSolver::Impl {
       run(pFvFace, kShapeGrid, w, h);
       barrier();
       pFvUpdate.set("final_", 0);
+      setTail(pFvUpdate, false, false);
       run(pFvUpdate, kShapeGrid, w, h);
       barrier();
       stage.bind(slots::kStateIn);  // the corrector's faces come from U1
@@ -169,6 +208,8 @@ struct GlSolver::Impl {
       run(pFvLimit, kShapeGrid, w, h);
       barrier();
       pFvUpdate.set("final_", 1);
+      setTail(pFvUpdate, tailSpeed, tailStats);
+      if (tailStats) pFvUpdate.set("wetThresholdM", wetThresholdM);
       run(pFvUpdate, kShapeGrid, w, h);
       barrier();
     }
@@ -186,7 +227,7 @@ struct GlSolver::Impl {
       run(pThermalApply, kShapeGrid, w, h);
       barrier();
     }
-    if (wetThresholdM >= 0) {
+    if (wetThresholdM >= 0 && !tailStats) {
       cur().bind(slots::kStateIn);
       floodStats.bind(slots::kFloodStats);
       pFloodStats.set("wetThresholdM", wetThresholdM);
@@ -232,6 +273,10 @@ struct GlSolver::Impl {
     // The state ping-pongs at every step queued; the steps queued after the clock reached its
     // end run nothing, so the current buffer is the one of the last step that ran.
     const bool startA = aIsCurrent;
+    if (p.cflAlpha > 0 && fusedTail()) {  // W36: the first step's wave speed; each update leaves the next's
+      bindAll();
+      waveSpeedPass();
+    }
     bool done = false;
     while (!done && out.steps < r.maxSteps) {
       // Enough steps to reach the end at the last step's length, and a few more: a step queued
@@ -247,7 +292,7 @@ struct GlSolver::Impl {
       out.timeS = c.timeS;
       done = c.done != 0 || Solver::reached(c.timeS, r.endS);
       aIsCurrent = c.steps % 2 == 0 ? startA : !startA;
-      if (c.steps > 0) lastDeviceDtS = double(c.lastDtS);
+      if (c.steps > 0) lastDeviceDtS = c.lastChosenDtS;
     }
     indirect = false;
     p.dtS = -1.0f;  // the GPU's P.dtS is the last device step's: the next host step uploads its own
@@ -259,14 +304,11 @@ struct GlSolver::Impl {
     return out;
   }
 
-  // One device step: the wave speed, step_clock.comp, then the passes as it says.
+  // One device step: the wave speed (unless the last step's update left it, W36), step_clock.comp,
+  // then the passes as it says.
   void deviceStep(size_t entryCount, float wetThresholdM) {
     bindAll();
-    if (p.cflAlpha > 0) {
-      maxSpeed.fill(0u);
-      pWaveSpeed.dispatchCovering(int(n));
-      barrier();
-    }
+    if (p.cflAlpha > 0 && !fusedTail()) waveSpeedPass();
     pClock.dispatchCovering(1);
     gl::memoryBarrier(gl::Barrier::kStorage | gl::Barrier::kCommand);
     passes(entryCount, nullptr, wetThresholdM);
@@ -465,6 +507,8 @@ Result<GlSolver> GlSolver::create(const SimInput& input, const SimParams& params
   s.accum = gl::Buffer(sizeof(float) * kAccumPerCell * n);
   s.accum.fill(0u);
   s.rain = gl::Buffer::from(std::span<const float>(rain));
+  s.rasterRain = std::any_of(rain.begin(), rain.end(), [](float r) { return r != 0.0f; });
+  s.infiltrates = input.infiltrationMmPerHour.size() > 0;
   // n^2 per cell of a roughness map; -1 (the uniform P.manningN, which setParams may change) without.
   std::vector<float> manningN2(n, -1.0f);
   for (size_t i = 0; i < input.manningN.size(); ++i) manningN2[i] = input.manningN.data[i] * input.manningN.data[i];
@@ -514,6 +558,7 @@ Status GlSolver::onRainRasterChanged(const gis::Grid<float>& mmPerHour) {
   } else {
     s.rain.fill(0u);
   }
+  s.rasterRain = std::any_of(mmPerHour.data.begin(), mmPerHour.data.end(), [](float r) { return r != 0.0f; });
   return {};
 }
 
