@@ -3,6 +3,7 @@
 // outgoing mass fluxes each cell can give without going below zero (as the pipe model's W2);
 // fv_update.comp scales each face's mass flux by its upwind cell's K, so no depth is clipped.
 #include "sim.glsl"
+#include "sim_limit_share.glsl"
 layout(local_size_x = SIM_GROUP_X, local_size_y = SIM_GROUP_Y) in;
 layout(std430, binding = SLOT_STATE_IN) readonly buffer StateIn { vec4 state[]; };
 layout(std430, binding = SLOT_FACE_X) readonly buffer FaceX { vec4 faceX[]; };
@@ -15,8 +16,5 @@ void main() {
   const int i = cellOf(p), w = P.width;
   const float fW = faceX[p.y * (w + 1) + p.x].x, fE = faceX[p.y * (w + 1) + p.x + 1].x;
   const float fN = faceY[p.y * w + p.x].x, fS = faceY[(p.y + 1) * w + p.x].x;
-  const float outVol = ((max(-fW, 0.0) + max(fE, 0.0)) * P.dyM + max(-fN, 0.0) * faceWidthY(p.y) +
-                     max(fS, 0.0) * faceWidthY(p.y + 1)) * P.dtS;
-  const float have = state[i].x * cellArea(p.y);
-  limit_[i] = outVol > have ? have / outVol : 1.0;
+  limit_[i] = limitShare(p, state[i].x, fW, fE, fN, fS);
 }

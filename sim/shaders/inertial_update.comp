@@ -12,15 +12,15 @@
 layout(local_size_x = SIM_GROUP_X, local_size_y = SIM_GROUP_Y) in;
 layout(std430, binding = SLOT_STATE_IN) readonly buffer StateIn { vec4 state[]; };
 layout(std430, binding = SLOT_STATE_OUT) writeonly buffer StateOut { vec4 stateOut[]; };
-layout(std430, binding = SLOT_FACE_X) readonly buffer FaceX { vec4 faceX[]; };
-layout(std430, binding = SLOT_FACE_Y) readonly buffer FaceY { vec4 faceY[]; };
+layout(std430, binding = SLOT_FACE_X) readonly buffer FaceX { float faceX[]; };  // one float a face (W36)
+layout(std430, binding = SLOT_FACE_Y) readonly buffer FaceY { float faceY[]; };
 layout(std430, binding = SLOT_FLUX) writeonly buffer Flux { vec4 flux[]; };
 
 vec4 updateCell(ivec2 p) {
   const int i = cellOf(p), w = P.width, h = P.height;
   const float dt = P.dtS, A = cellArea(p.y), wN = faceWidthY(p.y), wS = faceWidthY(p.y + 1), dy = P.dyM;
-  float fW = faceX[p.y * (w + 1) + p.x].x, fE = faceX[p.y * (w + 1) + p.x + 1].x;
-  float fN = faceY[p.y * w + p.x].x, fS = faceY[(p.y + 1) * w + p.x].x;
+  float fW = faceX[p.y * (w + 1) + p.x], fE = faceX[p.y * (w + 1) + p.x + 1];
+  float fN = faceY[p.y * w + p.x], fS = faceY[(p.y + 1) * w + p.x];
   fW *= limitOfFace(fW, p - ivec2(1, 0), p);
   fE *= limitOfFace(fE, p, p + ivec2(1, 0));
   fN *= limitOfFace(fN, p - ivec2(0, 1), p);

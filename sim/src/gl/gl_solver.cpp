@@ -52,7 +52,8 @@ struct GlSolver::Impl {
   bool rasterRain = false;   // the rain raster has a cell that rains
   bool infiltrates = false;  // W11b: the input gave infiltration rates
   gl::Program pSources, pPointSources, pWaveSpeed, pPipeFlux, pPipeUpdate, pFvFace, pFvLimit, pFvUpdate, pInertialFace,
-      pInertialUpdate, pErode, pThermalFlux, pThermalApply, pFloodStats, pLevel, pCopyRect, pBedRect, pClock;
+      pInertialLimit, pInertialUpdate, pErode, pThermalFlux, pThermalApply, pFloodStats, pLevel, pCopyRect, pBedRect,
+      pClock;
   // W35: a device step's passes dispatch the group counts step_clock.comp leaves in `clock`.
   bool indirect = false;
   // The step W10 chose last on the device (before the last one was shortened to land on a run's
@@ -186,7 +187,7 @@ struct GlSolver::Impl {
     } else if (p.floodScheme == int32_t(FloodScheme::kLocalInertial)) {
       run(pInertialFace, kShapeGrid, w, h);
       barrier();
-      run(pFvLimit, kShapeGrid, w, h);
+      run(pInertialLimit, kShapeGrid, w, h);
       barrier();
       setTail(pInertialUpdate, tailSpeed, tailStats);
       if (tailStats) pInertialUpdate.set("wetThresholdM", wetThresholdM);
@@ -452,6 +453,7 @@ Result<GlSolver> GlSolver::create(const SimInput& input, const SimParams& params
         Kernel{&s.pPipeUpdate, "sim/shaders/pipe_update.comp"}, Kernel{&s.pFvFace, "sim/shaders/fv_face.comp"},
         Kernel{&s.pFvLimit, "sim/shaders/fv_limit.comp"}, Kernel{&s.pFvUpdate, "sim/shaders/fv_update.comp"},
         Kernel{&s.pInertialFace, "sim/shaders/inertial_face.comp"},
+        Kernel{&s.pInertialLimit, "sim/shaders/inertial_limit.comp"},
         Kernel{&s.pInertialUpdate, "sim/shaders/inertial_update.comp"}, Kernel{&s.pErode, "sim/shaders/erode.comp"},
         Kernel{&s.pThermalFlux, "sim/shaders/thermal_flux.comp"},
         Kernel{&s.pThermalApply, "sim/shaders/thermal_apply.comp"},
@@ -688,6 +690,9 @@ std::vector<float> GlSolver::readFaceMassFlux() const {
   STRATA_CHECK(params().waterModel == WaterModel::kFiniteVolume) << "face fluxes exist in flood mode only";
   readBarrier();
   const auto fx = s.faceX.read<float>(), fy = s.faceY.read<float>();
+  // The finite-volume scheme's faces are vec4s (the mass flux first); the local-inertial
+  // scheme's one float each (W36).
+  const size_t stride = params().floodScheme == FloodScheme::kLocalInertial ? 1 : 4;
   const auto limit = s.fvLimit.read<float>();
   const int w = grid().width, h = grid().height;
   // The flux the last corrector applied: scaled by its upwind cell's W25 limit (fv_update.comp).
@@ -696,16 +701,16 @@ std::vector<float> GlSolver::readFaceMassFlux() const {
     return inside ? f * limit[size_t(upY) * size_t(w) + size_t(upX)] : f;
   };
   std::vector<float> out;
-  out.reserve(fx.size() / 4 + fy.size() / 4);
+  out.reserve(size_t(w + 1) * size_t(h) + size_t(w) * size_t(h + 1));
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x <= w; ++x) {
-      const float f = fx[4 * (size_t(y) * size_t(w + 1) + size_t(x))];
+      const float f = fx[stride * (size_t(y) * size_t(w + 1) + size_t(x))];
       out.push_back(f > 0 ? limited(f, x - 1, y) : limited(f, x, y));
     }
   }
   for (int y = 0; y <= h; ++y) {
     for (int x = 0; x < w; ++x) {
-      const float f = fy[4 * (size_t(y) * size_t(w) + size_t(x))];
+      const float f = fy[stride * (size_t(y) * size_t(w) + size_t(x))];
       out.push_back(f > 0 ? limited(f, x, y - 1) : limited(f, x, y));
     }
   }
