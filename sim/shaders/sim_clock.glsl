@@ -36,7 +36,7 @@ layout(std430, binding = SLOT_CLOCK) CLOCK_QUALIFIER buffer ClockBlock {
   uint adaptive;         // cflAlpha > 0 (W10); else every step is maxDtS
   uint termCount;        // Terms (the point-source entries' shares of the sources)
   uint inertial;         // the local-inertial scheme: W10's sqrt(S^2 + g r dt) (W33)
-  uint pad2;
+  uint pointSources;     // 1: the clock pours the point sources in itself (W36: no rain pass)
   uint pad3;
   uint dispatchNow[3 * CLOCK_SHAPES];   // what the passes dispatch this step
   uint dispatchFull[3 * CLOCK_SHAPES];  // the same while the clock runs

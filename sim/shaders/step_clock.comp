@@ -5,12 +5,15 @@
 // step shortened to land on C.endS; the point sources' mean discharge over the step (mergeSources,
 // W12); the step into P.dtS, the clock and the inflow budget forward; and the group counts of
 // the step's passes (0 once the clock has reached C.endS, so the steps queued after it run
-// nothing). One invocation.
+// nothing); with C.pointSources (W36: a step without the rain pass, so that nothing comes between)
+// the point sources poured in as point_sources.comp pours them. One invocation.
 #define SIM_PARAMS_WRITABLE
 #define CLOCK_QUALIFIER
 #include "sim.glsl"
+#include "sim_accum.glsl"
 #include "sim_clock.glsl"
 layout(local_size_x = 1) in;
+layout(std430, binding = SLOT_STATE_IN) buffer StateIn { vec4 state[]; };
 layout(std430, binding = SLOT_MAX_SPEED) buffer MaxSpeed { uint maxSpeedBits; };
 layout(std430, binding = SLOT_SOURCES) buffer Sources { SourceEntry entries[]; };
 layout(std430, binding = SLOT_SERIES) readonly buffer Series { dvec2 samples[]; };
@@ -115,6 +118,14 @@ void main() {
     }
   }
   P.dtS = dt;
+  if (C.pointSources != 0u) {  // point_sources.comp's W12, each entry once (after its last term)
+    for (uint k = 0u; k < C.termCount; ++k) {
+      if (k + 1u < C.termCount && terms[k + 1u].entry == terms[k].entry) continue;
+      const SourceEntry e = entries[terms[k].entry];
+      const int y = int(e.cell) / P.width;
+      state[e.cell].x = addDepth(state[e.cell].x, int(e.cell), e.rateM3S * P.dtS / cellArea(y));
+    }
+  }
   C.timeS = t1;
   C.inflowM3 += inflow;
   C.minChosenDtS = min(C.minChosenDtS, chosen);

@@ -56,6 +56,7 @@ struct GlSolver::Impl {
       pClock;
   // W35: a device step's passes dispatch the group counts step_clock.comp leaves in `clock`.
   bool indirect = false;
+  bool pointSourcesInClock = false;  // W36: step_clock.comp pours the point sources in (no rain pass)
   // The step W10 chose last on the device (before the last one was shortened to land on a run's
   // end), to size the next run of them.
   double lastDeviceDtS = 0;
@@ -170,12 +171,11 @@ struct GlSolver::Impl {
     const int w = p.width, h = p.height;
     const bool fused = fusedTail() && levels == nullptr;
     const bool tailSpeed = fused && p.cflAlpha > 0, tailStats = fused && wetThresholdM >= 0;
-    if (tailStats) pFloodStats.set("wetThresholdM", wetThresholdM);
     if (rainOrLosses()) {
       run(pSources, kShapeGrid, w, h);
       barrier();
     }
-    if (sourceEntryCount > 0) {
+    if (sourceEntryCount > 0 && !(indirect && pointSourcesInClock)) {
       run(pPointSources, kShapeEntries, int(sourceEntryCount));
       barrier();
     }
@@ -253,6 +253,8 @@ struct GlSolver::Impl {
     c.rainRateMS = r.rainRateMS;
     c.adaptive = sp.cflAlpha > 0 ? 1u : 0u;
     c.inertial = sp.floodScheme == FloodScheme::kLocalInertial ? 1u : 0u;
+    pointSourcesInClock = !rainOrLosses();
+    c.pointSources = pointSourcesInClock ? 1u : 0u;
     c.termCount = uint32_t(termCount);
     auto groups = [](size_t cells, int per) { return uint32_t((cells + size_t(per) - 1) / size_t(per)); };
     const uint32_t full[3 * kClockShapes] = {groups(size_t(p.width), 16),

@@ -79,7 +79,7 @@ struct GpuClock {
   double timeS = 0, endS = 0, inflowM3 = 0, minChosenDtS = 0, lastChosenDtS = 0;
   double maxDtS = 0, reachM = 0, gravityMS2 = 0, rainRateMS = 0, pad0 = 0;
   float lastDtS = 0;
-  uint32_t steps = 0, done = 0, adaptive = 0, termCount = 0, inertial = 0, pad2 = 0, pad3 = 0;
+  uint32_t steps = 0, done = 0, adaptive = 0, termCount = 0, inertial = 0, pointSources = 0, pad3 = 0;
   uint32_t dispatchNow[3 * kClockShapes] = {};
   uint32_t dispatchFull[3 * kClockShapes] = {};
 };
