@@ -4,11 +4,13 @@
 
 Writes into OUT (a new folder): plain_<cell>m.tif (flat, 2000 x 1000 m, EPSG:27700, elevation
 0), <scheme>_<cell>m.toml (Manning 0.05, closed edges, the 20 m breach in the middle of the west
-side, tests/support/flat_plain.hpp's hydrograph and gauges, 5 h, maps every hour, no pictures or
-plots) and a run folder per scenario; runs each scheme ROUNDS times, alternated, after one
-warm-up run each, and prints the best and median wall times and the report's step counts.
+side, tests/support/flat_plain.hpp's hydrograph and gauges, 5 h or --hours, maps every hour, no
+pictures or plots) and a run folder per scenario; runs each scheme ROUNDS times, alternated, after
+one warm-up run each, and prints the best and median wall times and the report's step counts.
+With --rounds 0 each scheme runs once (no warm-up): for the large grids.
 
-    bench/flat_plain.py OUT [--cell 20] [--rounds 3] [--strata build/apps/strata]
+    bench/flat_plain.py OUT [--cell 20] [--rounds 3] [--hours 5] [--schemes finite_volume,inertial]
+                            [--strata build/apps/strata]
 """
 import argparse
 import os
@@ -38,7 +40,7 @@ def write_plain(path, cell):
     ds = None
 
 
-def write_scenario(path, dem, scheme, cell):
+def write_scenario(path, dem, scheme, cell, hours=5):
     h = int(round(1000 / cell))
     n = max(1, int(round(20 / cell)))  # the breach's cells, rows y0 .. y0 + n - 1 (flat_plain.hpp)
     y0 = h // 2 - n // 2
@@ -64,7 +66,7 @@ name = "breach"
 hydrograph = {HYDROGRAPH}
 hydrograph_units = ["h", "m3/s"]
 [time]
-duration = "5 h"
+duration = "{hours:g} h"
 output_interval = "1 h"
 [outputs]
 maps = ["max_depth"]
@@ -90,22 +92,30 @@ def main():
     ap.add_argument("out")
     ap.add_argument("--cell", type=float, default=20.0)
     ap.add_argument("--rounds", type=int, default=3)
+    ap.add_argument("--hours", type=float, default=5.0, help="simulated hours (EA test 4: 5)")
+    ap.add_argument("--schemes", default="finite_volume,inertial", help="comma-separated")
     ap.add_argument("--strata", default=os.path.join(os.path.dirname(__file__), "..", "build", "apps", "strata"))
     a = ap.parse_args()
+    schemes = a.schemes.split(",")
+    if any(s not in ("finite_volume", "inertial") for s in schemes):
+        sys.exit(f"flat_plain.py: --schemes: finite_volume and/or inertial, got '{a.schemes}'")
+    if not a.hours > 0 or a.rounds < 0:
+        sys.exit("flat_plain.py: --hours must be > 0 and --rounds >= 0")
     if os.path.exists(a.out):
         sys.exit(f"flat_plain.py: {a.out} exists; give a new folder")
     os.makedirs(a.out)
     dem = os.path.join(a.out, f"plain_{a.cell:g}m.tif")
     write_plain(dem, a.cell)
     runs = {}
-    for scheme in ("finite_volume", "inertial"):
+    for scheme in schemes:
         toml = os.path.join(a.out, f"{scheme}_{a.cell:g}m.toml")
-        write_scenario(toml, dem, scheme, a.cell)
+        write_scenario(toml, dem, scheme, a.cell, a.hours)
         runs[scheme] = (toml, os.path.join(a.out, f"run_{scheme}"))
-        run(a.strata, *runs[scheme])  # warm-up
+        if a.rounds > 0:
+            run(a.strata, *runs[scheme])  # warm-up
     walls = {s: [] for s in runs}
     steps = {}
-    for _ in range(a.rounds):
+    for _ in range(max(a.rounds, 1)):
         for scheme, (toml, out) in runs.items():
             wall, n = run(a.strata, toml, out)
             walls[scheme].append(wall)
