@@ -462,11 +462,10 @@ void Impl::finishStep() {
   const bool rainEverywhere = p.rainMmPerHour != 0.0f;
 #pragma omp parallel for schedule(dynamic, 8) num_threads(passThreads) if (parallel)
   for (int b = 0; b < blocks; ++b) {
-    if (water.on[size_t(b)] && rainEverywhere) {
+    if (water.on[size_t(b)]) {
       const int x0 = (b % bw) * kBlock, y0 = (b / bw) * kBlock;
-      extent[size_t(b)] = {y0, std::min(h, y0 + kBlock), x0, std::min(w, x0 + kBlock)};
-    } else if (water.on[size_t(b)]) {
-      extent[size_t(b)] = busyExtent(b % bw, b / bw);
+      extent[size_t(b)] =
+          rainEverywhere ? Run{y0, std::min(h, y0 + kBlock), x0, std::min(w, x0 + kBlock)} : busyExtent(b % bw, b / bw);
     }
     if (sources.on[size_t(b)]) evapResidual[size_t(b)] = blockEvapResidual(b % bw, b / bw);
   }

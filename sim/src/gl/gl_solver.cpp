@@ -56,7 +56,6 @@ struct GlSolver::Impl {
       pClock;
   // W35: a device step's passes dispatch the group counts step_clock.comp leaves in `clock`.
   bool indirect = false;
-  bool pointSourcesInClock = false;  // W36: step_clock.comp pours the point sources in (no rain pass)
   // The step W10 chose last on the device (before the last one was shortened to land on a run's
   // end), to size the next run of them.
   double lastDeviceDtS = 0;
@@ -154,14 +153,16 @@ struct GlSolver::Impl {
            p.thermalEnabled == 0;
   }
 
-  // The tail's uniforms of the update program that ends the step (both 0 in every other pass).
-  static void setTail(const gl::Program& update, bool speed, bool stats) {
+  // The tail's uniforms of an update program (both 0 where it does not end the step).
+  static void setTail(const gl::Program& update, bool speed, bool stats, float wetThresholdM) {
     update.set("tailSpeed", speed ? 1u : 0u);
     update.set("tailStats", stats ? 1u : 0u);
+    if (stats) update.set("wetThresholdM", wetThresholdM);
   }
 
   // W11 or W11b can change a cell (the CPU backend's Impl::rainOrLosses): otherwise sources.comp
-  // adds 0 to settled depths and is not dispatched.
+  // adds 0 to settled depths and is not dispatched, and in a device step step_clock.comp pours the
+  // point sources in itself (W36: nothing comes between them).
   bool rainOrLosses() const {
     return p.rainMmPerHour != 0.0f || rasterRain || p.evaporationMmPerHour != 0.0f || infiltrates;
   }
@@ -175,7 +176,7 @@ struct GlSolver::Impl {
       run(pSources, kShapeGrid, w, h);
       barrier();
     }
-    if (sourceEntryCount > 0 && !(indirect && pointSourcesInClock)) {
+    if (sourceEntryCount > 0 && (!indirect || rainOrLosses())) {  // else the clock poured them in
       run(pPointSources, kShapeEntries, int(sourceEntryCount));
       barrier();
     }
@@ -189,8 +190,7 @@ struct GlSolver::Impl {
       barrier();
       run(pInertialLimit, kShapeGrid, w, h);
       barrier();
-      setTail(pInertialUpdate, tailSpeed, tailStats);
-      if (tailStats) pInertialUpdate.set("wetThresholdM", wetThresholdM);
+      setTail(pInertialUpdate, tailSpeed, tailStats, wetThresholdM);
       run(pInertialUpdate, kShapeGrid, w, h);
       barrier();
     } else {
@@ -198,7 +198,7 @@ struct GlSolver::Impl {
       run(pFvFace, kShapeGrid, w, h);
       barrier();
       pFvUpdate.set("final_", 0);
-      setTail(pFvUpdate, false, false);
+      setTail(pFvUpdate, false, false, wetThresholdM);
       run(pFvUpdate, kShapeGrid, w, h);
       barrier();
       stage.bind(slots::kStateIn);  // the corrector's faces come from U1
@@ -209,8 +209,7 @@ struct GlSolver::Impl {
       run(pFvLimit, kShapeGrid, w, h);
       barrier();
       pFvUpdate.set("final_", 1);
-      setTail(pFvUpdate, tailSpeed, tailStats);
-      if (tailStats) pFvUpdate.set("wetThresholdM", wetThresholdM);
+      setTail(pFvUpdate, tailSpeed, tailStats, wetThresholdM);
       run(pFvUpdate, kShapeGrid, w, h);
       barrier();
     }
@@ -253,8 +252,7 @@ struct GlSolver::Impl {
     c.rainRateMS = r.rainRateMS;
     c.adaptive = sp.cflAlpha > 0 ? 1u : 0u;
     c.inertial = sp.floodScheme == FloodScheme::kLocalInertial ? 1u : 0u;
-    pointSourcesInClock = !rainOrLosses();
-    c.pointSources = pointSourcesInClock ? 1u : 0u;
+    c.pointSources = rainOrLosses() ? 0u : 1u;
     c.termCount = uint32_t(termCount);
     auto groups = [](size_t cells, int per) { return uint32_t((cells + size_t(per) - 1) / size_t(per)); };
     const uint32_t full[3 * kClockShapes] = {groups(size_t(p.width), 16),
