@@ -22,7 +22,7 @@ HBM_EFFICIENCY = 0.7  # fraction of it memory-bound kernels reach (assumption)
 GPU_MEMORY = 80e9  # H100 SXM (datasheet); usable: 85% (assumption)
 BYTES_PER_CELL_MEMORY = 176  # GL flood mode: 738 MB at 2048^2 (docs/benchmarks.md)
 HALO = 8  # cells (TileOptions::halo: one step reads 7 away)
-HALO_BYTES_PER_CELL = 36  # state 16 + pipe/face flux 16 + one layer 4 (kBlockHalo; measured by bench)
+HALO_BYTES_PER_CELL = 28  # a water-only flood: state 16 + carried accumulators 12 (haloParts; bench_sim_mpi)
 NET_BPS = 50e9  # InfiniBand NDR 400 Gb/s, one adapter per GPU (DGX H100 datasheet)
 NET_LATENCY = 2e-6  # MPI message over NDR, one way (typical ping-pong half round trip; assumption)
 REDUCE_STAGE = 2e-6  # one recursive-doubling stage of an 8-byte MPI_Allreduce (assumption)
@@ -30,7 +30,7 @@ PCIE_BPS = 25e9  # GL buffer read/write through host memory: PCIe Gen5 x16 is 64
 #                 readbacks through a staging copy reach about 40% of it (assumption)
 GL_CALL = 10e-6  # one glGetNamedBufferSubData / glNamedBufferSubData on a small range incl. its
 #                 synchronisation (assumption: no GPU was available to measure it)
-PARTS = 3  # buffers per halo piece: state, flux, layers (one layer)
+PARTS = 2  # GL transfers per halo piece: the state and the carried accumulators
 
 
 def split(w, h, p):

@@ -250,7 +250,7 @@ std::vector<float> AdaptiveSolver::stateOf(const Tile& t) const {
 
 void AdaptiveSolver::writeState(Tile& t, const std::vector<float>& state) {
   const size_t L = size_t(t.level);
-  CellBlock b{0, 0, t.ex1[L] - t.ex0[L], t.ey1[L] - t.ey0[L], state, {}, {}, {}, {}};
+  CellBlock b{.rect = {0, 0, t.ex1[L] - t.ex0[L], t.ey1[L] - t.ey0[L]}, .state = state};
   t.sims[L]->writeBlock(b);
 }
 
@@ -518,9 +518,10 @@ gis::Grid<float> AdaptiveSolver::readBed() const {
 }
 
 CellBlock AdaptiveSolver::readBlock(int x0, int y0, int width, int height, unsigned parts) const {
-  CellBlock b{x0, y0, width, height, {}, {}, {}, {}, {}};
+  CellBlock b{.rect = {x0, y0, width, height}};
   STRATA_CHECK(blockFits(b, width_, height_, grid().layers)) << "readBlock outside the grid";
-  STRATA_CHECK((parts & (kBlockFlux | kBlockAccum)) == 0) << "adaptive tiles: only state and layers read as blocks";
+  STRATA_CHECK((parts & (kBlockFlux | kBlockAccum | kBlockCarried)) == 0)
+      << "adaptive tiles: only state and layers read as blocks";
   const size_t cells = b.cells(), row = size_t(width);
   if (parts & kBlockState) {
     const auto merged = mergedNow();

@@ -757,6 +757,14 @@ std::array<P*, N> planesOf(P (&planes)[N]) {
   for (size_t k = 0; k < N; ++k) out[k] = &planes[k];
   return out;
 }
+// The accumulators a halo carries (kBlockCarried): the last kAccumCarried of them.
+template <class P, size_t N>
+std::array<P*, kAccumCarried> carriedPlanesOf(P (&accum)[N]) {
+  static_assert(N == kAccumPerCell);
+  std::array<P*, kAccumCarried> out;
+  for (size_t k = 0; k < out.size(); ++k) out[k] = &accum[kAccumCarriedFrom + k];
+  return out;
+}
 template <class W>
 auto statePlanesOf(W& u) {
   using P = std::remove_reference_t<decltype((u.h))>;
@@ -791,7 +799,12 @@ Status CpuSolver::restoreCells(const SolverState& in) {
     return fail("sim: the saved state is of a different grid (" + std::to_string(in.state.size() / 4) +
                 " cells, this simulation has " + std::to_string(n) + ")");
   }
-  CellBlock b{{0, 0, m.w, m.h}, in.state, in.flux, in.fluxDiag, in.layers, in.accum};
+  CellBlock b{.rect = {0, 0, m.w, m.h},
+              .state = in.state,
+              .flux = in.flux,
+              .fluxDiag = in.fluxDiag,
+              .layers = in.layers,
+              .accum = in.accum};
   writeBlock(b);
   m.markAll();
   return {};
@@ -799,7 +812,7 @@ Status CpuSolver::restoreCells(const SolverState& in) {
 
 CellBlock CpuSolver::readBlock(int x0, int y0, int width, int height, unsigned parts) const {
   const Impl& m = *impl_;
-  CellBlock b{{x0, y0, width, height}, {}, {}, {}, {}, {}};
+  CellBlock b{.rect = {x0, y0, width, height}};
   STRATA_CHECK(blockFits(b, m.w, m.h, m.L)) << "readBlock (" << x0 << ", " << y0 << ") " << width << "x" << height
                                             << " outside the " << m.w << "x" << m.h << " grid";
   const auto& u = m.now();
@@ -834,6 +847,10 @@ CellBlock CpuSolver::readBlock(int x0, int y0, int width, int height, unsigned p
     b.accum.resize(kAccumPerCell * cells);
     planesToCells(accumPlanes, x0, y0, width, height, b.accum.data());
   }
+  if (parts & kBlockCarried) {
+    b.carried.resize(kAccumCarried * cells);
+    planesToCells(carriedPlanesOf(m.accum), x0, y0, width, height, b.carried.data());
+  }
   return b;
 }
 
@@ -851,6 +868,9 @@ void CpuSolver::writeBlock(const CellBlock& b) {
   if (!b.fluxDiag.empty())
     cellsToPlanes(b.fluxDiag.data(), b.rect.x, b.rect.y, b.rect.width, b.rect.height, diagPlanes);
   if (!b.accum.empty()) cellsToPlanes(b.accum.data(), b.rect.x, b.rect.y, b.rect.width, b.rect.height, accumPlanes);
+  if (!b.carried.empty()) {
+    cellsToPlanes(b.carried.data(), b.rect.x, b.rect.y, b.rect.width, b.rect.height, carriedPlanesOf(m.accum));
+  }
   if (!b.layers.empty()) {
     for (int l = 0; l < m.L; ++l) {
       for (int y = 0; y < b.rect.height; ++y) {

@@ -223,8 +223,9 @@ void forEachStatePart(State& s, F&& f) {
 void Solver::saveCells(SolverState& out) const {
   CellBlock b = readBlock(0, 0, grid_.width, grid_.height, kBlockAll);
   std::vector<std::vector<float>*> parts;
-  CellBlock::forEachPart(b, grid_.layers,
-                         [&](unsigned, std::vector<float>& v, size_t, size_t) { parts.push_back(&v); });
+  CellBlock::forEachPart(b, grid_.layers, [&](unsigned bit, std::vector<float>& v, size_t, size_t) {
+    if (bit != kBlockCarried) parts.push_back(&v);  // a part of the accumulators
+  });
   size_t k = 0;
   forEachStatePart(out, [&](std::vector<float>& v) { v = std::move(*parts[k++]); });
 }
@@ -237,11 +238,13 @@ Status Solver::restoreCells(const SolverState& in) {
     return fail("sim: the saved state is of a different grid or model (" + std::to_string(in.state.size() / 4) +
                 " cells, this simulation has " + std::to_string(n) + ")");
   }
-  CellBlock b{{0, 0, grid_.width, grid_.height}, {}, {}, {}, {}, {}};
+  CellBlock b{.rect = {0, 0, grid_.width, grid_.height}};
   std::vector<const std::vector<float>*> parts;
   forEachStatePart(in, [&](const std::vector<float>& v) { parts.push_back(&v); });
   size_t k = 0;
-  CellBlock::forEachPart(b, grid_.layers, [&](unsigned, std::vector<float>& v, size_t, size_t) { v = *parts[k++]; });
+  CellBlock::forEachPart(b, grid_.layers, [&](unsigned bit, std::vector<float>& v, size_t, size_t) {
+    if (bit != kBlockCarried) v = *parts[k++];
+  });
   writeBlock(b);
   return {};
 }
@@ -274,6 +277,13 @@ SimStats Solver::stats() const {
   for (float h : t.depth) hmax = std::max(hmax, h);
   s.maxDepthM = hmax;
   return s;
+}
+
+unsigned haloParts(const SimParams& p) {
+  unsigned parts = kBlockState | kBlockCarried;
+  if (p.waterModel == WaterModel::kVirtualPipes || p.floodScheme == FloodScheme::kLocalInertial) parts |= kBlockFlux;
+  if (p.erosionEnabled || p.thermalEnabled) parts |= kBlockLayers;
+  return parts;
 }
 
 bool blockFits(const CellBlock& b, int width, int height, int layers) {

@@ -125,6 +125,7 @@ void TiledSolver::exchangeHalos() {
     CellBlock block;  // global coordinates
   };
   std::vector<Piece> pieces;
+  const unsigned parts = haloParts(params());
   for (size_t k = 0; k < tiles_.size(); ++k) {
     const Tile& t = tiles_[k];
     for (size_t o = 0; o < tiles_.size(); ++o) {
@@ -133,7 +134,7 @@ void TiledSolver::exchangeHalos() {
       const int x0 = std::max(t.ex0, src.x0), x1 = std::min(t.ex1, src.x1);
       const int y0 = std::max(t.ey0, src.y0), y1 = std::min(t.ey1, src.y1);
       if (x0 >= x1 || y0 >= y1) continue;
-      CellBlock b = src.solver->readBlock(x0 - src.ex0, y0 - src.ey0, x1 - x0, y1 - y0, kBlockHalo);
+      CellBlock b = src.solver->readBlock(x0 - src.ex0, y0 - src.ey0, x1 - x0, y1 - y0, parts);
       b.rect.x = x0;
       b.rect.y = y0;
       pieces.push_back({k, std::move(b)});
@@ -159,7 +160,7 @@ gis::Grid<float> TiledSolver::readBed() const {
 }
 
 CellBlock TiledSolver::readBlock(int x0, int y0, int width, int height, unsigned parts) const {
-  CellBlock out{{x0, y0, width, height}, {}, {}, {}, {}, {}};
+  CellBlock out{.rect = {x0, y0, width, height}};
   STRATA_CHECK(blockFits(out, grid().width, grid().height, grid().layers)) << "readBlock outside the grid";
   for (const auto& t : tiles_) {
     const gis::CellRect own = out.rect.intersected({t.x0, t.y0, t.x1 - t.x0, t.y1 - t.y0});
@@ -177,7 +178,7 @@ void TiledSolver::writeBlock(const CellBlock& block) {
   for (auto& t : tiles_) {
     const gis::CellRect seen = block.rect.intersected({t.ex0, t.ey0, t.ex1 - t.ex0, t.ey1 - t.ey0});
     if (seen.empty()) continue;
-    CellBlock b{seen, {}, {}, {}, {}, {}};
+    CellBlock b{.rect = seen};
     copyOverlap(block, b, grid().layers);
     b.rect.x -= t.ex0;  // in the tile's coordinates
     b.rect.y -= t.ey0;

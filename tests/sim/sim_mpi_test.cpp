@@ -163,6 +163,66 @@ TEST(SimDistributed, InertialFloodEqualsOneRankBitForBit) {
   }
 }
 
+// Halos carry what the next steps read (haloParts): a flood in rain over a Green-Ampt soil
+// carries the state and the infiltrated sum and depth error of each halo cell, 28 B; once
+// erosion and thermal weathering are turned on (setParams) the four layers as well, 44 B. The
+// other sums are summed by their owner alone. Any split equals one process bit for bit, before
+// and after the change.
+TEST(SimDistributed, HalosCarryOnlyWhatTheStepsRead) {
+  auto scene = floodScene();
+  const int w = scene.input.baseM.width, h = scene.input.baseM.height;
+  scene.input.infiltrationMmPerHour = gis::Grid<float>(w, h, 10.0f);
+  scene.input.infiltrationSuctionM = gis::Grid<float>(w, h, 0.033f);
+  SimParams eroding = scene.params;
+  eroding.erosionEnabled = true;
+  eroding.thermalEnabled = true;
+  EXPECT_EQ(haloParts(scene.params), kBlockState | kBlockCarried);
+  EXPECT_EQ(haloParts(eroding), kBlockState | kBlockCarried | kBlockLayers);
+  auto run = [&](Solver& sim, std::vector<double>* bytesPerHaloCell) {
+    feed(sim, scene);
+    auto* d = dynamic_cast<DistributedSolver*>(&sim);
+    double bytes = 0, haloCells = 0;
+    auto tally = [&] {  // this phase's halo bytes over the halo cells the blocks received
+      const DistributedCounters& c = d->counters();
+      double b = c.haloBytesSent + c.haloBytesLocal, cells = c.computedCells - c.interiorCells;
+      MPI_Allreduce(MPI_IN_PLACE, &b, 1, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+      MPI_Allreduce(MPI_IN_PLACE, &cells, 1, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+      bytesPerHaloCell->push_back((b - bytes) / (cells - haloCells));
+      bytes = b, haloCells = cells;
+    };
+    sim.step(kFloodSteps / 2);
+    if (d && bytesPerHaloCell) tally();
+    ASSERT_TRUE(sim.setParams(eroding));
+    sim.step(kFloodSteps / 2);
+    if (d && bytesPerHaloCell) tally();
+  };
+  Snapshot plain;
+  if (worldRank() == 0) {
+    auto cpu = CpuSolver::create(scene.input, scene.params);
+    ASSERT_TRUE(cpu) << cpu.message();
+    run(*cpu, nullptr);
+    plain = snapshot(*cpu);
+    EXPECT_GT(plain.stats.infiltratedM3, 0.0);
+  }
+  DistributedOptions options;
+  options.blocksPerRank = 2;
+  options.skipIdle = false;  // every block steps, so its halo is received every step
+  auto sim = DistributedSolver::create(scene.input, scene.params, options, cpuSolverFactory());
+  ASSERT_TRUE(sim) << sim.message();
+  std::vector<double> bytesPerHaloCell;
+  run(*sim, &bytesPerHaloCell);
+  const Snapshot snap = snapshot(*sim);
+  if (worldRank() != 0) return;
+  const std::string what = std::to_string(sim->blockCount()) + " blocks on " + std::to_string(worldSize()) + " ranks";
+  std::printf("%s: %.1f B a halo cell in water only, %.1f B eroding; infiltrated %.3f m3\n", what.c_str(),
+              bytesPerHaloCell[0], bytesPerHaloCell[1], snap.stats.infiltratedM3);
+  expectSame(plain, snap, what, false);
+  EXPECT_NEAR(snap.stats.infiltratedM3, plain.stats.infiltratedM3, 1e-9 * plain.stats.infiltratedM3) << what;
+  ASSERT_EQ(bytesPerHaloCell.size(), 2u);
+  EXPECT_EQ(bytesPerHaloCell[0], 4.0 * (4 + kAccumCarried));
+  EXPECT_EQ(bytesPerHaloCell[1], 4.0 * (4 + kAccumCarried + 4));
+}
+
 // A spin-up starts the clock before 0: the blocks' springs and levels must follow the run's clock
 // (they once followed their own, from 0, and a scenario's spin-up fed the flood peak); so must a
 // clock moved on by Solver::restartAt (a spin-up steady early).

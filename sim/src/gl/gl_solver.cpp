@@ -376,8 +376,9 @@ struct GlSolver::Impl {
   struct Rect {
     size_t perCell, planes;
     int x0, y0, width, height;
+    size_t firstPlane = 0;  // of the buffer's planes
     size_t floats() const { return perCell * planes * size_t(width) * size_t(height); }
-    bool wholeRows(int gridWidth) const { return planes == 1 && x0 == 0 && width == gridWidth; }
+    bool wholeRows(int gridWidth) const { return planes == 1 && firstPlane == 0 && x0 == 0 && width == gridWidth; }
     size_t offset() const { return 4 * perCell * size_t(y0) * size_t(width); }  // bytes, whole rows
   };
   void copyRect(const gl::Buffer& buf, const Rect& r, bool scatter) {
@@ -392,6 +393,7 @@ struct GlSolver::Impl {
     pCopyRect.set("height", unsigned(r.height));
     pCopyRect.set("perCell", unsigned(r.perCell));
     pCopyRect.set("planes", unsigned(r.planes));
+    pCopyRect.set("firstPlane", unsigned(r.firstPlane));
     pCopyRect.set("scatter", scatter ? 1u : 0u);
     pCopyRect.dispatchCovering(int(r.perCell) * r.width, int(r.planes) * r.height);
   }
@@ -600,25 +602,27 @@ size_t GlSolver::gpuBytes() const {
 // only with them).
 namespace {
 template <class Impl>
-std::array<gl::Buffer*, 5> partBuffers(Impl& s, bool diag) {
-  return {&s.curMut(), &s.flux, diag ? &s.fluxDiag : nullptr, &s.layerBuf, &s.accum};
+std::array<gl::Buffer*, 6> partBuffers(Impl& s, bool diag) {
+  return {&s.curMut(), &s.flux, diag ? &s.fluxDiag : nullptr, &s.layerBuf, &s.accum, &s.accum};
 }
 
-// The accumulators of `cells` cells between the GPU's plane-major order (kAccumPerCell planes)
-// and CellBlock's cell-major one: toCells from planes to cells, else back.
-void transposeAccum(const std::vector<float>& from, std::vector<float>& to, size_t cells, bool toCells) {
+// `per` accumulators of `cells` cells between the GPU's plane-major order (sim_accum.glsl) and
+// CellBlock's cell-major one: toCells from planes to cells, else back.
+void transposeAccum(const std::vector<float>& from, std::vector<float>& to, size_t cells, size_t per, bool toCells) {
   for (size_t c = 0; c < cells; ++c) {
-    for (size_t k = 0; k < size_t(kAccumPerCell); ++k) {
-      const size_t planar = k * cells + c, cellMajor = c * size_t(kAccumPerCell) + k;
+    for (size_t k = 0; k < per; ++k) {
+      const size_t planar = k * cells + c, cellMajor = c * per + k;
       to[toCells ? cellMajor : planar] = from[toCells ? planar : cellMajor];
     }
   }
 }
+// The accumulator planes a part holds: all of them, or the carried ones (kBlockCarried).
+size_t firstAccumPlane(unsigned bit) { return bit == kBlockCarried ? size_t(kAccumCarriedFrom) : 0; }
 }  // namespace
 
 CellBlock GlSolver::readBlock(int x0, int y0, int width, int height, unsigned parts) const {
   const int w = grid().width, L = grid().layers;
-  CellBlock b{{x0, y0, width, height}, {}, {}, {}, {}, {}};
+  CellBlock b{.rect = {x0, y0, width, height}};
   STRATA_CHECK(blockFits(b, w, grid().height, L))
       << "readBlock (" << x0 << ", " << y0 << ") " << width << "x" << height << " outside the grid";
   Impl& s = *impl_;
@@ -630,10 +634,10 @@ CellBlock GlSolver::readBlock(int x0, int y0, int width, int height, unsigned pa
     gl::Buffer* buf = buffers[k++];
     if (!(parts & bit) || !buf) return;
     out.resize(per * planes * b.cells());
-    if (&out == &b.accum) {  // plane-major on the GPU (sim_accum.glsl), cell-major in the block
+    if (buf == &s.accum) {  // plane-major on the GPU (sim_accum.glsl), cell-major in the block
       std::vector<float> planar(out.size());
-      s.downloadRect(*buf, Impl::Rect{1, per, x0, y0, width, height}, planar.data());
-      transposeAccum(planar, out, b.cells(), true);
+      s.downloadRect(*buf, Impl::Rect{1, per, x0, y0, width, height, firstAccumPlane(bit)}, planar.data());
+      transposeAccum(planar, out, b.cells(), per, true);
       return;
     }
     s.downloadRect(*buf, Impl::Rect{per, planes, x0, y0, width, height}, out.data());
@@ -649,13 +653,13 @@ void GlSolver::writeBlock(const CellBlock& b) {
   const auto buffers = partBuffers(s, params().diagonalPipes);
   const gis::CellRect& r = b.rect;
   size_t k = 0;
-  CellBlock::forEachPart(b, L, [&](unsigned, const std::vector<float>& in, size_t per, size_t planes) {
+  CellBlock::forEachPart(b, L, [&](unsigned bit, const std::vector<float>& in, size_t per, size_t planes) {
     gl::Buffer* buf = buffers[k++];
     if (in.empty() || !buf) return;
-    if (&in == &b.accum) {  // cell-major in the block, plane-major on the GPU
+    if (buf == &s.accum) {  // cell-major in the block, plane-major on the GPU
       std::vector<float> planar(in.size());
-      transposeAccum(in, planar, b.cells(), false);
-      s.uploadRect(*buf, Impl::Rect{1, per, r.x, r.y, r.width, r.height}, planar.data());
+      transposeAccum(in, planar, b.cells(), per, false);
+      s.uploadRect(*buf, Impl::Rect{1, per, r.x, r.y, r.width, r.height, firstAccumPlane(bit)}, planar.data());
       return;
     }
     s.uploadRect(*buf, Impl::Rect{per, planes, r.x, r.y, r.width, r.height}, in.data());

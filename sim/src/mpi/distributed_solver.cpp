@@ -54,7 +54,7 @@ void pack(const CellBlock& b, std::vector<float>& out) {
 
 // The parts of a `rect` block read from `in` (as pack() wrote it); returns the floats used.
 size_t unpack(const float* in, const CellRect& rect, unsigned parts, bool diag, int layers, CellBlock& b) {
-  b = CellBlock{rect, {}, {}, {}, {}, {}};
+  b = CellBlock{.rect = rect};
   const size_t cells = b.cells();
   size_t at = 0;
   int k = 0;
@@ -135,7 +135,8 @@ struct DistributedSolver::Impl {
 
   bool diag(const SimParams& p) const { return p.diagonalPipes; }
   int layers() const { return int(region.materials.size()); }
-  size_t haloFloats(const SimParams& p) const { return floatsPerCell(kBlockHalo, diag(p), layers()); }
+  unsigned halo = 0;  // the parts halos carry (haloParts), as plan() last sized the messages
+  size_t haloFloats(const SimParams& p) const { return floatsPerCell(haloParts(p), diag(p), layers()); }
   Block& block(int id) { return blocks[size_t(localIndex[size_t(id)])]; }
   const Block& block(int id) const { return blocks[size_t(localIndex[size_t(id)])]; }
   bool mine(int id) const { return localIndex[size_t(id)] >= 0; }
@@ -228,6 +229,7 @@ struct DistributedSolver::Impl {
     sends.assign(blocks.size(), {});
     receives.clear();
     localCopies.clear();
+    halo = haloParts(params);
     const size_t per = haloFloats(params);
     for (const auto& p : pieces) {
       const bool src = mine(p.src), dst = mine(p.dst);
@@ -327,7 +329,7 @@ struct DistributedSolver::Impl {
       m.buffer.reserve(m.floats);
       for (const auto& p : m.pieces) {
         const CellRect r = b.local(p.rect);
-        pack(b.solver->readBlock(r.x, r.y, r.width, r.height, kBlockHalo), m.buffer);
+        pack(b.solver->readBlock(r.x, r.y, r.width, r.height, halo), m.buffer);
       }
       STRATA_CHECK(m.buffer.size() == m.floats)
           << "halo message of " << m.buffer.size() << " floats, planned " << m.floats;
@@ -341,7 +343,7 @@ struct DistributedSolver::Impl {
       const Block& s = block(p.src);
       Block& d = block(p.dst);
       const CellRect r = s.local(p.rect);
-      CellBlock piece = s.solver->readBlock(r.x, r.y, r.width, r.height, kBlockHalo);
+      CellBlock piece = s.solver->readBlock(r.x, r.y, r.width, r.height, halo);
       piece.rect.x = p.rect.x - d.extent.x;
       piece.rect.y = p.rect.y - d.extent.y;
       noteIncoming(d, piece);
@@ -361,7 +363,7 @@ struct DistributedSolver::Impl {
       for (const auto& p : m.pieces) {
         Block& d = block(p.dst);
         CellBlock piece;
-        at += unpack(m.buffer.data() + at, d.local(p.rect), kBlockHalo, diag(params), layers(), piece);
+        at += unpack(m.buffer.data() + at, d.local(p.rect), halo, diag(params), layers(), piece);
         noteIncoming(d, piece);
         d.solver->writeBlock(piece);
       }
@@ -392,7 +394,7 @@ struct DistributedSolver::Impl {
       pack(b.solver->readBlock(l.x, l.y, l.width, l.height, parts), mine);
     }
     const std::vector<float> all = gatherv(mine);
-    CellBlock out{rect.x, rect.y, rect.width, rect.height, {}, {}, {}, {}, {}};
+    CellBlock out{.rect = rect};
     if (rank != 0) return out;
     const size_t cells = out.cells();
     if (parts & kBlockState) out.state.resize(4 * cells);
@@ -400,6 +402,7 @@ struct DistributedSolver::Impl {
     if ((parts & kBlockFlux) && diag(params)) out.fluxDiag.resize(4 * cells);
     if (parts & kBlockLayers) out.layers.resize(size_t(layers()) * cells);
     if (parts & kBlockAccum) out.accum.resize(kAccumPerCell * cells);
+    if (parts & kBlockCarried) out.carried.resize(kAccumCarried * cells);
     for (size_t at = 0; at < all.size();) {
       const CellRect r{int(all[at]), int(all[at + 1]), int(all[at + 2]), int(all[at + 3])};
       CellBlock piece;
@@ -594,6 +597,9 @@ void DistributedSolver::onParamsChanged() {
     const auto status = b.solver->setParams(impl_->blockParams(params(), b.extent));
     STRATA_CHECK(status.ok()) << status.message();  // validated by Solver::setParams already
   }
+  // Erosion or thermal weathering turned on or off changes what halos carry (haloParts); every
+  // rank plans the same (setParams is collective).
+  if (haloParts(params()) != impl_->halo) impl_->plan(params());
 }
 
 Solver::RainTotals DistributedSolver::rainTotals() const {
@@ -800,7 +806,7 @@ SimStats DistributedSolver::stats() const {
 }
 
 CellBlock DistributedSolver::readBlock(int x0, int y0, int width, int height, unsigned parts) const {
-  CellBlock probe{{x0, y0, width, height}, {}, {}, {}, {}, {}};
+  CellBlock probe{.rect = {x0, y0, width, height}};
   STRATA_CHECK(blockFits(probe, grid().width, grid().height, grid().layers)) << "readBlock outside the grid";
   return impl_->gather({x0, y0, width, height}, parts, params());
 }
@@ -808,15 +814,15 @@ CellBlock DistributedSolver::readBlock(int x0, int y0, int width, int height, un
 void DistributedSolver::writeBlock(const CellBlock& block) {
   Impl& m = *impl_;
   // Rank 0's block to every rank: its rectangle, the size of each of its parts, then the parts.
-  int header[9] = {block.rect.x, block.rect.y, block.rect.width, block.rect.height};
+  int header[4 + 6] = {block.rect.x, block.rect.y, block.rect.width, block.rect.height};  // then the six parts' sizes
   int k = 4;
   CellBlock::forEachPart(block, grid().layers,
                          [&](unsigned, const std::vector<float>& v, size_t, size_t) { header[k++] = int(v.size()); });
   if (m.rank == 0) {
     STRATA_CHECK(blockFits(block, grid().width, grid().height, grid().layers)) << "writeBlock outside the grid";
   }
-  MPI_Bcast(header, 9, MPI_INT, 0, m.comm);
-  CellBlock b = m.rank == 0 ? block : CellBlock{{header[0], header[1], header[2], header[3]}, {}, {}, {}, {}, {}};
+  MPI_Bcast(header, 4 + 6, MPI_INT, 0, m.comm);
+  CellBlock b = m.rank == 0 ? block : CellBlock{.rect = {header[0], header[1], header[2], header[3]}};
   k = 4;
   CellBlock::forEachPart(b, grid().layers, [&](unsigned, std::vector<float>& v, size_t, size_t) {
     v.resize(size_t(header[k++]));
@@ -826,7 +832,7 @@ void DistributedSolver::writeBlock(const CellBlock& block) {
   for (auto& blk : m.blocks) {
     const CellRect r = b.rect.intersected(blk.extent);
     if (r.empty()) continue;
-    CellBlock part{r, {}, {}, {}, {}, {}};
+    CellBlock part{.rect = r};
     copyOverlap(b, part, grid().layers);
     part.rect.x -= blk.extent.x;
     part.rect.y -= blk.extent.y;

@@ -54,7 +54,7 @@ class AdaptiveSolver final : public Solver {
   SimStats stats() const override;  ///< volumes over all tiles at their levels
   std::string backendName() const override;
   double maxWaveSpeedMS() const override;
-  CellBlock readBlock(int x0, int y0, int width, int height, unsigned parts = kBlockHalo) const override;
+  CellBlock readBlock(int x0, int y0, int width, int height, unsigned parts = kBlockAll) const override;
   void writeBlock(const CellBlock& block) override;
   std::vector<float> readFaceMassFlux() const override;
 

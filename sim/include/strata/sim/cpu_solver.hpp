@@ -38,7 +38,7 @@ class CpuSolver final : public Solver {
   /// "CPU, N OpenMP threads".
   std::string backendName() const override;
   double maxWaveSpeedMS() const override;
-  CellBlock readBlock(int x0, int y0, int width, int height, unsigned parts = kBlockHalo) const override;
+  CellBlock readBlock(int x0, int y0, int width, int height, unsigned parts = kBlockAll) const override;
   void writeBlock(const CellBlock& block) override;
   std::vector<float> readFaceMassFlux() const override;
   std::vector<float> readFaceMassFluxAt(const std::vector<size_t>& faces) const override;

@@ -75,6 +75,11 @@ enum AccumOffset : int {
   /// Not a sum: what the float depth h could not hold, m; the cell holds h + this (W34).
   kAccumDepthError = 10,
   kAccumPerCell = 11,
+  /// The accumulators a step reads, not only adds to: the infiltrated sum (W11b's cumulative
+  /// infiltration) and the depth error (W34), the last kAccumCarried of a cell's floats. The
+  /// other sums only their cell's owner adds up, so halos leave them out (kBlockCarried).
+  kAccumCarriedFrom = kAccumInfiltrated,
+  kAccumCarried = kAccumPerCell - kAccumCarriedFrom,
 };
 
 /// Which parts of a rectangle of cells readBlock() reads (bits).
@@ -82,22 +87,30 @@ enum BlockParts : unsigned {
   kBlockState = 1u,   ///< h, s, hu, hv
   kBlockFlux = 2u,    ///< pipe outflows (and diagonal ones when the solver has them)
   kBlockLayers = 4u,  ///< layer thicknesses
-  kBlockAccum = 8u,   ///< compensated budget sums
-  /// What a halo exchange carries: state, fluxes, layers and the accumulators, whose depth error
-  /// (W34) the next steps' halo updates read (the sums there are the owner's, summed by it alone).
-  kBlockHalo = 15u,
-  kBlockAll = 15u,
+  kBlockAccum = 8u,   ///< every accumulator: compensated budget sums and the depth error
+  /// Only the accumulators a step reads (kAccumCarried a cell, from kAccumCarriedFrom), a part of
+  /// kBlockAccum of its own: what halos carry of them (haloParts).
+  kBlockCarried = 16u,
+  kBlockAll = 15u,  ///< everything a solver keeps
 };
+
+/// What a halo exchange (tiles, ranks) carries under `p`: the state and the carried
+/// accumulators; the fluxes where a step reads the last step's (pipes, the local-inertial
+/// scheme's faces); the layers where a step changes them (erosion, thermal weathering). The
+/// model and scheme are fixed at creation, and erosion and thermal weathering change layers only
+/// while on, so a halo skipped while they are off already holds its owner's layers.
+unsigned haloParts(const SimParams& p);
 
 /// The persistent state of a rectangle of cells: what a halo exchange (tiles, ranks) carries.
 /// An empty part is not read or, in writeBlock(), left as it is.
 struct CellBlock {
-  gis::CellRect rect;           ///< the cells [x, x + width) x [y, y + height)
-  std::vector<float> state;     ///< 4 per cell: depth h, suspended s, discharges hu, hv
-  std::vector<float> flux;      ///< 4 per cell: pipe outflows W, E, N, S (m^3/s)
-  std::vector<float> fluxDiag;  ///< 4 per cell: diagonal pipes NW, NE, SW, SE (with them)
-  std::vector<float> layers;    ///< layer-major: layers[l * cells + cell] (m)
-  std::vector<float> accum;     ///< kAccumPerCell per cell: compensated sums, depth error (AccumOffset)
+  gis::CellRect rect{};           ///< the cells [x, x + width) x [y, y + height)
+  std::vector<float> state{};     ///< 4 per cell: depth h, suspended s, discharges hu, hv
+  std::vector<float> flux{};      ///< 4 per cell: pipe outflows W, E, N, S (m^3/s)
+  std::vector<float> fluxDiag{};  ///< 4 per cell: diagonal pipes NW, NE, SW, SE (with them)
+  std::vector<float> layers{};    ///< layer-major: layers[l * cells + cell] (m)
+  std::vector<float> accum{};     ///< kAccumPerCell per cell: compensated sums, depth error (AccumOffset)
+  std::vector<float> carried{};   ///< kAccumCarried per cell: accum's from kAccumCarriedFrom on
   size_t cells() const { return size_t(rect.width) * size_t(rect.height); }
 
   /// The one list of a block's parts: f(part's BlockParts bit, its values, floats per cell of a
@@ -111,6 +124,7 @@ struct CellBlock {
     f(kBlockFlux, b.fluxDiag, size_t(4), size_t(1));
     f(kBlockLayers, b.layers, size_t(1), size_t(layers));
     f(kBlockAccum, b.accum, size_t(kAccumPerCell), size_t(1));
+    f(kBlockCarried, b.carried, size_t(kAccumCarried), size_t(1));
   }
 };
 
@@ -273,9 +287,10 @@ class Solver {
   /// `t1S` (m/s; sourceDepthRate, W10).
   double sourceDepthRateMS(double t1S) const;
   /// The `parts` of the persistent state of a rectangle of cells inside the grid.
-  virtual CellBlock readBlock(int x0, int y0, int width, int height, unsigned parts = kBlockHalo) const = 0;
+  virtual CellBlock readBlock(int x0, int y0, int width, int height, unsigned parts = kBlockAll) const = 0;
   /// Replaces the non-empty parts of the state of block.width x block.height cells at (x0, y0)
-  /// (inside the grid; each part of its full size); the bed follows the layers.
+  /// (inside the grid; each part of its full size; `carried` after `accum`); the bed follows the
+  /// layers.
   virtual void writeBlock(const CellBlock& block) = 0;
   /// Flood mode: the mass flux per unit width (m^2/s, positive east / south) the last step moved
   /// through each face (the Heun average, W22, scaled by W25's outflow limits): x faces

@@ -32,7 +32,7 @@ class TiledSolver final : public Solver {
   gis::Grid<float> readBed() const override;
   std::string backendName() const override;
   double maxWaveSpeedMS() const override;
-  CellBlock readBlock(int x0, int y0, int width, int height, unsigned parts = kBlockHalo) const override;
+  CellBlock readBlock(int x0, int y0, int width, int height, unsigned parts = kBlockAll) const override;
   void writeBlock(const CellBlock& block) override;
   std::vector<float> readFaceMassFlux() const override;
   int tileCount() const { return int(tiles_.size()); }

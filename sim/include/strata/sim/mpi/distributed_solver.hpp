@@ -101,7 +101,7 @@ class DistributedSolver final : public Solver {
   /// Collective: the largest over all ranks.
   double maxWaveSpeedMS() const override;
   /// Collective: the rectangle on rank 0 (the other ranks get it with no data).
-  CellBlock readBlock(int x0, int y0, int width, int height, unsigned parts = kBlockHalo) const override;
+  CellBlock readBlock(int x0, int y0, int width, int height, unsigned parts = kBlockAll) const override;
   /// Collective: rank 0's block is written (the others' argument is ignored).
   void writeBlock(const CellBlock& block) override;
   /// Collective: on rank 0, empty elsewhere.
