@@ -599,7 +599,7 @@ size_t GlSolver::gpuBytes() const {
 }
 
 // The buffer of each part of a CellBlock, in CellBlock::forEachPart's order (the diagonal pipes'
-// only with them).
+// only with them; the carried accumulators are the last planes of the accumulators' buffer).
 namespace {
 template <class Impl>
 std::array<gl::Buffer*, 6> partBuffers(Impl& s, bool diag) {
