@@ -11,6 +11,5 @@ void main() {
   const uint k = gl_GlobalInvocationID.x;
   if (k >= entryCount) return;
   const SourceEntry e = entries[k];
-  const int y = int(e.cell) / P.width;
-  state[e.cell].x = addDepth(state[e.cell].x, int(e.cell), e.rateM3S * P.dtS / cellArea(y));
+  state[e.cell].x = addDepth(state[e.cell].x, int(e.cell), pointSourceDepth(e));
 }

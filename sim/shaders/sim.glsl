@@ -85,6 +85,9 @@ bool insideGrid(ivec2 p) { return p.x >= 0 && p.y >= 0 && p.x < P.width && p.y <
 int cellOf(ivec2 p) { return p.y * P.width + p.x; }
 float cellDx(int y) { return rowDx[y]; }
 float cellArea(int y) { return rowDx[y] * P.dyM; }
+// W12: the depth a point-source entry pours into its cell over the step P.dtS (point_sources.comp,
+// and step_clock.comp where no rain pass comes between, W36).
+float pointSourceDepth(SourceEntry e) { return e.rateM3S * P.dtS / cellArea(int(e.cell) / P.width); }
 // Width of the y-face between rows yFace - 1 and yFace (the mean of the two rows' dx).
 float faceWidthY(int yFace) {
   if (yFace <= 0) return rowDx[0];

@@ -122,8 +122,7 @@ void main() {
     for (uint k = 0u; k < C.termCount; ++k) {
       if (k + 1u < C.termCount && terms[k + 1u].entry == terms[k].entry) continue;
       const SourceEntry e = entries[terms[k].entry];
-      const int y = int(e.cell) / P.width;
-      state[e.cell].x = addDepth(state[e.cell].x, int(e.cell), e.rateM3S * P.dtS / cellArea(y));
+      state[e.cell].x = addDepth(state[e.cell].x, int(e.cell), pointSourceDepth(e));
     }
   }
   C.timeS = t1;
