@@ -365,8 +365,9 @@ void flatPlain(benchmark::State& state, ts::FloodScheme scheme, bool gl, bool ho
 }
 
 void registerAll() {
-  for (auto [scheme, name] : {std::pair{ts::FloodScheme::kFiniteVolume, "finite_volume"},
-                              std::pair{ts::FloodScheme::kLocalInertial, "inertial"}}) {
+  for (auto [schemeOf, name] : {std::pair{ts::FloodScheme::kFiniteVolume, "finite_volume"},
+                                std::pair{ts::FloodScheme::kLocalInertial, "inertial"}}) {
+    const ts::FloodScheme scheme = schemeOf;  // a lambda captures no structured binding before Clang 16
     for (const char* kind : {"cpu", "gl", "gl_host_steps"}) {
       const bool gl = kind[0] == 'g', hostSteps = kind[2] == '_';
       benchmark::RegisterBenchmark(

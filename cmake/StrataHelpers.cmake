@@ -7,7 +7,8 @@ set(CMAKE_CXX_STANDARD_REQUIRED ON)
 set(CMAKE_CXX_EXTENSIONS OFF)
 
 add_library(strata_options INTERFACE)
-target_compile_options(strata_options INTERFACE -Wall -Wextra -Wpedantic -Wshadow=local)
+target_compile_options(strata_options INTERFACE -Wall -Wextra -Wpedantic $<$<CXX_COMPILER_ID:GNU>:-Wshadow=local>
+                                                $<$<CXX_COMPILER_ID:Clang>:-Wshadow;-Wno-pass-failed>)
 if(STRATA_WERROR)
   target_compile_options(strata_options INTERFACE -Werror)
 endif()
@@ -18,7 +19,8 @@ if(STRATA_SANITIZE)
   # GCC 12's -Wmaybe-uninitialized gives false positives inside libstdc++ (std::regex,
   # std::function) once sanitizer instrumentation is in: the warning stays on in the normal build.
   target_compile_options(strata_options INTERFACE -fsanitize=${STRATA_SANITIZE} -fno-omit-frame-pointer
-                                                  -fno-sanitize-recover=undefined -Wno-maybe-uninitialized)
+                                                  -fno-sanitize-recover=undefined
+                                                  $<$<CXX_COMPILER_ID:GNU>:-Wno-maybe-uninitialized>)
   target_link_options(strata_options INTERFACE -fsanitize=${STRATA_SANITIZE})
 endif()
 

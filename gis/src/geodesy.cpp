@@ -141,7 +141,7 @@ double ellipsoidalQuadAreaM2(double lat0Deg, double lat1Deg, double lonSpanDeg, 
 
 struct CrsTransform::Impl {
   struct Destroy {
-    void operator()(OGRCoordinateTransformation* ct) const { OGRCoordinateTransformation::DestroyCT(ct); }
+    void operator()(OGRCoordinateTransformation* t) const { OGRCoordinateTransformation::DestroyCT(t); }
   };
   std::unique_ptr<OGRCoordinateTransformation, Destroy> ct;
 };

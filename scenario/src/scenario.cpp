@@ -69,7 +69,6 @@ struct Range {
 };
 constexpr Range kAny{};
 constexpr Range kPositive{0, std::numeric_limits<double>::infinity(), true, ""};
-constexpr Range kNotNegative{0, std::numeric_limits<double>::infinity(), false, ""};
 
 // What `v` (outside `r`) violates: "must be positive", "must not be negative", "must be at most 10 km".
 std::string rangeText(const Range& r, double v) {

@@ -104,7 +104,7 @@ template <int kL>
 inline void takeFrom(const Stack& st, int x, int top, float amount, bool apply) {
   for (int l = 0; l < (kL > 0 ? kL : st.count); ++l) {
     const float v = st.at(l, x);
-    st.at(l, x) = apply & (top == l) ? v - amount : v;
+    st.at(l, x) = (apply & (top == l)) ? v - amount : v;
   }
 }
 

@@ -48,9 +48,7 @@ class Plane {
  public:
   Plane() = default;
   Plane(int width, int rows)
-      : stride_((size_t(width) + 15) / 16 * 16),
-        rows_(rows),
-        data_(new (std::align_val_t(64)) float[stride_ * size_t(rows)]()) {}
+      : stride_((size_t(width) + 15) / 16 * 16), data_(new (std::align_val_t(64)) float[stride_ * size_t(rows)]()) {}
   bool empty() const { return !data_; }
   size_t stride() const { return stride_; }
   float* row(int y) { return data_.get() + size_t(y) * stride_; }
@@ -63,7 +61,6 @@ class Plane {
     void operator()(float* p) const { ::operator delete[](p, std::align_val_t(64)); }
   };
   size_t stride_ = 0;
-  int rows_ = 0;
   std::unique_ptr<float[], Free> data_;
 };
 

@@ -93,7 +93,7 @@ Impl::Impl(const SimInput& input, const SimParams& params, int threadCount, bool
       recomputeBed(x, y);
     }
   }
-  const bool flood = p.waterModel == WaterModel::kFiniteVolume;
+  const bool floodMode = p.waterModel == WaterModel::kFiniteVolume;
   for (auto& s : state) s = Water{Plane(w, h), Plane(w, h), Plane(w, h), Plane(w, h)};
   if (input.waterDepthM.size() > 0) {
     for (int y = 0; y < h; ++y) {
@@ -117,12 +117,12 @@ Impl::Impl(const SimInput& input, const SimParams& params, int threadCount, bool
     }
   }
   for (auto& a : accum) a = Plane(w, h);
-  if (flood && p.floodScheme == FloodScheme::kLocalInertial) {
+  if (floodMode && p.floodScheme == FloodScheme::kLocalInertial) {
     faceX = Faces{Plane(w + 1, h), Plane(), Plane(), Plane()};
     faceY = Faces{Plane(w, h + 1), Plane(), Plane(), Plane()};
     limit = Plane(w, h);
     for (auto& f : flux) f = Plane(w, h);
-  } else if (flood) {
+  } else if (floodMode) {
     stage = Water{Plane(w, h), Plane(w, h), Plane(w, h), Plane(w, h)};
     faceX = Faces{Plane(w + 1, h), Plane(w + 1, h), Plane(w + 1, h), Plane(w + 1, h)};
     faceY = Faces{Plane(w, h + 1), Plane(w, h + 1), Plane(w, h + 1), Plane(w, h + 1)};

@@ -1095,7 +1095,7 @@ STRATA_ROW_KERNEL void floodStatsRow(const float* h, const float* hu, const floa
     maxSpeed[x] = maxOf(maxSpeed[x], std::sqrt(u * u + v * v));
     const bool isWet = hx > wet;
     const float a = arrival[x], t = wetTime[x];
-    arrival[x] = isWet & (a < 0.0f) ? endTimeS : a;
+    arrival[x] = (isWet & (a < 0.0f)) ? endTimeS : a;
     wetTime[x] = isWet ? t + dtS : t;
   }
 }

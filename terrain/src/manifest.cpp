@@ -5,7 +5,6 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
-#include <limits>
 #include <sstream>
 
 #include <toml++/toml.h>
@@ -14,8 +13,6 @@
 
 namespace strata::terrain::detail {
 namespace {
-
-constexpr double kInf = std::numeric_limits<double>::infinity();
 
 const char* layoutName(TileLayout l) { return l == TileLayout::Global ? "global" : "planar"; }
 const char* metricName(TileMetric m) { return m == TileMetric::Range ? "range" : "max_error"; }

@@ -252,10 +252,10 @@ TEST(TileStore, WindowReadsTouchOnlyTheTilesTheyCover) {
 
 TEST(TileStore, NonRectangularDomainsLeaveTilesAbsent) {
   const auto dir = test::tempDir("store");
-  const int n = 4 * kFootprint;
+  constexpr int n = 4 * kFootprint;
   // A disc of data (radius 0.35 n < the 0.354 n to the corner tiles' nearest point): the corner
   // tiles lie wholly outside it.
-  auto disc = [n](int x0, int y0, int w, int h) -> Result<Grid<float>> {
+  auto disc = [](int x0, int y0, int w, int h) -> Result<Grid<float>> {
     Grid<float> g(w, h, gis::kNoData);
     for (int y = 0; y < h; ++y) {
       for (int x = 0; x < w; ++x) {
