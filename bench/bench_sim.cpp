@@ -365,14 +365,13 @@ void flatPlain(benchmark::State& state, ts::FloodScheme scheme, bool gl, bool ho
 }
 
 void registerAll() {
-  for (auto [schemeOf, name] : {std::pair{ts::FloodScheme::kFiniteVolume, "finite_volume"},
-                                std::pair{ts::FloodScheme::kLocalInertial, "inertial"}}) {
-    const ts::FloodScheme scheme = schemeOf;  // a lambda captures no structured binding before Clang 16
+  for (auto [scheme, name] : {std::pair{ts::FloodScheme::kFiniteVolume, "finite_volume"},
+                              std::pair{ts::FloodScheme::kLocalInertial, "inertial"}}) {
     for (const char* kind : {"cpu", "gl", "gl_host_steps"}) {
       const bool gl = kind[0] == 'g', hostSteps = kind[2] == '_';
       benchmark::RegisterBenchmark(
           (std::string("flat_plain/") + name + "/" + kind).c_str(),
-          [scheme, gl, hostSteps](benchmark::State& s) { flatPlain(s, scheme, gl, hostSteps); })
+          [scheme = scheme, gl, hostSteps](benchmark::State& s) { flatPlain(s, scheme, gl, hostSteps); })
           ->Arg(20)
           ->Arg(10)
           ->Arg(5)

@@ -198,9 +198,10 @@ StorageFootprint TileStore::footprintStats() const {
       const auto& r = impl_->rec(tx, ty);
       if (!r.present) continue;
       const auto [wIn, hIn] = impl_->inGrid(tx, ty);
-      const uint64_t w = uint64_t(wIn), h = uint64_t(hIn);  // a lambda captures no binding before Clang 16
       // Samples of block side b covering the wIn x hIn cells inside the grid, level by level.
-      auto covering = [&](uint64_t b) { return ((w + b - 1) / b) * ((h + b - 1) / b); };
+      auto covering = [w = uint64_t(wIn), h = uint64_t(hIn)](uint64_t b) {
+        return ((w + b - 1) / b) * ((h + b - 1) / b);
+      };
       uint64_t b = uint64_t(1) << (maxLod() - r.exp);
       s.storedSamples += covering(b) * nf;
       for (int level = r.exp; level >= 0; --level, b *= 2) s.storedWithMips += covering(b) * nf;
