@@ -324,7 +324,10 @@ void glHaloStrip(benchmark::State& state) {
 // with OpenMP's default count (grid-capped, tuned). Reports the steps and the solver's wall time.
 // GL takes its steps as advance() does, chosen on the GPU (W35); `hostSteps` chooses each on the
 // host instead (a 4-byte read of the wave speed a step): the two side by side are W35's gain.
-void flatPlain(benchmark::State& state, ts::FloodScheme scheme, bool gl, bool hostSteps = false) {
+// `localSteps`: the CPU backend with W37's local time steps (3 levels); the CPU runs count their
+// cell updates.
+void flatPlain(benchmark::State& state, ts::FloodScheme scheme, bool gl, bool hostSteps = false,
+               bool localSteps = false) {
   const double cellM = double(state.range(0));
   const auto plain = test::flatPlain(cellM);
   const double duration = cellM <= 1.0 ? 3600.0 : test::kPlainDurationS;
@@ -335,7 +338,9 @@ void flatPlain(benchmark::State& state, ts::FloodScheme scheme, bool gl, bool ho
       auto s = ts::GlSolver::create(plain.input, test::flatPlainParams(scheme));
       if (s) sim = std::make_unique<ts::GlSolver>(std::move(s).value());
     } else {
-      auto s = ts::CpuSolver::create(plain.input, test::flatPlainParams(scheme));
+      auto p = test::flatPlainParams(scheme);
+      p.localStepLevels = localSteps ? ts::kMaxLocalStepLevels : 0;
+      auto s = ts::CpuSolver::create(plain.input, p);
       if (s) sim = std::make_unique<ts::CpuSolver>(std::move(s).value());
     }
     if (!sim || !sim->addSource(plain.breach)) return state.SkipWithError("the solver could not be created");
@@ -356,6 +361,9 @@ void flatPlain(benchmark::State& state, ts::FloodScheme scheme, bool gl, bool ho
     state.counters["balance"] = st.waterBalanceM3() / st.inflowM3;
     state.counters["cell_steps/s"] = benchmark::Counter(double(st.steps) * double(plain.input.baseM.size()),
                                                         benchmark::Counter::kIsIterationInvariantRate);
+    if (const auto* cpu = dynamic_cast<const ts::CpuSolver*>(sim.get())) {
+      state.counters["cell_updates"] = double(cpu->cellUpdates());
+    }
     if (gl) {
       state.counters["dispatches/step"] = double(calls1.dispatches - calls0.dispatches) / double(st.steps);
       state.counters["reads/step"] = double(calls1.hostReads - calls0.hostReads) / double(st.steps);
@@ -367,11 +375,12 @@ void flatPlain(benchmark::State& state, ts::FloodScheme scheme, bool gl, bool ho
 void registerAll() {
   for (auto [scheme, name] : {std::pair{ts::FloodScheme::kFiniteVolume, "finite_volume"},
                               std::pair{ts::FloodScheme::kLocalInertial, "inertial"}}) {
-    for (const char* kind : {"cpu", "gl", "gl_host_steps"}) {
-      const bool gl = kind[0] == 'g', hostSteps = kind[2] == '_';
+    for (const char* kind : {"cpu", "cpu_local_steps", "gl", "gl_host_steps"}) {
+      const bool gl = kind[0] == 'g', hostSteps = kind[2] == '_', local = std::string(kind) == "cpu_local_steps";
+      if (local && scheme != ts::FloodScheme::kLocalInertial) continue;  // W37 is the local-inertial scheme's
       benchmark::RegisterBenchmark(
           (std::string("flat_plain/") + name + "/" + kind).c_str(),
-          [scheme = scheme, gl, hostSteps](benchmark::State& s) { flatPlain(s, scheme, gl, hostSteps); })
+          [scheme = scheme, gl, hostSteps, local](benchmark::State& s) { flatPlain(s, scheme, gl, hostSteps, local); })
           ->Arg(20)
           ->Arg(10)
           ->Arg(5)

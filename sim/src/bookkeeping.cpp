@@ -63,14 +63,8 @@ std::vector<SourceEntry> mergeSources(const std::vector<Source>& sources, int wi
 double stepDt(const SimParams& params, double maxWaveSpeedMS, double minCellM, double sourceDepthRateMS) {
   const double cap = params.maxDtS, reach = double(params.cflAlpha) * minCellM;
   if (params.cflAlpha <= 0 || (maxWaveSpeedMS <= 0 && sourceDepthRateMS <= 0)) return cap;
-  const double k = std::sqrt(double(params.gravityMS2) * std::max(sourceDepthRateMS, 0.0));
-  // W10: dt (S + k sqrt(dt)), or dt sqrt(S^2 + k^2 dt) for the local-inertial scheme (W33), grows
-  // with dt; bisect for where it reaches alpha * min cell.
-  const bool inertial = params.floodScheme == FloodScheme::kLocalInertial;
-  auto travel = [&](double dt) {
-    return inertial ? dt * std::sqrt(maxWaveSpeedMS * maxWaveSpeedMS + k * k * dt)
-                    : dt * (maxWaveSpeedMS + k * std::sqrt(dt));
-  };
+  // W10's travel grows with dt: bisect for where it reaches alpha * min cell.
+  auto travel = [&](double dt) { return stepTravelM(params, maxWaveSpeedMS, sourceDepthRateMS, dt); };
   if (travel(cap) <= reach) return cap;
   double lo = 0.0, hi = cap;
   for (int i = 0; i < 60; ++i) {
@@ -78,6 +72,15 @@ double stepDt(const SimParams& params, double maxWaveSpeedMS, double minCellM, d
     (travel(mid) <= reach ? lo : hi) = mid;
   }
   return lo;
+}
+
+double stepTravelM(const SimParams& params, double maxWaveSpeedMS, double sourceDepthRateMS, double dtS) {
+  const double k = std::sqrt(double(params.gravityMS2) * std::max(sourceDepthRateMS, 0.0));
+  // W10: dt (S + k sqrt(dt)), or dt sqrt(S^2 + k^2 dt) for the local-inertial scheme (W33).
+  if (params.floodScheme == FloodScheme::kLocalInertial) {
+    return dtS * std::sqrt(maxWaveSpeedMS * maxWaveSpeedMS + k * k * dtS);
+  }
+  return dtS * (maxWaveSpeedMS + k * std::sqrt(dtS));
 }
 
 double sourceDepthRate(const SimParams& params, double maxRainRasterMmH, const std::vector<Source>& sources,

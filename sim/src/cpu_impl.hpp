@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <memory>
 #include <new>
+#include <unordered_map>
 #include <vector>
 
 #include <strata/sim/bookkeeping.hpp>
@@ -210,7 +211,7 @@ struct Impl {
   // ---- one step ----
   void step(const std::vector<SourceEntry>& sources, const std::vector<LevelEntry>& levels, float dtS, double endS);
   void planStep(const std::vector<SourceEntry>& sources, const std::vector<LevelEntry>& levels);
-  void finishStep();
+  void finishStep(long long updates);
   void fillRuns(BlockSet& set) const;
   void fillWaterRuns();
   void dilate(std::vector<uint8_t>& on);
@@ -225,6 +226,7 @@ struct Impl {
 
   // ---- passes (cpu_water.cpp) ----
   void sourcesPass(const std::vector<SourceEntry>& entries);
+  void rainPass(const BlockSet& set);                          // W11, W11b on the set's cells
   void pointSources(const std::vector<SourceEntry>& entries);  // W12
   // W11 or W11b can change a cell: rain (uniform or a raster), evaporation or infiltration.
   bool rainOrLosses() const {
@@ -233,12 +235,14 @@ struct Impl {
   void pipeFluxPass();
   void pipeUpdatePass();
   void fvFacePass(const Water& u, bool average);
-  void fvLimitPass();
+  void fvLimitPass() { fvLimitPass(water); }
+  void fvLimitPass(const BlockSet& set);
   void fvDenPass();
   void fvUpdatePass(bool final);
   void tiltRows(int y, int x0, int x1);  // E0 for cells [x0, x1) of row y
   void levelPass(const std::vector<LevelEntry>& entries);
-  void floodStatsPass(float endTimeS);
+  void floodStatsPass(float endTimeS) { floodStatsPass(water, endTimeS); }
+  void floodStatsPass(const BlockSet& set, float endTimeS);
   float maxWaveSpeed() const;
   float outflowLimited(int x, int y) const;  // W25-limited volume rate leaving a cell (m^3/s)
   float fvSedimentEdge(int x, int y, const FaceFlux limited[4]);
@@ -246,8 +250,50 @@ struct Impl {
   // per unit width, fvLimitPass its W25 limits, and flux[0..3] every cell's W, E, N, S face
   // discharges as the last step applied them (the state the next step starts from).
   bool inertial() const { return p.floodScheme == FloodScheme::kLocalInertial; }
-  void inertialFacePass();
-  void inertialUpdatePass();
+  void inertialFacePass() { inertialFacePass(water); }
+  void inertialFacePass(const BlockSet& set);
+  void inertialUpdatePass() { inertialUpdatePass(water); }
+  void inertialUpdatePass(const BlockSet& set);
+  float inertialFaceAt(int x, int y, bool alongX, float q0) const;
+  bool inPlace = false;  // inertialUpdatePass updates now() (W37), not next()
+
+  // ---- local time steps (W37, cpu_local_steps.cpp) ----
+  /// A face between blocks of two levels: it steps with the finer level (cells a, b: the cell west
+  /// or north of it and the cell east or south), and what it carries reaches the coarser cell
+  /// each time the finer cell takes it.
+  struct LevelFace {
+    int x, y;      // cell a
+    bool alongX;   // an x face (b = (x + 1, y)), else a y face (b = (x, y + 1))
+    bool fineIsA;  // a is the finer cell
+    int level;     // the finer cell's
+  };
+  /// A cell beside a finer block: its W25 limit over its own step, the volume it may still give
+  /// through its faces to finer cells, and its faces to finer cells (bits W, E, N, S).
+  struct LevelCell {
+    int x, y, level;
+    float limit, budget;
+    uint8_t finer;
+  };
+  std::vector<uint8_t> blockLevel;  // per block
+  // Per block: max sqrt(g h), the sources' depth rate and the faces' inflow rate (m/s).
+  std::vector<float> blockSpeed, blockRate, blockInflow;
+  std::vector<BlockSet> levelWater, levelRain;  // the water and sources sets' runs of each level
+  std::vector<LevelFace> levelFaces;
+  std::vector<LevelCell> levelCells;
+  // Faces whose flux is integrated over the local steps (Solver::integrateFaces): readFaceMassFlux's
+  // indices, the slot of each, and the volume per unit width through each over the last step.
+  std::vector<size_t> integrated;
+  std::unordered_map<size_t, size_t> integratedSlot;
+  std::vector<double> integratedQdt;
+  double integratedStepS = 0;  // the step they were integrated over (0: none yet)
+  void integrateLevel(int m, float dtLevel);
+  void localStep(const std::vector<SourceEntry>& entries, const std::vector<LevelEntry>& levels, float dtS, double endS,
+                 double rainRateMS);
+  int planLevels(const std::vector<SourceEntry>& entries, float dtS, double rainRateMS);
+  void splitByLevel(const BlockSet& in, std::vector<BlockSet>& out, int levels) const;
+  void spread(std::vector<float>& perBlock) const;
+  void findLevelFaces();
+  int levelOf(int x, int y) const { return blockLevel[size_t((y / kBlock) * bw + x / kBlock)]; }
 
   // ---- passes (cpu_erosion.cpp) ----
   void erosionPass();

@@ -304,6 +304,7 @@ void Impl::fillRuns(BlockSet& set) const {
 // (SimCpu.SkippingQuietBlocksChangesNoBit fails with 1 and 0.) Pipes, erosion's bank failure and
 // the thermal passes after the water keep the 8 cells the blocks gave them (not analysed).
 int Impl::reachCells() const {
+  if (p.localStepLevels > 0) return 1 << p.localStepLevels;  // W37: a step of up to 2^levels of the finest
   if (p.waterModel != WaterModel::kFiniteVolume || p.erosionEnabled || p.thermalEnabled) return kBlock;
   return inertial() ? 1 : 2;
 }
@@ -449,9 +450,10 @@ void Impl::planStep(const std::vector<SourceEntry>& entries, const std::vector<L
   }
 }
 
-// After a step: the quiet and evaporation flags of the blocks that ran (the others did not change).
-void Impl::finishStep() {
-  cellUpdates += (long long)water.cells;
+// After a step that updated `updates` cells: the quiet and evaporation flags of the blocks that ran
+// (the others did not change).
+void Impl::finishStep(long long updates) {
+  cellUpdates += updates;
   dirty = false;
   thermalDirty = false;
   if (!skip) return;
@@ -513,7 +515,7 @@ void Impl::step(const std::vector<SourceEntry>& entries, const std::vector<Level
     std::fill(thermalApply.on.begin(), thermalApply.on.end(), 0);
   }
   if (floodStats) floodStatsPass(float(endS));
-  finishStep();
+  finishStep((long long)water.cells);
 }
 
 }  // namespace cpu
@@ -553,6 +555,16 @@ std::string CpuSolver::backendName() const {
 
 int CpuSolver::threads() const { return impl_->threads; }
 long long CpuSolver::cellUpdates() const { return impl_->cellUpdates; }
+
+void CpuSolver::integrateFaces(const std::vector<size_t>& faces) {
+  Impl& m = *impl_;
+  if (m.p.localStepLevels == 0) return;  // one step applies one flux
+  m.integrated = faces;
+  m.integratedSlot.clear();
+  for (size_t k = 0; k < faces.size(); ++k) m.integratedSlot.emplace(faces[k], k);
+  m.integratedQdt.assign(faces.size(), 0.0);
+  m.integratedStepS = 0;
+}
 
 SolverFactory cpuSolverFactory(const CpuOptions& options) {
   return [options](const SimInput& input, const SimParams& params) -> Result<std::unique_ptr<Solver>> {
@@ -601,11 +613,17 @@ void CpuSolver::runStep(const StepInputs& step) {
   Impl& m = *impl_;
   m.floodStats = floodThresholdM() >= 0;
   m.wetThresholdM = floodThresholdM();
-  if (!m.tune) return m.step(step.sources, step.levels, step.dtS, step.startS + double(step.dtS));
+  auto run = [&] {
+    const double end = step.startS + double(step.dtS);
+    if (m.p.localStepLevels == 0) return m.step(step.sources, step.levels, step.dtS, end);
+    // W10's bound on the rain's depth rate, as sourceDepthRate adds it.
+    m.localStep(step.sources, step.levels, step.dtS, end, (double(m.p.rainMmPerHour) + maxRainRasterMmH()) / 3.6e6);
+  };
+  if (!m.tune) return run();
   m.passThreads = m.tuner.threads();
   const long long before = m.cellUpdates;
   const auto t0 = std::chrono::steady_clock::now();
-  m.step(step.sources, step.levels, step.dtS, step.startS + double(step.dtS));
+  run();
   m.tuner.record(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), m.cellUpdates - before);
 }
 
@@ -906,9 +924,15 @@ void CpuSolver::writeBlock(const CellBlock& b) {
 namespace {
 
 // Flood mode's flux through x face (x, y) or y face (x, y) as the last corrector applied it:
-// scaled by its upwind cell's W25 limit (fvUpdatePass).
+// scaled by its upwind cell's W25 limit (fvUpdatePass). The local-inertial scheme's cells keep the
+// discharges they applied (the same product), which local steps (W37) leave on every face as the
+// last step of its finer cell applied it.
 template <class Impl>
 float appliedFaceFlux(const Impl& m, bool xFace, int x, int y) {
+  if (m.inertial()) {
+    if (xFace) return x < m.w ? m.flux[0].at(x, y) : m.flux[1].at(m.w - 1, y);
+    return y < m.h ? m.flux[2].at(x, y) : m.flux[3].at(x, m.h - 1);
+  }
   const float f = xFace ? m.faceX.mass.at(x, y) : m.faceY.mass.at(x, y);
   const int ux = f > 0.0f ? (xFace ? x - 1 : x) : x, uy = f > 0.0f ? (xFace ? y : y - 1) : y;
   return ux < 0 || uy < 0 || ux >= m.w || uy >= m.h ? f : f * m.limit.at(ux, uy);
@@ -938,7 +962,10 @@ std::vector<float> CpuSolver::readFaceMassFluxAt(const std::vector<size_t>& face
   out.reserve(faces.size());
   for (size_t i : faces) {
     STRATA_CHECK(i < all) << "face " << i << " outside the grid's " << all;
-    if (i < xFaces) {
+    // W37: an integrated face's mean over the last step of local steps.
+    if (const auto slot = m.integratedSlot.find(i); slot != m.integratedSlot.end() && m.integratedStepS > 0) {
+      out.push_back(float(m.integratedQdt[slot->second] / m.integratedStepS));
+    } else if (i < xFaces) {
       out.push_back(appliedFaceFlux(m, true, int(i % size_t(m.w + 1)), int(i / size_t(m.w + 1))));
     } else {
       out.push_back(appliedFaceFlux(m, false, int((i - xFaces) % size_t(m.w)), int((i - xFaces) / size_t(m.w))));

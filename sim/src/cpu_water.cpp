@@ -68,11 +68,12 @@ STRATA_ROW_KERNEL void infiltrationRow(float* h, float* herr, float* sum, float*
 // point_sources.comp (W12). Without rain, evaporation or infiltration W11 and W11b change nothing
 // (adding 0 leaves a settled depth as it is) and are skipped, as the GL backend skips the pass.
 void Impl::sourcesPass(const std::vector<SourceEntry>& entries) {
-  if (!rainOrLosses()) {
-    pointSources(entries);
-    return;
-  }
-  forRuns(sources, [&](const Run& r, int) {
+  if (rainOrLosses()) rainPass(sources);
+  pointSources(entries);
+}
+
+void Impl::rainPass(const BlockSet& set) {
+  forRuns(set, [&](const Run& r, int) {
     const float evapMax = p.evaporationMmPerHour * kMmPerHourToMS * dt;
     for (int y = r.y0; y < r.y1; ++y) {
       float* herr = accum[kAccumDepthError].row(y);
@@ -84,7 +85,6 @@ void Impl::sourcesPass(const std::vector<SourceEntry>& entries) {
       }
     }
   });
-  pointSources(entries);
 }
 
 void Impl::pointSources(const std::vector<SourceEntry>& entries) {
@@ -554,8 +554,8 @@ STRATA_ROW_KERNEL void limitRow(const float* fx, const float* fn, const float* f
 // sim/shaders/fv_limit.comp, W25: after the corrector's faces, the share K = min(1, h A /
 // (outflow dt)) of its outgoing mass fluxes each cell can give without going below zero (as the
 // pipe model's W2), so the corrector never has to clip a depth, which would create water.
-void Impl::fvLimitPass() {
-  forRuns(water, [&](const Run& r, int) {
+void Impl::fvLimitPass(const BlockSet& set) {
+  forRuns(set, [&](const Run& r, int) {
     for (int y = r.y0; y < r.y1; ++y) {
       limitRow(faceX.mass.row(y), faceY.mass.row(y), faceY.mass.row(y + 1), now().h.row(y), limit.row(y), r.x0, r.x1,
                dy, faceWidthY[size_t(y)], faceWidthY[size_t(y) + 1], rowArea[size_t(y)], dt);
@@ -916,8 +916,8 @@ STRATA_ROW_KERNEL void inertialFaceRow(const InertialFaces& r, float* out, int x
 // limits follow in fvLimitPass). Each cell owns its east and south faces, and the west face in
 // column 0 and the north face in row 0, as in fvFacePass; a face owned by an inactive cell is
 // zero and stays so. Reads last step's applied discharges from flux[0..3].
-void Impl::inertialFacePass() {
-  forRuns(water, [&](const Run& r, int) {
+void Impl::inertialFacePass(const BlockSet& set) {
+  forRuns(set, [&](const Run& r, int) {
     const float dtg = dt * p.gravityMS2, dry = p.dryDepthM, n2u = p.manningN * p.manningN;
     const Water& u = now();
     auto n2At = [&](int x, int y) { return manningN2.empty() ? n2u : manningN2.at(x, y); };
@@ -978,6 +978,21 @@ void Impl::inertialFacePass() {
   });
 }
 
+// W30 on the interior face between cell (x, y) and its east (alongX) or south neighbour, from the
+// discharge q0 it carried last: what inertialFacePass computes there (W37 recomputes the faces
+// between blocks of two levels with the finer cell's q0).
+float Impl::inertialFaceAt(int x, int y, bool alongX, float q0) const {
+  const int xb = alongX ? x + 1 : x, yb = alongX ? y : y + 1;
+  const Water& u = now();
+  const float n2u = p.manningN * p.manningN;
+  const float n2 = manningN2.empty() ? n2u : 0.5f * (manningN2.at(x, y) + manningN2.at(xb, yb));
+  // The faces across: north and south of both cells for an x face, west and east for a y face.
+  const int t0 = alongX ? 2 : 0, t1 = alongX ? 3 : 1;
+  const float qt = 0.25f * ((flux[t0].at(x, y) + flux[t1].at(x, y)) + (flux[t0].at(xb, yb) + flux[t1].at(xb, yb)));
+  return inertialFace(q0, qt, bed.at(x, y), u.h.at(x, y), bed.at(xb, yb), u.h.at(xb, yb),
+                      alongX ? rowDx[size_t(y)] : dy, dt * p.gravityMS2, n2, p.dryDepthM);
+}
+
 // One row of the local-inertial update's inputs and outputs.
 struct InertialRow {
   float A, wN, wS, dy, dt;
@@ -1023,14 +1038,16 @@ STRATA_ROW_KERNEL void inertialUpdateRow(const InertialRow& r, int x0, int x1) {
   for (int x = x0; x < x1; ++x) inertialUpdateCell<false>(r, x, true, true, true, true);
 }
 
-// The local-inertial update (W18 with W30's faces, W25 final): the depths into next(), the applied
-// face discharges into flux[0..3], the water leaving through open edges into the outflow sums.
-void Impl::inertialUpdatePass() {
-  forRuns(water, [&](const Run& run, int) {
+// The local-inertial update (W18 with W30's faces, W25 final): the depths into next() (into now()
+// with local steps, W37: the faces and limits were taken before, and a cell reads only its own
+// depth), the applied face discharges into flux[0..3], the water leaving through open edges into
+// the outflow sums.
+void Impl::inertialUpdatePass(const BlockSet& set) {
+  forRuns(set, [&](const Run& run, int) {
     for (int y = run.y0; y < run.y1; ++y) {
       const int yn = std::max(y - 1, 0), ys = std::min(y + 1, h - 1);
       const Water& u = now();
-      Water& o = next();
+      Water& o = inPlace ? now() : next();
       const InertialRow r{rowArea[size_t(y)],
                           faceWidthY[size_t(y)],
                           faceWidthY[size_t(y) + 1],
@@ -1051,7 +1068,7 @@ void Impl::inertialUpdatePass() {
                           flux[2].row(y),
                           flux[3].row(y),
                           accum[kAccumDepthError].row(y)};
-      std::copy(u.s.row(y) + run.x0, u.s.row(y) + run.x1, o.s.row(y) + run.x0);
+      if (!inPlace) std::copy(u.s.row(y) + run.x0, u.s.row(y) + run.x1, o.s.row(y) + run.x0);
       auto edgeCell = [&](int x) {
         const float out = inertialUpdateCell<true>(r, x, x > 0, x<w - 1, y> 0, y < h - 1);
         if (out > 0.0f) kahanAdd(accum[kAccumOutflow].at(x, y), accum[kAccumOutflow + 1].at(x, y), out);
@@ -1102,8 +1119,8 @@ STRATA_ROW_KERNEL void floodStatsRow(const float* h, const float* hu, const floa
 
 // sim/shaders/flood_stats.comp: per cell the deepest water and fastest flow, the end of the
 // first step with depth above the wet threshold, and the time spent above it.
-void Impl::floodStatsPass(float endTimeS) {
-  forRuns(water, [&](const Run& r, int) {
+void Impl::floodStatsPass(const BlockSet& set, float endTimeS) {
+  forRuns(set, [&](const Run& r, int) {
     for (int y = r.y0; y < r.y1; ++y) {
       floodStatsRow(now().h.row(y), now().hu.row(y), now().hv.row(y), flood[0].row(y), flood[1].row(y), flood[2].row(y),
                     flood[3].row(y), r.x0, r.x1, wetThresholdM, p.dryDepthM, dt, endTimeS);

@@ -36,6 +36,15 @@ Status validateParams(const SimParams& p) {
         "finite-volume scheme",
         "floodScheme", "moves water only: erosion and thermal weathering need the finite-volume scheme");
   }
+  if (p.localStepLevels < 0 || p.localStepLevels > kMaxLocalStepLevels) {
+    return failField("sim params: localStepLevels " + std::to_string(p.localStepLevels) + " is not in [0, " +
+                         std::to_string(kMaxLocalStepLevels) + "]",
+                     "localStepLevels", "is not in [0, " + std::to_string(kMaxLocalStepLevels) + "]");
+  }
+  if (p.localStepLevels > 0 && (!inertial || p.cflAlpha <= 0)) {
+    return failField("sim params: local time steps need the local-inertial scheme and an adaptive step (cflAlpha > 0)",
+                     "localStepLevels", "needs the local-inertial scheme and an adaptive step (cflAlpha > 0)");
+  }
   if (p.slopeLimiter != SlopeLimiter::kMinmod && p.slopeLimiter != SlopeLimiter::kMonotonizedCentral) {
     return failField("sim params: slopeLimiter " + std::to_string(int(p.slopeLimiter)) + " is not 0 (minmod) or 1 (MC)",
                      "slopeLimiter", "is not 0 (minmod) or 1 (MC)");
@@ -101,6 +110,7 @@ SimParams runtimeParams(const SimParams& current, const SimParams& next) {
   SimParams p = next;
   p.waterModel = current.waterModel;
   p.floodScheme = current.floodScheme;
+  p.localStepLevels = current.localStepLevels;
   p.diagonalPipes = current.diagonalPipes;
   return p;
 }

@@ -85,7 +85,18 @@ Status Solver::onRainRasterChanged(const gis::Grid<float>& /*mmPerHour*/) {
 
 double Solver::nextDt() {
   if (params_.cflAlpha <= 0) return params_.maxDtS;  // no wave speed needed (a GPU read-back saved)
-  return stepDtWithSources(params_, maxWaveSpeedMS(), maxRainRasterMmH_, sources_, grid_, c_.timeS);
+  const int levels = params_.localStepLevels;
+  if (levels == 0) return stepDtWithSources(params_, maxWaveSpeedMS(), maxRainRasterMmH_, sources_, grid_, c_.timeS);
+  // W37: the grid's step is 2^k of the finest, which W10 bounds for the fastest cell and the
+  // sources' peak over the whole step: k the most levels whose step max_step allows, so that the
+  // finest step is W10's own (a power of two of max_step would take up to twice the steps).
+  const double speed = maxWaveSpeedMS();
+  const double window = double(1 << levels) * stepDt(params_, speed, grid_.minCellM);
+  const double rate = sourceDepthRate(params_, maxRainRasterMmH_, sources_, grid_, c_.timeS, c_.timeS + window);
+  const double fine = stepDt(params_, speed, grid_.minCellM, rate);
+  int k = levels;
+  while (k > 0 && fine * double(1 << k) > double(params_.maxDtS)) --k;
+  return fine * double(1 << k);
 }
 
 double Solver::sourceDepthRateMS(double t1S) const {

@@ -18,6 +18,7 @@ Result<TiledSolver> TiledSolver::create(const SimInput& input, const SimParams& 
   if (options.tileWidth < 2 || options.tileHeight < 2 || options.halo < 1) {
     return fail("tiles: tileWidth and tileHeight must be >= 2 and halo >= 1");
   }
+  if (params.localStepLevels > 0) return fail(kLocalStepsOnTheCpuOnly);
   TiledSolver t(input, params, options);
   const int width = input.baseM.width, height = input.baseM.height;
   t.tilesX_ = (width + options.tileWidth - 1) / options.tileWidth;

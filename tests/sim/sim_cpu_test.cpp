@@ -88,6 +88,14 @@ SimParams inertialCase() {
   return p;
 }
 
+// W37: the same with local time steps (the spring's block at the finest level, the valley's
+// shallower water at coarser ones).
+SimParams localStepsCase() {
+  SimParams p = inertialCase();
+  p.localStepLevels = kMaxLocalStepLevels;
+  return p;
+}
+
 SimParams erosionCase(bool diagonal) {
   SimParams p = test::erosionParams();
   p.rainMmPerHour = 0.0f;  // the raster's patch only: most blocks stay dry
@@ -159,6 +167,7 @@ std::vector<Case> cases() {
   return {{"flood", floodCase(), 80},
           {"flood, MC limiter, open west edge", floodCaseMC(), 80},
           {"local inertial", inertialCase(), 80},
+          {"local inertial, local steps", localStepsCase(), 20},
           {"pipes + erosion + thermal", erosionCase(false), 150},
           {"diagonal pipes + erosion + thermal", erosionCase(true), 150}};
 }

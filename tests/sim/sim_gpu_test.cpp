@@ -469,6 +469,18 @@ TEST_F(GlTest, SimFloodAgreesWithCpuReference) {
 
 // The local-inertial scheme (W30-W33) on both backends: the dam break in the sloshing box with a
 // roughness map and an open edge, and the flat-floodplain flood at 40 m cells with its breach.
+// W37: local time steps are the CPU backend's; the GL backend, which takes one step for the whole
+// grid, refuses them rather than ignore them.
+TEST_F(GlTest, SimRefusesLocalSteps) {
+  auto p = floodParams();
+  p.floodScheme = strata::sim::FloodScheme::kLocalInertial;
+  p.cflAlpha = 0.7f;
+  p.localStepLevels = 2;
+  auto gl = strata::sim::GlSolver::create(test::sloshingBox(16), p);
+  ASSERT_FALSE(gl);
+  EXPECT_NE(gl.message().find("CPU backend only"), std::string::npos) << gl.message();
+}
+
 TEST_F(GlTest, SimInertialAgreesWithCpuReference) {
   auto in = test::sloshingBox(32);
   for (int y = 0; y < 32; ++y) {

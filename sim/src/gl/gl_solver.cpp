@@ -436,6 +436,7 @@ GlSolver::~GlSolver() = default;
 
 Result<GlSolver> GlSolver::create(const SimInput& input, const SimParams& params) {
   STRATA_TRY_STATUS(validate(input, params));
+  if (params.localStepLevels > 0) return fail(kLocalStepsOnTheCpuOnly);
   auto impl = std::make_unique<Impl>();
   Impl& s = *impl;
   const CellGrid grid = CellGrid::of(input);

@@ -486,6 +486,7 @@ Result<DistributedSolver> DistributedSolver::create(const RegionSource& region, 
   // Checks that fail alike on every rank (the same arguments everywhere): no collective needed.
   STRATA_TRY_STATUS(checkRegionSource(region));
   STRATA_TRY_STATUS(validateParams(params));
+  if (params.localStepLevels > 0) return fail(kLocalStepsOnTheCpuOnly);
   if (options.halo < 1 || options.blocksPerRank < 1 || options.blockWidth < 0 || options.blockHeight < 0 ||
       !(options.idleWeight > 0) || !(options.rebalanceAbove >= 1) || options.rebalanceEvery < 0) {
     return fail(

@@ -46,6 +46,10 @@ std::vector<SourceEntry> mergeSources(const std::vector<Source>& sources, int wi
 /// its step is the longest with dt * sqrt(S^2 + g r dt) <= alpha * minCellM.
 double stepDt(const SimParams& params, double maxWaveSpeedMS, double minCellM, double sourceDepthRateMS = 0.0);
 
+/// How far (m) W10's (W33's) bound lets a wave travel in a step of dtS: stepDt's longest step is
+/// the one where this reaches alpha * minCellM. Local time steps (W37) test each block's with it.
+double stepTravelM(const SimParams& params, double maxWaveSpeedMS, double sourceDepthRateMS, double dtS);
+
 /// Bound on the depth per second (m/s) rain and sources add to any one cell over [t0S, t1S]:
 /// max over cells of the uniform rain, plus `maxRainRasterMmH`, plus the sum of the peak
 /// discharges over the window of the sources feeding the cell divided by its area. Any step

@@ -42,6 +42,7 @@ class CpuSolver final : public Solver {
   void writeBlock(const CellBlock& block) override;
   std::vector<float> readFaceMassFlux() const override;
   std::vector<float> readFaceMassFluxAt(const std::vector<size_t>& faces) const override;
+  void integrateFaces(const std::vector<size_t>& faces) override;
 
   /// The OpenMP threads the passes run on.
   int threads() const;

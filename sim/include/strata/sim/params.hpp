@@ -52,15 +52,29 @@ enum class ErosionLaw : int32_t {
 /// a closed one is a wall.
 enum EdgeBits : uint32_t { kEdgeWest = 1u, kEdgeEast = 2u, kEdgeNorth = 4u, kEdgeSouth = 8u };
 
+/// The most levels of local time steps (W37): blocks step at up to 2^3 = 8 times the finest step
+/// (more levels saved nothing on the Environment Agency's test 4, docs/sim-water.md).
+constexpr int kMaxLocalStepLevels = 3;
+
+/// What a backend other than the CPU's says to localStepLevels > 0: its steps are the grid's.
+inline constexpr const char* kLocalStepsOnTheCpuOnly =
+    "sim params: local time steps (localStepLevels) run on the CPU backend only; this backend takes one step for the "
+    "whole grid";
+
 /// The model and its constants. setParams() may change any of them mid-run but the water model,
-/// the flood scheme and diagonal pipes, which decide what the solver allocates.
+/// the flood scheme, local steps and diagonal pipes, which decide what the solver allocates.
 struct SimParams {
   WaterModel waterModel = WaterModel::kVirtualPipes;
   FloodScheme floodScheme = FloodScheme::kFiniteVolume;  ///< flood mode's scheme (fixed at creation)
-  SlopeLimiter slopeLimiter = SlopeLimiter::kMinmod;     ///< flood mode's W21 slopes
-  uint32_t openEdges = 0;                                ///< EdgeBits; 0 = closed box
-  bool erosionEnabled = false;                           ///< erosion, deposition, dissolution and transport (E1-E6)
-  bool thermalEnabled = false;                           ///< weathering of slopes and bank failure (E7-E8)
+  /// Local time steps (W37; the local-inertial scheme on the CPU backend, fixed at creation): each
+  /// block of cells steps at dt, 2 dt, ... 2^localStepLevels dt as its own CFL bound allows, the
+  /// grid's step being the longest. 0: one step for the whole grid (the default); at most
+  /// kMaxLocalStepLevels.
+  int localStepLevels = 0;
+  SlopeLimiter slopeLimiter = SlopeLimiter::kMinmod;  ///< flood mode's W21 slopes
+  uint32_t openEdges = 0;                             ///< EdgeBits; 0 = closed box
+  bool erosionEnabled = false;                        ///< erosion, deposition, dissolution and transport (E1-E6)
+  bool thermalEnabled = false;                        ///< weathering of slopes and bank failure (E7-E8)
   bool diagonalPipes = false;         ///< pipes model with 8 pipes (diagonals too), no axis-aligned gullies (W1b)
   float gravityMS2 = 9.81f;           ///< g (m/s^2)
   float maxDtS = 0.05f;               ///< fixed step, or the upper bound of the adaptive one (s)
@@ -88,8 +102,8 @@ struct SimParams {
 /// parameter and the problem.
 Status validateParams(const SimParams& params);
 
-/// `next` with what is fixed at creation (water model, flood scheme, diagonal pipes) taken from `current`: what
-/// setParams() applies mid-run.
+/// `next` with what is fixed at creation (water model, flood scheme, local steps, diagonal pipes)
+/// taken from `current`: what setParams() applies mid-run.
 SimParams runtimeParams(const SimParams& current, const SimParams& next);
 
 }  // namespace strata::sim

@@ -301,6 +301,11 @@ class Solver {
   /// a cross-section sums after every step. By default picked from the whole vector; a backend
   /// that can read single faces cheaply reads only those.
   virtual std::vector<float> readFaceMassFluxAt(const std::vector<size_t>& faces) const;
+  /// The faces (indices as above) whose flux a caller integrates over the steps, as a
+  /// cross-section does: a backend whose step is made of shorter ones (local time steps, W37)
+  /// then gives at these faces the mean over its last step, so that flux times step is the volume
+  /// that crossed. By default nothing to do (one step applies one flux).
+  virtual void integrateFaces(const std::vector<size_t>& faces) { (void)faces; }
 
  protected:
   /// Sets up the shared bookkeeping from a validated input.
