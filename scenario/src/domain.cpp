@@ -1226,6 +1226,7 @@ sim::SimParams modelParams(const Scenario& s) {
   sim::SimParams p;
   p.waterModel = s.model.kind;
   p.floodScheme = s.model.inertial ? sim::FloodScheme::kLocalInertial : sim::FloodScheme::kFiniteVolume;
+  p.localStepLevels = s.model.localSteps ? sim::kMaxLocalStepLevels : 0;
   p.cflAlpha = float(s.model.cfl);
   // The CFL step (W10) is capped (docs/scenario.md, max_step).
   p.maxDtS = float(s.model.maxStepS);

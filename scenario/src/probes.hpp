@@ -23,6 +23,8 @@ class Probes {
   bool empty() const { return gauges_.empty() && sections_.empty(); }
   /// The next time a row is due (s).
   double nextRowS() const { return nextRowS_; }
+  /// The sections' faces, numbered as Solver::readFaceMassFlux numbers them.
+  const std::vector<size_t>& faceIndices() const { return faceIndices_; }
   /// After a step of `dtS` (flood mode; the run's clock, not the spin-up's).
   void afterStep(const sim::Solver& solver, double dtS);
   /// Writes the row of the solver's time (once it has reached nextRowS()).

@@ -272,8 +272,12 @@ Status writeReport(const fs::path& runDir, const ReportInput& in) {
         " m |\n";
   md += std::string("| model | ") +
         (s.model.kind == sim::WaterModel::kFiniteVolume
-             ? (s.model.inertial ? "flood mode (local-inertial shallow water, Bates et al. 2010, Manning friction)"
-                                 : "flood mode (finite-volume shallow water, Manning friction)")
+             ? (s.model.inertial
+                    ? (s.model.localSteps ? "flood mode (local-inertial shallow water, Bates et al. 2010, Manning "
+                                            "friction; local time steps, W37)"
+                                          : "flood mode (local-inertial shallow water, Bates et al. 2010, Manning "
+                                            "friction)")
+                    : "flood mode (finite-volume shallow water, Manning friction)")
              : "virtual pipes: an interactive authoring model without friction, whose depths and speeds depend on "
                "the pipe area and the time step and are not physical (kind = \"flood\" for analysis, "
                "docs/sim-water.md)") +

@@ -344,6 +344,7 @@ class Run {
   Status startProbes(const std::vector<double>* saved) {
     if (d_.gauges.empty() && d_.sections.empty()) return {};
     probes_.emplace(d_, solver().grid(), s_.outputs.probeIntervalS);
+    solver().integrateFaces(probes_->faceIndices());  // each step's volume through them (W37)
     if (saved) return probes_->restore(*saved);
     probes_->row(solver());
     return {};
@@ -1041,7 +1042,15 @@ class Session {
                   "rain frames do not reach MPI ranks yet (each rank's blocks would need their windows of every "
                   "frame): run this scenario in one process");
     }
-    STRATA_TRY(engine_, startContext(opt_.backend.value_or(s_.model.backend), opt_.pictures, ranks_));
+    // Local time steps run on the CPU backend in one process: `auto` takes it.
+    Backend backend = opt_.backend.value_or(s_.model.backend);
+    if (s_.model.localSteps && (backend == Backend::kGpu || ranks_.distributed())) {
+      return fail(s_.at("model.local_steps") +
+                  "local time steps run on the CPU backend in one process (the GPU backend and MPI ranks take one "
+                  "step for the whole grid): leave them out or run with the CPU backend in one process");
+    }
+    if (s_.model.localSteps) backend = Backend::kCpu;
+    STRATA_TRY(engine_, startContext(backend, opt_.pictures, ranks_));
     std::optional<detail::RowsBuilt> rows;
     if (ranks_.distributed()) {
       auto planned =

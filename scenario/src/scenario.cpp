@@ -466,8 +466,8 @@ Status readModel(const Reader& r, const toml::table& root, Scenario& s) {
   const auto* t = root["model"].as_table();
   if (!t) return {};
   STRATA_TRY_STATUS(r.onlyKeys(*t, "model",
-                               {"kind", "scheme", "manning_n", "manning_raster", "land_cover", "cfl", "max_step",
-                                "slopes", "boundary", "backend"}));
+                               {"kind", "scheme", "local_steps", "manning_n", "manning_raster", "land_cover", "cfl",
+                                "max_step", "slopes", "boundary", "backend"}));
   if (const auto* m = t->get("manning_raster")) {
     STRATA_TRY(auto path, r.string(*m, "model.manning_raster"));
     s.model.manningRaster = r.path(path);
@@ -526,6 +526,16 @@ Status readModel(const Reader& r, const toml::table& root, Scenario& s) {
     auto backend = parseBackend(v);
     if (!backend) return r.error(*b, "model.backend", backend.message());
     s.model.backend = *backend;
+  }
+  if (const auto* l = t->get("local_steps")) {
+    STRATA_TRY(s.model.localSteps, r.boolean(*l, "model.local_steps"));
+    if (s.model.localSteps && !s.model.inertial) {
+      return r.error(*l, "model.local_steps", "local time steps need scheme = \"inertial\"");
+    }
+    if (s.model.localSteps && s.model.backend == Backend::kGpu) {
+      return r.error(*l, "model.local_steps",
+                     "local time steps run on the CPU backend; backend = \"gpu\" takes one step for the whole grid");
+    }
   }
   if (const auto* n = t->get("manning_n")) {
     STRATA_TRY(s.model.manningN, r.number(*n, "model.manning_n"));

@@ -127,6 +127,12 @@ INSTANTIATE_TEST_SUITE_P(
                 "\"diffusive\""},
         BadCase{"a scheme for the pipe model", "kind = \"flood\"", "kind = \"pipe\"\nscheme = \"inertial\"",
                 "/data/runs/gc.toml:11: key 'model.scheme': is flood mode's choice; kind = \"pipe\" has no scheme"},
+        BadCase{"local steps with finite volumes", "manning_n = 0.035", "manning_n = 0.035\nlocal_steps = true",
+                "/data/runs/gc.toml:12: key 'model.local_steps': local time steps need scheme = \"inertial\""},
+        BadCase{"local steps on the GPU", "manning_n = 0.035",
+                "manning_n = 0.035\nscheme = \"inertial\"\nbackend = \"gpu\"\nlocal_steps = true",
+                "/data/runs/gc.toml:14: key 'model.local_steps': local time steps run on the CPU backend; backend = "
+                "\"gpu\" takes one step for the whole grid"},
         BadCase{"finite volumes above CFL 0.5", "manning_n = 0.035", "manning_n = 0.035\ncfl = 0.7",
                 "/data/runs/gc.toml:12: key 'model.cfl': flood mode needs cfl <= 0.5 (positivity of the "
                 "finite-volume scheme)"},

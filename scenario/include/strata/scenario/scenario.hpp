@@ -145,6 +145,9 @@ struct Scenario {
     std::map<long long, double> landCoverManning;  ///< class code -> n
     /// Flood mode's scheme: the local-inertial one (W30-W33) instead of finite volumes.
     bool inertial = false;
+    /// Local time steps (W37): the local-inertial scheme's blocks step as their own CFL bound
+    /// allows, on the CPU backend in one process.
+    bool localSteps = false;
     double cfl = 0.45;         ///< finite volumes need <= 0.5 (positivity); the local-inertial default is 0.7
     double maxStepS = 30.0;    ///< cap on the adaptive step (s); see docs/scenario.md
     bool sharpSlopes = false;  ///< flood mode: MC slopes instead of minmod (W21); see docs/sim-water.md
