@@ -1,6 +1,7 @@
 #!/usr/bin/python3
 """The flat-floodplain flood after the Environment Agency's benchmark test 4 as a user runs it:
-`strata flood` on a GeoTIFF plain, both flood schemes, whole-process wall time.
+`strata flood` on a GeoTIFF plain, both flood schemes (and the local-inertial one with local time
+steps, `inertial_local`), whole-process wall time.
 
 Writes into OUT (a new folder): plain_<cell>m.tif (flat, 2000 x 1000 m, EPSG:27700, elevation
 0), <scheme>_<cell>m.toml (Manning 0.05, closed edges, the 20 m breach in the middle of the west
@@ -9,7 +10,8 @@ pictures or plots) and a run folder per scenario; runs each scheme ROUNDS times,
 one warm-up run each, and prints the best and median wall times and the report's step counts.
 With --rounds 0 each scheme runs once (no warm-up): for the large grids.
 
-    bench/flat_plain.py OUT [--cell 20] [--rounds 3] [--hours 5] [--schemes finite_volume,inertial]
+    bench/flat_plain.py OUT [--cell 20] [--rounds 3] [--hours 5]
+                            [--schemes finite_volume,inertial,inertial_local]
                             [--strata build/apps/strata]
 """
 import argparse
@@ -56,7 +58,8 @@ def write_scenario(path, dem, scheme, cell, hours=5):
 dem = "{os.path.basename(dem)}"
 [model]
 kind = "flood"
-scheme = "{scheme}"
+scheme = "{scheme.removesuffix('_local')}"
+local_steps = {'true' if scheme.endswith('_local') else 'false'}
 manning_n = 0.05
 boundary = "closed"
 backend = "cpu"
@@ -97,8 +100,8 @@ def main():
     ap.add_argument("--strata", default=os.path.join(os.path.dirname(__file__), "..", "build", "apps", "strata"))
     a = ap.parse_args()
     schemes = a.schemes.split(",")
-    if any(s not in ("finite_volume", "inertial") for s in schemes):
-        sys.exit(f"flat_plain.py: --schemes: finite_volume and/or inertial, got '{a.schemes}'")
+    if any(s not in ("finite_volume", "inertial", "inertial_local") for s in schemes):
+        sys.exit(f"flat_plain.py: --schemes: finite_volume, inertial and/or inertial_local, got '{a.schemes}'")
     if not a.hours > 0 or a.rounds < 0:
         sys.exit("flat_plain.py: --hours must be > 0 and --rounds >= 0")
     if os.path.exists(a.out):
