@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <memory>
 #include <new>
+#include <span>
 #include <unordered_map>
 #include <vector>
 
@@ -196,6 +197,10 @@ struct Impl {
   const Water& now() const { return state[cur]; }
   Water& next() { return state[1 - cur]; }
   size_t cells() const { return size_t(w) * size_t(h); }
+  /// The block of a row-major cell index.
+  size_t blockOf(uint32_t cell) const {
+    return size_t(int(cell / uint32_t(w)) / kBlock * bw + int(cell % uint32_t(w)) / kBlock);
+  }
   float bedOf(int x, int y) const;
   void recomputeBed(int x, int y);
 
@@ -226,8 +231,8 @@ struct Impl {
 
   // ---- passes (cpu_water.cpp) ----
   void sourcesPass(const std::vector<SourceEntry>& entries);
-  void rainPass(const BlockSet& set);                          // W11, W11b on the set's cells
-  void pointSources(const std::vector<SourceEntry>& entries);  // W12
+  void rainPass(const BlockSet& set);                       // W11, W11b on the set's cells
+  void pointSources(std::span<const SourceEntry> entries);  // W12
   // W11 or W11b can change a cell: rain (uniform or a raster), evaporation or infiltration.
   bool rainOrLosses() const {
     return p.rainMmPerHour != 0.0f || !rain.empty() || p.evaporationMmPerHour != 0.0f || !infilKs.empty();
@@ -240,7 +245,7 @@ struct Impl {
   void fvDenPass();
   void fvUpdatePass(bool final);
   void tiltRows(int y, int x0, int x1);  // E0 for cells [x0, x1) of row y
-  void levelPass(const std::vector<LevelEntry>& entries);
+  void levelPass(std::span<const LevelEntry> entries);
   void floodStatsPass(float endTimeS) { floodStatsPass(water, endTimeS); }
   void floodStatsPass(const BlockSet& set, float endTimeS);
   float maxWaveSpeed() const;
@@ -280,9 +285,14 @@ struct Impl {
   std::vector<BlockSet> levelWater, levelRain;  // the water and sources sets' runs of each level
   std::vector<LevelFace> levelFaces;
   std::vector<LevelCell> levelCells;
-  // Faces whose flux is integrated over the local steps (Solver::integrateFaces): readFaceMassFlux's
-  // indices, the slot of each, and the volume per unit width through each over the last step.
-  std::vector<size_t> integrated;
+  // Faces whose flux is integrated over the local steps (Solver::integrateFaces): each one's cells
+  // a (west / north) and b (east / south), either outside the grid at an edge; the slot of each
+  // of readFaceMassFlux's indices; the volume per unit width through each over the last step.
+  struct IntegratedFace {
+    int xa, ya, xb, yb;
+    bool alongX, hasA, hasB;
+  };
+  std::vector<IntegratedFace> integrated;
   std::unordered_map<size_t, size_t> integratedSlot;
   std::vector<double> integratedQdt;
   double integratedStepS = 0;  // the step they were integrated over (0: none yet)
@@ -294,6 +304,7 @@ struct Impl {
   void spread(std::vector<float>& perBlock) const;
   void findLevelFaces();
   int levelOf(int x, int y) const { return blockLevel[size_t((y / kBlock) * bw + x / kBlock)]; }
+  int levelOf(uint32_t cell) const { return blockLevel[blockOf(cell)]; }
 
   // ---- passes (cpu_erosion.cpp) ----
   void erosionPass();

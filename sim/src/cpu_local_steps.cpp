@@ -75,9 +75,8 @@ int Impl::planLevels(const std::vector<SourceEntry>& entries, float dtS, double 
     blockInflow[size_t(b)] = inflow;
   }
   for (const auto& e : entries) {
-    const int y = int(e.cell / uint32_t(w)), x = int(e.cell % uint32_t(w));
-    float& r = blockRate[size_t((y / kBlock) * bw + x / kBlock)];
-    r = std::max(r, float(rainRateMS + double(e.rateM3S) / double(rowArea[size_t(y)])));
+    float& r = blockRate[blockOf(e.cell)];
+    r = std::max(r, float(rainRateMS + double(e.rateM3S) / double(rowArea[size_t(e.cell / uint32_t(w))])));
   }
   // A block takes the fastest speed and rate of the blocks around it as well: water from a
   // neighbour can cross a whole block (kBlock cells) in the grid's step at most (one cell a finest
@@ -111,10 +110,7 @@ int Impl::planLevels(const std::vector<SourceEntry>& entries, float dtS, double 
     while (m > 0 && !fits(b, double(dtS) / double(1 << (levels - m)), true)) --m;
     blockLevel[size_t(b)] = uint8_t(m);
   }
-  for (const auto& e : entries) {
-    const int y = int(e.cell / uint32_t(w)), x = int(e.cell % uint32_t(w));
-    blockLevel[size_t((y / kBlock) * bw + x / kBlock)] = 0;
-  }
+  for (const auto& e : entries) blockLevel[blockOf(e.cell)] = 0;
   auto lower = [&](int b, int n) {
     blockLevel[size_t(b)] = uint8_t(std::min(int(blockLevel[size_t(b)]), int(blockLevel[size_t(n)]) + 1));
   };
@@ -201,19 +197,11 @@ void Impl::findLevelFaces() {
 // step, if the face steps with level m (the finer of its cells'; the finer cell's discharge is the
 // face's, W37).
 void Impl::integrateLevel(int m, float dtLevel) {
-  const size_t xFaces = size_t(w + 1) * size_t(h);
   for (size_t k = 0; k < integrated.size(); ++k) {
-    const size_t i = integrated[k];
-    const bool alongX = i < xFaces;
-    const size_t j = alongX ? i : i - xFaces;
-    // Cells a (west / north) and b (east / south) of the face, either outside at an edge.
-    const int x = alongX ? int(j % size_t(w + 1)) : int(j % size_t(w));
-    const int y = alongX ? int(j / size_t(w + 1)) : int(j / size_t(w));
-    const int xa = alongX ? x - 1 : x, ya = alongX ? y : y - 1;
-    const bool hasA = xa >= 0 && ya >= 0, hasB = x < w && y < h;
-    const int la = hasA ? levelOf(xa, ya) : 255, lb = hasB ? levelOf(x, y) : 255;
+    const IntegratedFace& f = integrated[k];
+    const int la = f.hasA ? levelOf(f.xa, f.ya) : 255, lb = f.hasB ? levelOf(f.xb, f.yb) : 255;
     if (std::min(la, lb) != m) continue;
-    const float q = la <= lb ? flux[alongX ? 1 : 3].at(xa, ya) : flux[alongX ? 0 : 2].at(x, y);
+    const float q = la <= lb ? flux[f.alongX ? 1 : 3].at(f.xa, f.ya) : flux[f.alongX ? 0 : 2].at(f.xb, f.yb);
     integratedQdt[k] += double(q) * double(dtLevel);
   }
 }
@@ -270,9 +258,7 @@ void Impl::localStep(const std::vector<SourceEntry>& entries, const std::vector<
       dt = dtOf(m);
       if (rains) rainPass(levelRain[size_t(m)]);
       for (const auto& e : entries) {
-        const int y = int(e.cell / uint32_t(w)), x = int(e.cell % uint32_t(w));
-        if (levelOf(x, y) == m)
-          addDepth(u.h.at(x, y), accum[kAccumDepthError].at(x, y), e.rateM3S * dt / rowArea[size_t(y)]);
+        if (levelOf(e.cell) == m) pointSources({&e, 1});
       }
       inertialFacePass(levelWater[size_t(m)]);
     }
@@ -321,7 +307,7 @@ void Impl::localStep(const std::vector<SourceEntry>& entries, const std::vector<
       inertialUpdatePass(levelWater[size_t(m)]);
       updates += (long long)levelWater[size_t(m)].cells;
       for (const auto& e : levels) {
-        if (levelOf(int(e.cell % uint32_t(w)), int(e.cell / uint32_t(w))) == m) levelPass({&e, &e + 1});
+        if (levelOf(e.cell) == m) levelPass({&e, 1});
       }
       // What the finer cells just applied through faces to coarser cells reaches those: the
       // same float term W34 added to the finer cell's depth (on rows of equal area).

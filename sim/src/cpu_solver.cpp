@@ -384,9 +384,6 @@ void Impl::planStep(const std::vector<SourceEntry>& entries, const std::vector<L
   std::vector<uint8_t>& busy = sources.on;
   const bool rainEverywhere = p.rainMmPerHour != 0.0f;
   for (size_t b = 0; b < blocks; ++b) busy[b] = !quiet(b) || rainBlock[b] || rainEverywhere;
-  auto blockOf = [&](uint32_t cell) {
-    return size_t(int(cell / uint32_t(w)) / kBlock * bw + int(cell % uint32_t(w)) / kBlock);
-  };
   for (const auto& e : entries) busy[blockOf(e.cell)] = 1;
   for (const auto& e : levels) busy[blockOf(e.cell)] = 1;
   // Last step's marks are cleared where they were (row spans), this step's made.
@@ -559,9 +556,18 @@ long long CpuSolver::cellUpdates() const { return impl_->cellUpdates; }
 void CpuSolver::integrateFaces(const std::vector<size_t>& faces) {
   Impl& m = *impl_;
   if (m.p.localStepLevels == 0) return;  // one step applies one flux
-  m.integrated = faces;
+  const size_t xFaces = size_t(m.w + 1) * size_t(m.h);
+  m.integrated.clear();
   m.integratedSlot.clear();
-  for (size_t k = 0; k < faces.size(); ++k) m.integratedSlot.emplace(faces[k], k);
+  for (size_t k = 0; k < faces.size(); ++k) {
+    const size_t i = faces[k];
+    const bool alongX = i < xFaces;
+    const size_t j = alongX ? i : i - xFaces, across = size_t(alongX ? m.w + 1 : m.w);
+    const int x = int(j % across), y = int(j / across);  // cell b's, and the face's, position
+    const int xa = alongX ? x - 1 : x, ya = alongX ? y : y - 1;
+    m.integrated.push_back({xa, ya, x, y, alongX, xa >= 0 && ya >= 0, x < m.w && y < m.h});
+    m.integratedSlot.emplace(i, k);
+  }
   m.integratedQdt.assign(faces.size(), 0.0);
   m.integratedStepS = 0;
 }

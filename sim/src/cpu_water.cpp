@@ -87,7 +87,7 @@ void Impl::rainPass(const BlockSet& set) {
   });
 }
 
-void Impl::pointSources(const std::vector<SourceEntry>& entries) {
+void Impl::pointSources(std::span<const SourceEntry> entries) {
   for (const auto& e : entries) {
     const int y = int(e.cell / uint32_t(w)), x = int(e.cell % uint32_t(w));
     addDepth(now().h.at(x, y), accum[kAccumDepthError].at(x, y), e.rateM3S * dt / rowArea[size_t(y)]);
@@ -1086,7 +1086,7 @@ void Impl::inertialUpdatePass(const BlockSet& set) {
 // water update, before erosion, so every output shows them held): depth max(0, stage - bed),
 // the discharge scaled with the depth (the velocity kept), the volume put in (< 0: taken out)
 // summed per cell with compensation (slot 6).
-void Impl::levelPass(const std::vector<LevelEntry>& entries) {
+void Impl::levelPass(std::span<const LevelEntry> entries) {
   Water& u = now();
   for (const auto& e : entries) {
     const int y = int(e.cell / uint32_t(w)), x = int(e.cell % uint32_t(w));
