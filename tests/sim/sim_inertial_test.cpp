@@ -148,7 +148,6 @@ struct PlainRun {
   std::vector<std::vector<double>> gauges;  // per gauge, the depth every 5 minutes
   long long steps = 0, updates = 0;
   double seconds = 0, balance = 0, stored = 0;
-  float shallowest = 0;  // the least depth any cell had at the 5-minute reads
   gis::Grid<float> maxDepth;
 };
 
@@ -167,7 +166,6 @@ PlainRun runPlain(double cellM, FloodScheme scheme, int localStepLevels = 0, dou
   for (int k = 1; k <= int(seconds / 300.0); ++k) {
     sim->advance(300.0);
     const auto h = sim->readWaterDepth();
-    r.shallowest = std::min(r.shallowest, *std::min_element(h.data.begin(), h.data.end()));
     for (size_t g = 0; g < plain.gauges.size(); ++g) {
       r.gauges[g].push_back(h.at(plain.gauges[g].first, plain.gauges[g].second));
     }
@@ -215,7 +213,7 @@ TEST(SimInertialCpu, FlatPlainFloodAgreesWithTheFiniteVolumeScheme) {
 }
 
 // W37, issue 35 item 3: local time steps on the plain give one step for the grid's answer: the
-// gauges within 0.01 m RMS of it, the same flooded cells, no depth below 0, every drop kept; and at
+// gauges within 0.01 m RMS of it, the same flooded cells, every drop kept; and at
 // 10 m cells with fewer cell updates (at 20 m the plain's 13 x 7 blocks leave too few to step
 // slower: measured 0.95x). The deepest water differs most at the breach's cells, whose peak
 // depends on the step with one step for the grid too (0.139 / 0.194 / 0.245 m at 1,200 s with steps
@@ -241,8 +239,9 @@ TEST(SimLocalStepsCpu, FlatPlainAgreesWithOneStepForTheGrid) {
           double(both) / double(either), loc.balance);
       EXPECT_LT(worst, 0.01) << cell << " m, " << levels;
       EXPECT_GT(double(both) / double(either), 0.995) << cell << " m, " << levels;
+      // W34 settles a depth below 0 at 0, which would make water: the balance is what shows that
+      // W25's budget over a coarser cell's step let none go below.
       EXPECT_LT(loc.balance, 1e-6) << cell << " m, " << levels;
-      EXPECT_GE(loc.shallowest, 0.0f);
       if (cell == 10.0) {
         EXPECT_GT(ratio, 1.05) << levels;  // measured 1.10 (1 level: 1.14)
       }
