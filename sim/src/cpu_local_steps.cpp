@@ -207,9 +207,9 @@ void Impl::integrateLevel(int m, float dtLevel) {
 }
 
 // One step of dtS in local steps (docs/sim-water.md, "Local time steps"). Substep i of the finest
-// step dt runs, for each level m whose step starts at i (i a multiple of 2^m): the sources, faces
-// and limits of its cells over 2^m dt; the faces between levels with the finer cell's step and its
-// q0; the limits of the coarser cells beside them (what they may still give); then, for each
+// step dt runs, for each level m whose step starts at i (i a multiple of 2^m): the faces of its
+// cells over 2^m dt; the faces between levels with the finer cell's step and its q0; the sources
+// and limits of its cells (W38); the limits of the coarser cells beside them (what they may still give); then, for each
 // level whose step ends at i, finest first, the update of its cells, its fixed levels (W26) and
 // flood statistics. The update writes the state in place (no ping-pong: a cell whose step has not
 // ended is read where it is).
@@ -252,14 +252,11 @@ void Impl::localStep(const std::vector<SourceEntry>& entries, const std::vector<
   for (int i = 0; i < substeps; ++i) {
     auto starts = [&](int m) { return i % (1 << m) == 0; };
     auto ends = [&](int m) { return (i + 1) % (1 << m) == 0; };
-    // Sources, faces and limits of the levels starting a step.
+    // Faces, then sources (W38: after the faces, before the limits), then limits of the levels
+    // starting a step.
     for (int m = 0; m <= M; ++m) {
       if (!starts(m)) continue;
       dt = dtOf(m);
-      if (rains) rainPass(levelRain[size_t(m)]);
-      for (const auto& e : entries) {
-        if (levelOf(e.cell) == m) pointSources({&e, 1});
-      }
       inertialFacePass(levelWater[size_t(m)]);
     }
     for (const auto& f : levelFaces) {
@@ -270,6 +267,10 @@ void Impl::localStep(const std::vector<SourceEntry>& entries, const std::vector<
     for (int m = 0; m <= M; ++m) {
       if (!starts(m)) continue;
       dt = dtOf(m);
+      if (rains) rainPass(levelRain[size_t(m)]);
+      for (const auto& e : entries) {
+        if (levelOf(e.cell) == m) pointSources({&e, 1});
+      }
       fvLimitPass(levelWater[size_t(m)]);
     }
     // W25 over a coarser cell's whole step: at its start its limit K from all its faces (those to

@@ -478,12 +478,13 @@ void Impl::step(const std::vector<SourceEntry>& entries, const std::vector<Level
                 double endS) {
   dt = dtS;
   planStep(entries, levels);
-  sourcesPass(entries);
+  if (!inertial()) sourcesPass(entries);
   if (p.waterModel == WaterModel::kVirtualPipes) {
     pipeFluxPass();
     pipeUpdatePass();
   } else if (inertial()) {
     inertialFacePass();
+    sourcesPass(entries);  // W38: after the faces, before the limits
     fvLimitPass();
     inertialUpdatePass();
   } else {

@@ -166,20 +166,31 @@ struct GlSolver::Impl {
   bool rainOrLosses() const {
     return p.rainMmPerHour != 0.0f || rasterRain || p.evaporationMmPerHour != 0.0f || infiltrates;
   }
+  // W36: the clock pours the point sources in itself where nothing comes between it and them: a
+  // step without a rain pass, unless the local-inertial scheme pours after its faces (W38).
+  bool clockPours() const {
+    return !rainOrLosses() && (p.waterModel == int32_t(WaterModel::kVirtualPipes) ||
+                               p.floodScheme != int32_t(FloodScheme::kLocalInertial));
+  }
 
   // The passes of a step after its sources' entries are in place (docs/sim-water.md, "One step").
   void passes(size_t sourceEntryCount, const std::vector<LevelEntry>* levels, float wetThresholdM) {
     const int w = p.width, h = p.height;
     const bool fused = fusedTail() && levels == nullptr;
     const bool tailSpeed = fused && p.cflAlpha > 0, tailStats = fused && wetThresholdM >= 0;
-    if (rainOrLosses()) {
-      run(pSources, kShapeGrid, w, h);
-      barrier();
-    }
-    if (sourceEntryCount > 0 && (!indirect || rainOrLosses())) {  // else the clock poured them in
-      run(pPointSources, kShapeEntries, int(sourceEntryCount));
-      barrier();
-    }
+    auto pour = [&] {  // W11, W11b, W12
+      if (rainOrLosses()) {
+        run(pSources, kShapeGrid, w, h);
+        barrier();
+      }
+      if (sourceEntryCount > 0 && (!indirect || !clockPours())) {  // else the clock poured them in
+        run(pPointSources, kShapeEntries, int(sourceEntryCount));
+        barrier();
+      }
+    };
+    const bool inertial =
+        p.floodScheme == int32_t(FloodScheme::kLocalInertial) && p.waterModel != int32_t(WaterModel::kVirtualPipes);
+    if (!inertial) pour();
     if (p.waterModel == int32_t(WaterModel::kVirtualPipes)) {
       run(pPipeFlux, kShapeGrid, w, h);
       barrier();
@@ -188,6 +199,7 @@ struct GlSolver::Impl {
     } else if (p.floodScheme == int32_t(FloodScheme::kLocalInertial)) {
       run(pInertialFace, kShapeGrid, w, h);
       barrier();
+      pour();  // W38: the faces from the depths before the step's sources
       run(pInertialLimit, kShapeGrid, w, h);
       barrier();
       setTail(pInertialUpdate, tailSpeed, tailStats, wetThresholdM);
@@ -252,7 +264,7 @@ struct GlSolver::Impl {
     c.rainRateMS = r.rainRateMS;
     c.adaptive = sp.cflAlpha > 0 ? 1u : 0u;
     c.inertial = sp.floodScheme == FloodScheme::kLocalInertial ? 1u : 0u;
-    c.pointSources = rainOrLosses() ? 0u : 1u;
+    c.pointSources = clockPours() ? 1u : 0u;
     c.termCount = uint32_t(termCount);
     auto groups = [](size_t cells, int per) { return uint32_t((cells + size_t(per) - 1) / size_t(per)); };
     const uint32_t full[3 * kClockShapes] = {groups(size_t(p.width), 16),
