@@ -478,8 +478,8 @@ void Impl::step(const std::vector<SourceEntry>& entries, const std::vector<Level
                 double endS) {
   dt = dtS;
   planStep(entries, levels);
-  if (!inertial()) sourcesPass(entries);
   if (p.waterModel == WaterModel::kVirtualPipes) {
+    sourcesPass(entries);
     pipeFluxPass();
     pipeUpdatePass();
   } else if (inertial()) {
@@ -488,6 +488,7 @@ void Impl::step(const std::vector<SourceEntry>& entries, const std::vector<Level
     fvLimitPass();
     inertialUpdatePass();
   } else {
+    sourcesPass(entries);
     fvFacePass(now(), false);
     fvUpdatePass(false);
     fvFacePass(stage, true);

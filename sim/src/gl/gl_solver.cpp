@@ -188,10 +188,8 @@ struct GlSolver::Impl {
         barrier();
       }
     };
-    const bool inertial =
-        p.floodScheme == int32_t(FloodScheme::kLocalInertial) && p.waterModel != int32_t(WaterModel::kVirtualPipes);
-    if (!inertial) pour();
     if (p.waterModel == int32_t(WaterModel::kVirtualPipes)) {
+      pour();
       run(pPipeFlux, kShapeGrid, w, h);
       barrier();
       run(pPipeUpdate, kShapeGrid, w, h);
@@ -206,6 +204,7 @@ struct GlSolver::Impl {
       run(pInertialUpdate, kShapeGrid, w, h);
       barrier();
     } else {
+      pour();
       pFvFace.set("average", 0);
       run(pFvFace, kShapeGrid, w, h);
       barrier();
