@@ -209,10 +209,10 @@ void Impl::integrateLevel(int m, float dtLevel) {
 // One step of dtS in local steps (docs/sim-water.md, "Local time steps"). Substep i of the finest
 // step dt runs, for each level m whose step starts at i (i a multiple of 2^m): the faces of its
 // cells over 2^m dt; the faces between levels with the finer cell's step and its q0; the sources
-// and limits of its cells (W38); the limits of the coarser cells beside them (what they may still give); then, for each
-// level whose step ends at i, finest first, the update of its cells, its fixed levels (W26) and
-// flood statistics. The update writes the state in place (no ping-pong: a cell whose step has not
-// ended is read where it is).
+// and limits of its cells (W38); the limits of the coarser cells beside them (what they may still
+// give); then, for each level whose step ends at i, finest first, the update of its cells, its
+// fixed levels (W26) and flood statistics. The update writes the state in place (no ping-pong: a
+// cell whose step has not ended is read where it is).
 void Impl::localStep(const std::vector<SourceEntry>& entries, const std::vector<LevelEntry>& levels, float dtS,
                      double endS, double rainRateMS) {
   planStep(entries, levels);
@@ -268,9 +268,7 @@ void Impl::localStep(const std::vector<SourceEntry>& entries, const std::vector<
       if (!starts(m)) continue;
       dt = dtOf(m);
       if (rains) rainPass(levelRain[size_t(m)]);
-      for (const auto& e : entries) {
-        if (levelOf(e.cell) == m) pointSources({&e, 1});
-      }
+      if (m == 0) pointSources(entries);  // a point source's block is level 0 (planLevels)
       fvLimitPass(levelWater[size_t(m)]);
     }
     // W25 over a coarser cell's whole step: at its start its limit K from all its faces (those to
