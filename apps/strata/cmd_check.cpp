@@ -38,8 +38,7 @@ void addCheckCommand(CLI::App& app) {
     auto store =
         terrain::TileStore::open(*dir, {.budgetBytes = size_t(64) << 20, .prefetch = false}, {.allowIncomplete = true});
     if (!store) {
-      std::fprintf(stderr, "strata check: %s\n", store.message().c_str());
-      throw CLI::RuntimeError(1);
+      exitCommand("check", store.message());
     }
     std::printf("store     %s\n%s", dir->c_str(), terrain::describeStore(*store).c_str());
     const auto problems = store->verify();

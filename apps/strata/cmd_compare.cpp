@@ -25,8 +25,7 @@ void addCompareCommand(CLI::App& app) {
     opt->plots = !*noPlots;
     auto written = scenario::compareRuns(*opt);
     if (!written) {
-      std::fprintf(stderr, "strata compare: %s\n", written.message().c_str());
-      throw CLI::RuntimeError(1);
+      exitCommand("compare", written.message());
     }
     std::printf("compared: %s/compare.md (%zu files)\n", out->c_str(), written->size());
   });

@@ -17,11 +17,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-[[noreturn]] void die(const std::string& m) {
-  std::fprintf(stderr, "strata export: %s\n", m.c_str());
-  throw CLI::RuntimeError(1);
-}
-
 // Whether `dir` holds a Strata tile store (a manifest that says so).
 bool isStore(const fs::path& dir) {
   std::ifstream in(dir / "manifest.toml");
@@ -41,12 +36,6 @@ std::optional<fs::path> storeAround(const fs::path& out, const fs::path& store) 
     if (p == p.root_path()) break;
   }
   return std::nullopt;
-}
-
-std::string number(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
 }
 
 }  // namespace
@@ -70,35 +59,39 @@ void addExportCommand(CLI::App& app) {
   cmd->add_flag("--overwrite", o->overwrite, "Replace OUTPUT if it exists");
   cmd->callback([o] {
     if (auto inside = storeAround(o->out, o->store)) {
-      die(o->out + ": inside the tile store " + inside->string() + "; write the GeoTIFF elsewhere");
+      exitCommand("export", o->out + ": inside the tile store " + inside->string() + "; write the GeoTIFF elsewhere");
     }
     std::error_code ec;
-    if (!o->overwrite && fs::exists(o->out, ec)) die(o->out + ": already exists (pass --overwrite to replace it)");
+    if (!o->overwrite && fs::exists(o->out, ec))
+      exitCommand("export", o->out + ": already exists (pass --overwrite to replace it)");
     auto store = terrain::TileStore::open(o->store);
-    if (!store) die(store.message());
+    if (!store) exitCommand("export", store.message());
     const int field = store->fieldIndex(o->field);
-    if (field < 0) die(o->store + ": no field '" + o->field + "'");
+    if (field < 0) exitCommand("export", o->store + ": no field '" + o->field + "'");
     if (o->lod < 0 || o->lod > store->maxLod())
-      die("--lod " + std::to_string(o->lod) + " outside 0.." + std::to_string(store->maxLod()));
+      exitCommand("export", "--lod " + std::to_string(o->lod) + " outside 0.." + std::to_string(store->maxLod()));
     const int lw = store->levelWidth(o->lod), lh = store->levelHeight(o->lod);
     gis::CellRect w{0, 0, lw, lh};
     if (!o->window.empty()) w = {o->window[0], o->window[1], o->window[2], o->window[3]};
     if (w.width <= 0 || w.height <= 0 || w.width > (1 << 20) || w.height > (1 << 20)) {
-      die("--window: width and height must be 1..2^20 cells");
+      exitCommand("export", "--window: width and height must be 1..2^20 cells");
     }
     const bool global = store->desc().layout == terrain::TileLayout::Global;
     if (!global && (w.x < 0 || w.y < 0 || int64_t(w.x) + w.width > lw || int64_t(w.y) + w.height > lh)) {
-      die("--window " + std::to_string(w.x) + " " + std::to_string(w.y) + " " + std::to_string(w.width) + " " +
-          std::to_string(w.height) + " reaches outside level " + std::to_string(o->lod) + "'s " + std::to_string(lw) +
-          " x " + std::to_string(lh) + " cells");
+      exitCommand("export", "--window " + std::to_string(w.x) + " " + std::to_string(w.y) + " " +
+                                std::to_string(w.width) + " " + std::to_string(w.height) + " reaches outside level " +
+                                std::to_string(o->lod) + "'s " + std::to_string(lw) + " x " + std::to_string(lh) +
+                                " cells");
     }
     auto values = store->readWindow(field, w, o->lod);
-    if (!values) die(values.message());
+    if (!values) exitCommand("export", values.message());
     size_t nodata = 0;
     for (float v : values->data) nodata += std::isnan(v);
     const size_t cells = values->data.size();
     if (nodata == cells) {
-      die(o->store + ": the window holds no data (the store has no tile there: no source covered it); nothing written");
+      exitCommand(
+          "export",
+          o->store + ": the window holds no data (the store has no tile there: no source covered it); nothing written");
     }
     gis::Raster r;
     r.georef = store->windowGeoref(w, o->lod);
@@ -119,7 +112,9 @@ void addExportCommand(CLI::App& app) {
         {"STRATA_LOD", std::to_string(o->lod)},
         {"STRATA_FIELD", o->field}};
     if (auto st = gis::writeGeoTiff(o->out, r, wo); !st) {
-      die(st.message() + (st.message().find("already exists") != std::string::npos ? " (pass --overwrite)" : ""));
+      exitCommand(
+          "export",
+          st.message() + (st.message().find("already exists") != std::string::npos ? " (pass --overwrite)" : ""));
     }
     std::printf("%s: %s %dx%d at level %d from %s; tiles' error max %s m, RMS %s m\n", o->out.c_str(), o->field.c_str(),
                 w.width, w.height, o->lod, o->store.c_str(), number(err.maxM).c_str(), number(err.rmsM).c_str());

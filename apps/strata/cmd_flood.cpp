@@ -49,7 +49,7 @@ void addRunCommand(CLI::App& app, const char* name, const char* help, bool erosi
     const auto& mpi = mpiLaunch();
     // One line per failure, from rank 0 only (every rank fails alike).
     auto failWith = [&](const std::string& what, int code) {
-      if (mpi.rank == 0) std::fprintf(stderr, "strata %s: %s\n", name, what.c_str());
+      if (mpi.rank == 0) exitCommand(name, what, code);
       throw CLI::RuntimeError(code);
     };
     auto scenario = scenario::loadScenario(args->scenario);

@@ -118,8 +118,7 @@ void addGenerateCommand(CLI::App& app) {
   cmd->callback([args] {
     const auto status = run(args->script, args->out, args->seed, args->size, args->levels);
     if (!status) {
-      std::fprintf(stderr, "strata generate: %s\n", status.message().c_str());
-      throw CLI::RuntimeError(1);
+      exitCommand("generate", status.message());
     }
   });
 }

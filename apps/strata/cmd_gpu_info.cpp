@@ -14,8 +14,7 @@ void addGpuInfoCommand(CLI::App& app) {
   cmd->callback([device] {
     auto ctx = gl::HeadlessContext::create({.device = *device, .debugOutput = false});
     if (!ctx) {
-      std::fprintf(stderr, "strata gpu-info: %s\n", ctx.message().c_str());
-      throw CLI::RuntimeError(1);
+      exitCommand("gpu-info", ctx.message());
     }
     const auto& i = ctx->info();
     const auto l = gl::queryContextLimits();

@@ -58,8 +58,7 @@ void addInfoCommand(CLI::App& app) {
     if (!o->assignGeotransform.empty()) {
       auto gt = gis::parseGeoTransform(o->assignGeotransform, "--assign-geotransform");
       if (!gt) {
-        std::fprintf(stderr, "strata info: %s\n", gt.message().c_str());
-        throw CLI::RuntimeError(1);
+        exitCommand("info", gt.message());
       }
       assignGt = *gt;
     }

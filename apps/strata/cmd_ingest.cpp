@@ -20,11 +20,6 @@ namespace strata::app {
 
 namespace {
 
-[[noreturn]] void die(const std::string& message) {
-  std::fprintf(stderr, "strata ingest: %s\n", message.c_str());
-  throw CLI::RuntimeError(1);
-}
-
 bool fileExists(const std::string& path) {
   struct stat st {};
   return ::stat(path.c_str(), &st) == 0 || path.rfind("/vsi", 0) == 0;
@@ -38,8 +33,8 @@ gis::MosaicInput parseInput(const std::string& spec) {
   if (fileExists(spec)) {
     const auto at = spec.rfind('@');
     if (at != std::string::npos && gis::parseBlendSpec(spec.substr(at + 1)) && fileExists(spec.substr(0, at))) {
-      die("'" + spec + "' is ambiguous: both it and '" + spec.substr(0, at) +
-          "' exist; name the blend mode with --blend MODE PATH");
+      exitCommand("ingest", "'" + spec + "' is ambiguous: both it and '" + spec.substr(0, at) +
+                                "' exist; name the blend mode with --blend MODE PATH");
     }
     return in;
   }
@@ -70,15 +65,10 @@ std::string identity(const gis::MosaicInput& in) {
   return id;
 }
 
-std::string number(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
-}
-
 double finite(double v, const std::string& option, double lo, double hi) {
   if (!std::isfinite(v) || v < lo || v > hi) {
-    die(option + " " + number(v) + ": expected a finite number in [" + number(lo) + ", " + number(hi) + "]");
+    exitCommand("ingest",
+                option + " " + number(v) + ": expected a finite number in [" + number(lo) + ", " + number(hi) + "]");
   }
   return v;
 }
@@ -114,7 +104,8 @@ void addIngestCommand(CLI::App& app) {
          [o](const std::vector<std::string>& v) {
            for (size_t i = 0; i + 1 < v.size(); i += 2) {
              auto mode = gis::parseBlendSpec(v[i]);
-             if (!mode) die("--blend " + v[i] + ": " + mode.message() + " (add '+fill' to fill no data)");
+             if (!mode)
+               exitCommand("ingest", "--blend " + v[i] + ": " + mode.message() + " (add '+fill' to fill no data)");
              gis::MosaicInput in;
              in.path = v[i + 1];
              in.mode = mode->mode;
@@ -160,8 +151,8 @@ void addIngestCommand(CLI::App& app) {
     installInterruptHandler();
     terrain::IngestOptions opts;
     if (o->minExp < 0 || o->minExp > 14 || o->maxExp < 0 || o->maxExp > 14 || o->minExp > o->maxExp) {
-      die("--min-exp " + std::to_string(o->minExp) + " / --max-exp " + std::to_string(o->maxExp) +
-          ": need 0 <= min-exp <= max-exp <= 14");
+      exitCommand("ingest", "--min-exp " + std::to_string(o->minExp) + " / --max-exp " + std::to_string(o->maxExp) +
+                                ": need 0 <= min-exp <= max-exp <= 14");
     }
     opts.metric = {o->minExp, o->maxExp};
     if (o->metric == "max-error") {
@@ -169,7 +160,7 @@ void addIngestCommand(CLI::App& app) {
     } else if (o->metric == "range") {
       opts.metric.kind = terrain::TileMetric::Range;
     } else {
-      die("--metric '" + o->metric + "': expected max-error or range");
+      exitCommand("ingest", "--metric '" + o->metric + "': expected max-error or range");
     }
     opts.metric.maxErrorM = finite(o->maxErrorM, "--max-error", 0, 1e6);
     opts.layout = o->global ? terrain::TileLayout::Global : terrain::TileLayout::Planar;
@@ -177,9 +168,9 @@ void addIngestCommand(CLI::App& app) {
     gis::Georef grid;
     std::vector<terrain::IngestSource> sources;
     if (o->synthetic != 0) {
-      if (!o->bedrock.empty()) die("give either --synthetic or --dem, not both");
+      if (!o->bedrock.empty()) exitCommand("ingest", "give either --synthetic or --dem, not both");
       if (o->synthetic < 1 || o->synthetic > (1 << 20))
-        die("--synthetic " + std::to_string(o->synthetic) + ": 1..2^20");
+        exitCommand("ingest", "--synthetic " + std::to_string(o->synthetic) + ": 1..2^20");
       finite(o->cellSizeM, "--cell-size", 1e-6, 1e7);
       grid.epsg = 3857;
       grid.crsName = "WGS 84 / Pseudo-Mercator";
@@ -192,7 +183,7 @@ void addIngestCommand(CLI::App& app) {
                          "synthetic " + std::to_string(o->synthetic) + " cells of " + std::to_string(o->cellSizeM) +
                              " m, blocks of " + std::to_string(scene.blockCells)});
     } else {
-      if (o->bedrock.empty()) die("give a source (--dem PATH or --synthetic N)");
+      if (o->bedrock.empty()) exitCommand("ingest", "give a source (--dem PATH or --synthetic N)");
       // Inputs of every field; the assigned georeference goes to those without one.
       std::vector<std::vector<gis::MosaicInput>> fields{o->bedrock};
       std::vector<std::pair<terrain::StoreField, std::string>> extra;
@@ -211,7 +202,7 @@ void addIngestCommand(CLI::App& app) {
       for (const auto& l : o->layers) {
         const auto colon = l.find(':'), eq = l.find('=');
         if (colon == std::string::npos || eq == std::string::npos || eq < colon) {
-          die("--layer '" + l + "': expected NAME:MATERIAL=PATH");
+          exitCommand("ingest", "--layer '" + l + "': expected NAME:MATERIAL=PATH");
         }
         extra.push_back({{l.substr(0, colon), terrain::LayerKind::Material, l.substr(colon + 1, eq - colon - 1)}, l});
         fields.push_back(splitList(l.substr(eq + 1)));
@@ -223,7 +214,7 @@ void addIngestCommand(CLI::App& app) {
       std::optional<gis::GeoTransform> assignGt;
       if (!o->assignGeotransform.empty()) {
         auto gt = gis::parseGeoTransform(o->assignGeotransform, "--assign-geotransform");
-        if (!gt) die(gt.message());
+        if (!gt) exitCommand("ingest", gt.message());
         assignGt = *gt;
       }
       auto resampling = [&]() -> gis::Resampling {
@@ -233,7 +224,7 @@ void addIngestCommand(CLI::App& app) {
         if (r == "cubic") return gis::Resampling::Cubic;
         if (r == "min") return gis::Resampling::Minimum;
         if (r == "min-if-coarser") return gis::Resampling::MinimumIfCoarser;
-        die("--resampling '" + r + "': expected nearest, bilinear, cubic, min or min-if-coarser");
+        exitCommand("ingest", "--resampling '" + r + "': expected nearest, bilinear, cubic, min or min-if-coarser");
       }();
       bool crsUsed = false, gtUsed = false;
       for (auto& inputs : fields) {
@@ -241,15 +232,16 @@ void addIngestCommand(CLI::App& app) {
           in.resampling = resampling;
           if (o->assignCrs.empty() && !assignGt) continue;
           auto has = gis::georefPresence(in.path);
-          if (!has) die(has.message());
+          if (!has) exitCommand("ingest", has.message());
           if (!o->assignCrs.empty() && !has->crs) in.assignCrs = o->assignCrs, crsUsed = true;
           if (assignGt && !has->transform) in.assignTransform = assignGt, gtUsed = true;
         }
       }
       if (!o->assignCrs.empty() && !crsUsed)
-        die("--assign-crs: every input has a CRS of its own (it fills in a missing one)");
+        exitCommand("ingest", "--assign-crs: every input has a CRS of its own (it fills in a missing one)");
       if (assignGt && !gtUsed)
-        die("--assign-geotransform: every input has a geotransform of its own (it fills in a missing one)");
+        exitCommand("ingest",
+                    "--assign-geotransform: every input has a geotransform of its own (it fills in a missing one)");
 
       gis::MosaicGridOptions go;
       if (!o->crs.empty()) go.crs = o->crs;
@@ -259,20 +251,21 @@ void addIngestCommand(CLI::App& app) {
             std::array<double, 2>{o->resolution[0], o->resolution.size() > 1 ? o->resolution[1] : o->resolution[0]};
       }
       auto g = gis::mosaicGrid(fields[0], go);
-      if (!g) die(g.message());
+      if (!g) exitCommand("ingest", g.message());
       grid = *g;
       for (size_t f = 0; f < fields.size(); ++f) {
         std::string id;
         for (const auto& in : fields[f]) id += (id.empty() ? "" : "; ") + identity(in);
         auto reader = terrain::mosaicReader(fields[f], grid);
-        if (!reader) die((f == 0 ? std::string() : "'" + extra[f - 1].second + "': ") + reader.message());
+        if (!reader)
+          exitCommand("ingest", (f == 0 ? std::string() : "'" + extra[f - 1].second + "': ") + reader.message());
         terrain::StoreField field =
             f == 0 ? terrain::StoreField{"bedrock", terrain::LayerKind::Bedrock, ""} : extra[f - 1].first;
         sources.push_back({std::move(field), std::move(*reader), id});
       }
     }
     auto rep = terrain::ingest(o->store, grid, sources, opts);
-    if (!rep) die(rep.message());
+    if (!rep) exitCommand("ingest", rep.message());
     if (rep->alreadyComplete) {
       std::printf("%s: already complete; nothing to resume\n", o->store.c_str());
       return;

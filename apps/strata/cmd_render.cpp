@@ -51,11 +51,6 @@ struct RenderArgs {
   bool overwrite = false;
 };
 
-[[noreturn]] void die(const std::string& message) {
-  std::fprintf(stderr, "strata render: %s\n", message.c_str());
-  throw CLI::RuntimeError(1);
-}
-
 // "synthetic:SIZE[:SEED]" (a rough fractal terrain of SIZE^2 cells of 30 m), else a DEM file
 // (any raster GDAL reads, through strata::gis::readDem).
 Result<gis::Raster> loadDem(const std::string& spec, bool planetary, const std::string& assignCrs,
@@ -135,11 +130,12 @@ void reportStream(const TerrainScene& scene) {
 void checkNumbers(const RenderArgs& a) {
   auto check = [](const char* option, std::optional<double> v, double lo, double hi) {
     if (!v) return;
-    if (!std::isfinite(*v)) die(std::string(option) + " " + std::to_string(*v) + ": not a finite number");
+    if (!std::isfinite(*v))
+      exitCommand("render", std::string(option) + " " + std::to_string(*v) + ": not a finite number");
     if (*v < lo || *v > hi) {
       char msg[160];
       std::snprintf(msg, sizeof msg, "%s %g: expected %g to %g", option, *v, lo, hi);
-      die(msg);
+      exitCommand("render", msg);
     }
   };
   check("--lon", a.lon, -1e9, 1e9);  // degrees, or metres of a projected CRS
@@ -154,7 +150,7 @@ void checkNumbers(const RenderArgs& a) {
   check("--fog", double(a.fogM), 0, 1e9);
   check("--gpu-budget", a.gpuBudgetMiB, 1, 1 << 20);
   if (!a.path.empty() && (a.frames < 2 || a.frames > 1000000)) {
-    die("--frames " + std::to_string(a.frames) + ": a flight path needs 2 to 1000000 frames");
+    exitCommand("render", "--frames " + std::to_string(a.frames) + ": a flight path needs 2 to 1000000 frames");
   }
 }
 
@@ -170,22 +166,22 @@ void checkOutputs(const RenderArgs& a) {
     }
     for (int i = 0; i < a.frames; ++i) {
       auto name = frameName(pattern, i);
-      if (!name) die(name.message());
+      if (!name) exitCommand("render", name.message());
       outputs.push_back(*name);
     }
   }
   for (const auto& f : outputs) {
     std::error_code ec;
-    if (std::filesystem::exists(f, ec)) die(f + ": exists (use --overwrite to replace it)");
+    if (std::filesystem::exists(f, ec)) exitCommand("render", f + ": exists (use --overwrite to replace it)");
   }
 }
 
 void run(const RenderArgs& a) {
   int w = 0, h = 0;
   if (std::sscanf(a.size.c_str(), "%dx%d", &w, &h) != 2 || w < 1 || h < 1 || w > 16384 || h > 16384) {
-    die("--size '" + a.size + "': expected WxH, e.g. 1280x720");
+    exitCommand("render", "--size '" + a.size + "': expected WxH, e.g. 1280x720");
   }
-  if (a.height && a.agl) die("--height and --agl: give one of them");
+  if (a.height && a.agl) exitCommand("render", "--height and --agl: give one of them");
   checkNumbers(a);
   checkOutputs(a);
   Shading shading;
@@ -196,7 +192,7 @@ void run(const RenderArgs& a) {
   const VoidMode voids = a.voids == "holes" ? VoidMode::kHoles : VoidMode::kFill;
 
   auto ctx = gl::HeadlessContext::create({.debugOutput = false});
-  if (!ctx) die(ctx.message());
+  if (!ctx) exitCommand("render", ctx.message());
   // A folder with a manifest is a tile store: its elevation is streamed around the viewer.
   auto scene = [&]() -> Result<TerrainScene> {
     if (!std::filesystem::is_regular_file(std::filesystem::path(a.dem) / "manifest.toml")) {
@@ -211,12 +207,13 @@ void run(const RenderArgs& a) {
                                          .gpuBudgetBytes = size_t(a.gpuBudgetMiB * 1048576.0)},
                                         {.planetary = a.planetary});
   }();
-  if (!scene) die(scene.message().starts_with(a.dem + ":") ? scene.message() : a.dem + ": " + scene.message());
-  if (auto st = apps::applyView(a.view, *scene, shading); !st) die(st.message());
+  if (!scene)
+    exitCommand("render", scene.message().starts_with(a.dem + ":") ? scene.message() : a.dem + ": " + scene.message());
+  if (auto st = apps::applyView(a.view, *scene, shading); !st) exitCommand("render", st.message());
   auto renderer = makeRenderer(a);
-  if (!renderer) die(renderer.message());
+  if (!renderer) exitCommand("render", renderer.message());
   auto target = OffscreenTarget::create(w, h, a.view.msaa);
-  if (!target) die(target.message());
+  if (!target) exitCommand("render", target.message());
 
   // The camera: default over the DEM's centre, 1000 m above the ground.
   const auto& c = scene->georef().transform.c;
@@ -233,7 +230,7 @@ void run(const RenderArgs& a) {
   std::optional<Overlay> overlay;
   if (a.view.layers.scaleBar) {
     auto o = Overlay::create();
-    if (!o) die(o.message());
+    if (!o) exitCommand("render", o.message());
     overlay.emplace(std::move(*o));
   }
   auto drawOverlays = [&](const CameraPose& pose) {
@@ -247,34 +244,35 @@ void run(const RenderArgs& a) {
       // One picture: draw until every page of the windows is resident (each draw copies at
       // most --upload-pages of them), so the image is the full-resolution one.
       for (int i = 0; i < 10000; ++i) {
-        if (auto s = (*renderer)->draw(*scene, cam, shading, *target); !s) die(s.message());
+        if (auto s = (*renderer)->draw(*scene, cam, shading, *target); !s) exitCommand("render", s.message());
         if (st->stats().pending == 0) break;
       }
     } else if (auto s = (*renderer)->draw(*scene, cam, shading, *target); !s) {
-      die(s.message());
+      exitCommand("render", s.message());
     }
     drawOverlays(cam);
     const auto frame = frameGeometry(*scene, cam, shading, w, h);
-    if (auto s = writeOutputs(*target, frame, a.output, a.depthOut, a.elevationOut); !s) die(s.message());
+    if (auto s = writeOutputs(*target, frame, a.output, a.depthOut, a.elevationOut); !s)
+      exitCommand("render", s.message());
     std::printf("%s: %dx%d, %zu triangles (%s)\n", a.output.c_str(), w, h, (*renderer)->trianglesPerFrame(*scene),
                 (*renderer)->name().c_str());
     reportStream(*scene);
     return;
   }
   auto path = FlightPath::load(a.path);
-  if (!path) die(path.message());
+  if (!path) exitCommand("render", path.message());
   for (int i = 0; i < a.frames; ++i) {
     const CameraPose pose = path->at(double(i) / double(a.frames - 1));
-    if (auto s = (*renderer)->draw(*scene, pose, shading, *target); !s) die(s.message());
+    if (auto s = (*renderer)->draw(*scene, pose, shading, *target); !s) exitCommand("render", s.message());
     auto name = frameName(a.output, i);
-    if (!name) die(name.message());
+    if (!name) exitCommand("render", name.message());
     auto depthName = a.depthOut.empty() ? Result<std::string>(std::string()) : frameName(a.depthOut, i);
     auto elevName = a.elevationOut.empty() ? Result<std::string>(std::string()) : frameName(a.elevationOut, i);
-    if (!depthName) die(depthName.message());
-    if (!elevName) die(elevName.message());
+    if (!depthName) exitCommand("render", depthName.message());
+    if (!elevName) exitCommand("render", elevName.message());
     drawOverlays(pose);
     const auto frame = frameGeometry(*scene, pose, shading, w, h);
-    if (auto s = writeOutputs(*target, frame, *name, *depthName, *elevName); !s) die(s.message());
+    if (auto s = writeOutputs(*target, frame, *name, *depthName, *elevName); !s) exitCommand("render", s.message());
   }
   std::printf("%d frames %dx%d along %s\n", a.frames, w, h, a.path.c_str());
   reportStream(*scene);

@@ -3,6 +3,9 @@
 // on stderr and throws CLI::RuntimeError(exit code).
 #include <CLI/CLI.hpp>
 
+#include <string>
+#include <string_view>
+
 namespace strata::app {
 
 void addGpuInfoCommand(CLI::App& app);
@@ -22,5 +25,10 @@ struct MpiLaunch {
   int rank = 0, size = 1;
 };
 const MpiLaunch& mpiLaunch();
+
+/// Ends subcommand `command` with one line on stderr, "strata COMMAND: WHAT", and exit code `code`.
+[[noreturn]] void exitCommand(std::string_view command, const std::string& what, int code = 1);
+/// A number as messages and metadata print it (printf's %g: six significant digits).
+std::string number(double v);
 
 }  // namespace strata::app

@@ -28,6 +28,17 @@ bool launchedByMpirun() {
 
 const MpiLaunch& mpiLaunch() { return gLaunch; }
 
+void exitCommand(std::string_view command, const std::string& what, int code) {
+  std::fprintf(stderr, "strata %.*s: %s\n", int(command.size()), command.data(), what.c_str());
+  throw CLI::RuntimeError(code);
+}
+
+std::string number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
 }  // namespace strata::app
 
 int main(int argc, char** argv) {
