@@ -9,6 +9,11 @@ set(CMAKE_CXX_EXTENSIONS OFF)
 add_library(strata_options INTERFACE)
 target_compile_options(strata_options INTERFACE -Wall -Wextra -Wpedantic $<$<CXX_COMPILER_ID:GNU>:-Wshadow=local>
                                                 $<$<CXX_COMPILER_ID:Clang>:-Wshadow;-Wno-pass-failed>)
+if(STRATA_UNITY_BUILD)
+  # GCC says a class with external linkage that holds an anonymous namespace's type belongs in a
+  # header; a unity batch includes the .cpp files that define such private Impl classes.
+  target_compile_options(strata_options INTERFACE $<$<CXX_COMPILER_ID:GNU>:-Wno-subobject-linkage>)
+endif()
 if(STRATA_WERROR)
   target_compile_options(strata_options INTERFACE -Werror)
 endif()

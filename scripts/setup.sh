@@ -8,7 +8,8 @@
 # build steps on a fresh build folder); without it everything is built (tests, benchmarks).
 #
 # Environment: STRATA_BUILD_TYPE (default RelWithDebInfo), STRATA_WERROR (ON in CI),
-# STRATA_LINE_TABLES=1 (debug info of line tables only, as CI builds).
+# STRATA_LINE_TABLES=1 (debug info of line tables only, as CI builds), STRATA_UNITY=0 (no unity
+# batches: for editing one file at a time).
 set -euo pipefail
 
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -90,14 +91,18 @@ if [ -n "$sanitize" ]; then
 elif [ "${STRATA_LINE_TABLES:-0}" = "1" ]; then
   opt_flags=(-DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g1 -DNDEBUG")
 fi
-want="type=$build_type werror=$werror sanitize=$sanitize bench=$bench flags=${opt_flags[*]:-}"
+# Unity builds (CMakeLists.txt: STRATA_UNITY_BUILD) compile each target's sources in batches:
+# STRATA_UNITY=0 compiles them one by one (an edit then recompiles one file, not its batch).
+unity=ON
+[ "${STRATA_UNITY:-1}" = "0" ] && unity=OFF
+want="type=$build_type werror=$werror sanitize=$sanitize bench=$bench unity=$unity flags=${opt_flags[*]:-}"
 stamp="$build_dir/.strata-setup"
 if [ ! -f "$build_dir/build.ninja" ] || [ "$(cat "$stamp" 2>/dev/null)" != "$want" ]; then
   cmake -S "$root" -B "$build_dir" -G Ninja \
     -DCMAKE_BUILD_TYPE="$build_type" \
     -DSTRATA_WERROR="$werror" \
     -DSTRATA_SANITIZE="$sanitize" \
-    -DSTRATA_BUILD_BENCH="$bench" "${opt_flags[@]}" >/dev/null
+    -DSTRATA_BUILD_BENCH="$bench" -DSTRATA_UNITY_BUILD="$unity" "${opt_flags[@]}" >/dev/null
   echo "$want" > "$stamp"
 fi
 cmake --build "$build_dir" -j "$(nproc)" "${targets[@]}"

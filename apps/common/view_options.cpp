@@ -7,6 +7,7 @@
 #include <numbers>
 #include <optional>
 
+#include <strata/core/angles.hpp>
 #include <strata/render/colour_ramp.hpp>
 #include <strata/render/drape.hpp>
 #include <strata/render/sun.hpp>
@@ -99,7 +100,6 @@ Status applyLight(const LightArgs& a, render::TerrainScene& scene, render::Shadi
   if (shading.subsolarLonLat) {
     const glm::dvec2 c = scene.centreLonLat();
     const glm::dvec3 d = render::sunDirectionEnu(*shading.subsolarLonLat, c.x, c.y);
-    constexpr double kDeg = std::numbers::pi / 180.0;
     std::printf("sun: overhead at %.3f, %.3f; at the terrain's centre azimuth %.1f, elevation %.1f deg\n",
                 shading.subsolarLonLat->x, shading.subsolarLonLat->y, std::fmod(std::atan2(d.x, d.y) / kDeg + 360, 360),
                 std::asin(std::clamp(d.z, -1.0, 1.0)) / kDeg);

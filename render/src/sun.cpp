@@ -8,12 +8,12 @@
 
 #include <glm/geometric.hpp>
 
+#include <strata/core/angles.hpp>
 #include <strata/gis/geodesy.hpp>
 
 namespace strata::render {
 
 namespace {
-constexpr double kDeg = std::numbers::pi / 180.0;
 constexpr double kSunRadiusDeg = 0.2666;  // the sun's apparent radius from the Earth
 
 double wrap180(double deg) { return deg - 360.0 * std::floor((deg + 180.0) / 360.0); }

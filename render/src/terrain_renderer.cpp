@@ -1,3 +1,4 @@
+#include <strata/core/angles.hpp>
 #include <strata/render/terrain_renderer.hpp>
 
 #include <algorithm>
@@ -20,7 +21,6 @@ namespace strata::render {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
-constexpr double kDeg = kPi / 180.0;
 constexpr int kMaxLevels = 32;  // terrain_common.glsl's per-level arrays
 
 glm::mat4 toFloat(const glm::dmat4& m) { return glm::mat4(m); }

@@ -27,6 +27,7 @@
 #include "drape_raster.hpp"
 #include "gl_fixture.hpp"
 #include "strata_test.hpp"
+#include "terrain_fixture.hpp"
 
 namespace strata::render {
 namespace {
@@ -154,8 +155,7 @@ TEST_F(GlTest, GpuTileCacheEvictsTheLeastRecentlyUsed) {
 
 // ---- Streaming -----------------------------------------------------------------------------
 
-// The golden test's oblique view of the canyon (terrain_render_test.cpp).
-const CameraPose kCanyonCamera{.lon = -112.08, .lat = 36.06, .heightM = 3800, .headingDeg = 295, .pitchDeg = -14};
+using test::kCanyonCamera;  // the golden test's oblique view of the canyon
 
 // The store's level-0 read as a whole-DEM scene: what streaming must reproduce.
 Result<TerrainScene> storeAsWholeScene() {

@@ -79,9 +79,7 @@ Result<TerrainScene> grandCanyon() {
   return TerrainScene::create(dem);
 }
 
-// The fixed oblique view of the Grand Canyon used by the golden image and the error report:
-// from above the South Rim east of Grand Canyon Village, looking west-north-west along the canyon.
-const CameraPose kCanyonCamera{.lon = -112.08, .lat = 36.06, .heightM = 3800, .headingDeg = 295, .pitchDeg = -14};
+using test::kCanyonCamera;
 
 // A rough terrain (7 octaves of value noise, down to a 2-cell period) over a magenta background:
 // every pixel whose ray must meet the terrain within `reachM` of the viewer is terrain-coloured.

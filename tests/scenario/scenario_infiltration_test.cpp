@@ -17,7 +17,7 @@
 #include "scenario_fixture.hpp"
 #include "strata_test.hpp"
 
-namespace strata::scenario {
+namespace strata::scenario::infiltration_test {
 namespace {
 
 using namespace test_support;
@@ -220,4 +220,4 @@ TEST(ScenarioRainFrames, EachFrameRainsItsRasterForItsTime) {
 }
 
 }  // namespace
-}  // namespace strata::scenario
+}  // namespace strata::scenario::infiltration_test

@@ -18,7 +18,7 @@
 #include "../../scenario/src/domain_rows.hpp"
 #include "strata_test.hpp"
 
-namespace strata::scenario {
+namespace strata::scenario::store_test {
 namespace {
 
 using namespace strata::terrain;
@@ -298,4 +298,4 @@ TEST(ScenarioStore, CorruptTileIsNamed) {
 }
 
 }  // namespace
-}  // namespace strata::scenario
+}  // namespace strata::scenario::store_test

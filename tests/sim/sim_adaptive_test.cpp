@@ -20,10 +20,6 @@ namespace {
 
 using test::GlTest;
 
-double seconds(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-
 // maxLevel 0: every tile at full resolution, halos copied; the run must be the untiled one
 // (the same kernels on the same values), which pins the halo and bookkeeping code.
 TEST_F(GlTest, SimAdaptiveOneLevelEqualsUntiled) {
@@ -90,13 +86,13 @@ TEST_F(GlTest, SimAdaptiveCanyonFloodAgreesWithFullResolution) {
   auto t0 = std::chrono::steady_clock::now();
   full->step(steps);
   (void)full->readWaterDepth();
-  const double fullS = seconds(t0);
+  const double fullS = test::secondsSince(t0);
   t0 = std::chrono::steady_clock::now();
   adaptive->step(1);
   const auto levelsAtStart = adaptive->levels();
   adaptive->step(steps - 1);
   (void)adaptive->readWaterDepth();
-  const double adaptiveS = seconds(t0);
+  const double adaptiveS = test::secondsSince(t0);
   const auto levelsAtEnd = adaptive->levels();
 
   const auto hf = full->readWaterDepth(), ha = adaptive->readWaterDepth();

@@ -37,10 +37,6 @@ double maxAbsDiff(const gis::Grid<float>& a, const gis::Grid<float>& b) {
   return m;
 }
 
-double seconds(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-
 // Every kernel's buffer blocks sit on the slots sim/gl/shader_slots.hpp declares (the GL backend
 // binds through the same table), and every slot and kernel file is used.
 TEST_F(GlTest, SimKernelsUseTheSlotsDeclaredInCpp) {
@@ -90,7 +86,7 @@ TEST_F(GlTest, SimClosedBoxConservesVolume) {
     std::printf(
         "GPU closed box (model %d, %dx%d): %lld steps in %.2f s wall, %.1f s simulated, relative volume "
         "change %.3g\n",
-        int(params.waterModel), n, n, st.steps, seconds(t0), st.timeS, rel);
+        int(params.waterModel), n, n, st.steps, test::secondsSince(t0), st.timeS, rel);
     // Issue 5's bound; the CPU reference measures 1e-8 (pipes) and 1.4e-7 (flood).
     EXPECT_LT(rel, 1e-6);
   }
@@ -150,7 +146,7 @@ TEST_F(GlTest, SimBalanceHoldsOver150kFloat32Steps) {
     const auto st = sim->stats();
     const double water = st.initialWaterM3 + st.rainM3 + st.inflowM3;
     std::printf("GL, scheme %d: %lld steps in %.1f s, stored %.2f -> %.2f m3, balance %.2e\n", int(scheme), st.steps,
-                seconds(t0), st.initialWaterM3, st.storedWaterM3, st.waterBalanceM3() / water);
+                test::secondsSince(t0), st.initialWaterM3, st.storedWaterM3, st.waterBalanceM3() / water);
     EXPECT_EQ(st.steps, test::kLongRainSteps);
     EXPECT_LT(std::abs(st.waterBalanceM3()), 1e-5 * water) << int(scheme);
   }
@@ -425,7 +421,7 @@ TEST_F(GlTest, SimRainPlaneHoldsTheKinematicWaveAtEveryStep) {
     std::printf(
         "GL plane, max step %g s: %lld steps in %.1f s, held %.1f m^3 (kinematic wave %.1f, %+.2f%%), balance "
         "%.1e of the rain\n",
-        cap, st.steps, seconds(t0), st.storedWaterM3, ref, 100.0 * (st.storedWaterM3 / ref - 1.0),
+        cap, st.steps, test::secondsSince(t0), st.storedWaterM3, ref, 100.0 * (st.storedWaterM3 / ref - 1.0),
         std::abs(st.waterBalanceM3()) / st.rainM3);
     EXPECT_NEAR(st.storedWaterM3 / ref, 1.0, 0.02) << cap;
     EXPECT_LT(std::abs(st.waterBalanceM3()) / st.rainM3, 1e-5) << cap;
@@ -579,7 +575,7 @@ TEST_F(GlTest, SimErosionConservesMaterial) {
   std::printf(
       "GPU erosion: %lld steps in %.2f s wall, material rel change %.3g, suspended %.3f m3, layers changed by "
       "%.1f m3\n",
-      st.steps, seconds(t0), rel, st.suspendedM3, moved);
+      st.steps, test::secondsSince(t0), rel, st.suspendedM3, moved);
   EXPECT_GT(moved, 10.0);
   // Issue 5's bound; pure float transfers (the CPU reference measures 3e-7 over 10,000 steps).
   EXPECT_LT(rel, 1e-5);
@@ -609,7 +605,7 @@ TEST_F(GlTest, SimErosionBalanceClosesWithEverythingOn) {
   std::printf(
       "GPU everything on: %lld steps (%.0f s) in %.2f s wall, layers moved %.2f m3, out %.4f m3, balance %.3g "
       "m3 (rel %.3g)\n",
-      st.steps, st.timeS, seconds(t0), moved, st.sedimentOutflowM3, balance, rel);
+      st.steps, st.timeS, test::secondsSince(t0), moved, st.sedimentOutflowM3, balance, rel);
   EXPECT_GT(moved, 3.0);  // measured 7.7 m^3
   EXPECT_GT(st.sedimentOutflowM3, 0.01);
   // E9 on the GPU as on the CPU: float32 rounding of the receivers only.

@@ -1,10 +1,16 @@
 #pragma once
 // Test helpers: where the shared real data and the test outputs live; running a program.
+#include <chrono>
 #include <filesystem>
 #include <string>
 #include <vector>
 
 namespace strata::test {
+
+/// Seconds of wall time since `t0`.
+inline double secondsSince(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
 
 /// ../shared/data/<relative> (compiled in as STRATA_DATA_DIR).
 std::string dataPath(const std::string& relative);

@@ -9,8 +9,14 @@
 #include <strata/core/result.hpp>
 #include <strata/gis/raster.hpp>
 #include <strata/render/image_io.hpp>
+#include <strata/render/terrain_renderer.hpp>
 
 namespace strata::test {
+
+/// The fixed oblique view of the Grand Canyon of the golden images and the error report: from
+/// above the South Rim east of Grand Canyon Village, looking west-north-west along the canyon.
+inline const render::CameraPose kCanyonCamera{
+    .lon = -112.08, .lat = 36.06, .heightM = 3800, .headingDeg = 295, .pitchDeg = -14};
 
 /// Tolerances of a golden comparison (Magnum's CompareImage habit: a per-pixel cap plus a mean).
 /// A pixel's difference is the largest channel difference. The cap applies to every pixel, but

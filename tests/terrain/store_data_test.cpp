@@ -22,10 +22,13 @@
 #include <strata/terrain/synthetic.hpp>
 #include <strata/terrain/tile_store.hpp>
 
+#include "store_support.hpp"
 #include "strata_test.hpp"
 
 namespace strata::terrain {
 namespace {
+
+using test::gridReader;
 
 namespace fs = std::filesystem;
 using gis::Grid;
@@ -45,14 +48,6 @@ Grid<float> readPixels(const std::string& path) {
     STRATA_CHECK(in->read_image(0, 0, 0, 1, OIIO::TypeDesc::FLOAT, g.data.data())) << path;
   }
   return g;
-}
-
-WindowReader gridReader(const Grid<float>& src) {
-  return [&src](int x0, int y0, int w, int h) -> Result<Grid<float>> {
-    Grid<float> g(w, h);
-    for (int y = 0; y < h; ++y) std::copy_n(&src.data[src.index(x0, y0 + y)], w, &g.data[g.index(0, y)]);
-    return g;
-  };
 }
 
 gis::Georef gridGeoref(int w, int h) {

@@ -22,15 +22,20 @@
 #include <strata/terrain/synthetic.hpp>
 #include <strata/terrain/tile_store.hpp>
 
+#include "store_support.hpp"
 #include "strata_test.hpp"
 
 namespace strata::terrain {
 namespace {
 
+using test::bedrock;
+using test::gridReader;
+using test::problemsOf;
+
 namespace fs = std::filesystem;
 using gis::Grid;
 
-constexpr int kMaxExp = 6, kF = 1 << kMaxExp;
+constexpr int kFinestExp = 6, kF = 1 << kFinestExp;
 
 gis::Georef utmGeoref(int w, int h) {
   gis::Georef g;
@@ -40,26 +45,6 @@ gis::Georef utmGeoref(int w, int h) {
   g.width = w;
   g.height = h;
   return g;
-}
-
-WindowReader gridReader(Grid<float> src) {
-  return [src = std::move(src)](int x0, int y0, int w, int h) -> Result<Grid<float>> {
-    Grid<float> g(w, h, gis::kNoData);
-    for (int y = 0; y < h; ++y) {
-      for (int x = 0; x < w; ++x) {
-        if (src.contains(x0 + x, y0 + y)) g.at(x, y) = src.at(x0 + x, y0 + y);
-      }
-    }
-    return g;
-  };
-}
-
-IngestSource bedrock(WindowReader r) { return {{"bedrock", LayerKind::Bedrock, ""}, std::move(r)}; }
-
-std::string problemsOf(const TileStore& s) {
-  std::string out;
-  for (const auto& p : s.verify()) out += p.message + "\n";
-  return out;
 }
 
 std::string slurp(const fs::path& p) {
@@ -94,7 +79,7 @@ TEST(MaxErrorMetric, EachTileIsTheCoarsestWithinTheTolerance) {
   const int w = 5 * kF, h = 4 * kF;
   const auto dir = test::tempDir("maxerr");
   IngestOptions o;
-  o.metric = {2, kMaxExp};
+  o.metric = {2, kFinestExp};
   o.metric.maxErrorM = 10.0;
   ASSERT_TRUE(ingest(dir, utmGeoref(w, h), {bedrock(syntheticReader(s))}, o));
   auto store = TileStore::open(dir);
@@ -110,7 +95,7 @@ TEST(MaxErrorMetric, EachTileIsTheCoarsestWithinTheTolerance) {
       // Flat: exact at the coarsest. Ramp: 0.3 * 1000 m over 63 columns (4.76 m a column); a
       // block of b columns errs by (b - 1) / 2 columns at its ends: b = 4 gives 7.1 m <= 10, b = 8
       // gives 16.7 m: 2^4 samples. Rough (white noise over 1000 m): full resolution.
-      const int want = kind == SyntheticBlock::Flat ? 2 : kind == SyntheticBlock::Ramp ? 4 : kMaxExp;
+      const int want = kind == SyntheticBlock::Flat ? 2 : kind == SyntheticBlock::Ramp ? 4 : kFinestExp;
       EXPECT_EQ(t.exp, want) << tx << "," << ty;
       double maxE = 0;
       for (int y = ty * kF; y < (ty + 1) * kF; ++y) {
@@ -145,7 +130,7 @@ TEST(MaxErrorMetric, VoidsStayVoidUnderEitherMetric) {
   const auto crop = rainier(512, 512, 256, 192);
   for (TileMetric m : {TileMetric::MaxError, TileMetric::Range}) {
     IngestOptions o;
-    o.metric = {0, kMaxExp};
+    o.metric = {0, kFinestExp};
     o.metric.kind = m;
     o.metric.maxErrorM = 1000;  // anything goes, but voids
     const auto dir = test::tempDir(m == TileMetric::Range ? "voids_range" : "voids_err");
@@ -162,7 +147,7 @@ TEST(MaxErrorMetric, VoidsStayVoidUnderEitherMetric) {
           for (int x = 0; x < kF; ++x) voids |= std::isnan(crop.values.at(tx * kF + x, ty * kF + y));
         }
         voidFree += !voids;
-        coarse += store->tile(tx, ty).exp < kMaxExp;
+        coarse += store->tile(tx, ty).exp < kFinestExp;
       }
     }
     EXPECT_GT(voidFree, 0);
@@ -178,7 +163,7 @@ TEST(StoreWriters, OneAtATimeAcrossObjectsAndProcesses) {
   const auto crop = rainier(300, 300, 192, 128);
   const auto dir = test::tempDir("lock");
   IngestOptions o;
-  o.metric = {2, kMaxExp};
+  o.metric = {2, kFinestExp};
   ASSERT_TRUE(ingest(dir, crop.georef, {bedrock(gridReader(crop.values))}, o));
   auto a = TileStore::open(dir);
   auto b = TileStore::open(dir);
@@ -229,7 +214,7 @@ TEST(StoreWriters, TouchOnlyTheFilesTheyCreated) {
   std::ofstream(dir / "tiles" / "README") << "mine too";
   std::ofstream(dir / "tiles" / "x0_y0_g1.exr.bak") << "a backup";
   IngestOptions o;
-  o.metric = {2, kMaxExp};
+  o.metric = {2, kFinestExp};
   o.commitEveryTiles = 1;  // a commit (and its sweep of superseded files) after every tile
   ASSERT_TRUE(ingest(dir, crop.georef, {bedrock(gridReader(crop.values))}, o));
   {
@@ -258,7 +243,7 @@ struct Interrupted {
   gis::Raster crop = rainier(500, 420, 384, 256);
   IngestOptions options() const {
     IngestOptions o;
-    o.metric = {1, kMaxExp};
+    o.metric = {1, kFinestExp};
     o.metric.maxErrorM = 5;  // some tiles coarse, some not
     o.commitEveryTiles = 5;
     return o;
@@ -426,7 +411,7 @@ struct Edited {
   explicit Edited(const std::string& name) : dir(test::tempDir(name)) {
     const auto crop = rainier(700, 200, 192, 128);
     IngestOptions o;
-    o.metric = {2, kMaxExp};
+    o.metric = {2, kFinestExp};
     o.metric.maxErrorM = 20;
     auto r = ingest(dir, crop.georef, {bedrock(gridReader(crop.values))}, o);
     STRATA_CHECK(r.ok()) << r.message();

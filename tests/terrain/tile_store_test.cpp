@@ -17,10 +17,14 @@
 #include <strata/terrain/synthetic.hpp>
 #include <strata/terrain/tile_store.hpp>
 
+#include "store_support.hpp"
 #include "strata_test.hpp"
 
 namespace strata::terrain {
 namespace {
+
+using test::bedrock;
+using test::problemsOf;
 
 namespace fs = std::filesystem;
 using gis::Grid;
@@ -55,17 +59,8 @@ IngestOptions smallOptions(bool prefetch = false, TileMetric metric = TileMetric
   return o;
 }
 
-// verify()'s problems, one per line (empty: none).
-std::string problemsOf(const TileStore& s) {
-  std::string out;
-  for (const auto& p : s.verify()) out += p.message + "\n";
-  return out;
-}
-
-IngestSource bedrockFrom(WindowReader r) { return {{"bedrock", LayerKind::Bedrock, ""}, std::move(r)}; }
-
 TileStore ingestScene(const fs::path& dir, int w, int h, const SyntheticScene& s, bool prefetch = false) {
-  auto rep = ingest(dir, planarGeoref(w, h), {bedrockFrom(syntheticReader(s))}, smallOptions(prefetch));
+  auto rep = ingest(dir, planarGeoref(w, h), {bedrock(syntheticReader(s))}, smallOptions(prefetch));
   STRATA_CHECK(rep.ok()) << rep.message();
   auto store = TileStore::open(dir, smallOptions(prefetch).cache);
   STRATA_CHECK(store.ok()) << store.message();
@@ -265,7 +260,7 @@ TEST(TileStore, NonRectangularDomainsLeaveTilesAbsent) {
     }
     return g;
   };
-  auto rep = ingest(dir, planarGeoref(n, n), {bedrockFrom(disc)}, smallOptions());
+  auto rep = ingest(dir, planarGeoref(n, n), {bedrock(disc)}, smallOptions());
   ASSERT_TRUE(rep) << rep.message();
   EXPECT_EQ(rep->tilesAbsent, 4);
   EXPECT_EQ(rep->tilesPresent, 12);
@@ -347,7 +342,7 @@ TEST(TileStore, GlobalLayoutWrapsTheSeamAndFoldsThePoles) {
   auto opts = smallOptions();
   opts.layout = TileLayout::Global;
   opts.metric = {kMaxExp, kMaxExp};  // every tile at full resolution: reads are exact
-  ASSERT_TRUE(ingest(dir, g, {bedrockFrom(reader)}, opts));
+  ASSERT_TRUE(ingest(dir, g, {bedrock(reader)}, opts));
   auto store = TileStore::open(dir);
   ASSERT_TRUE(store);
   // Across the seam: columns 250..255 then 0..5.
@@ -370,7 +365,7 @@ TEST(TileStore, GlobalLayoutWrapsTheSeamAndFoldsThePoles) {
   EXPECT_EQ(south->at(1, 1), value(0, h - 1));
   // A global layout needs a whole-globe geographic grid.
   g.transform.c[1] = 1.0;
-  EXPECT_FALSE(ingest(test::tempDir("bad"), g, {bedrockFrom(reader)}, opts));
+  EXPECT_FALSE(ingest(test::tempDir("bad"), g, {bedrock(reader)}, opts));
 }
 
 TEST(TileCache, KeepsItsBudgetAndHitsOnRereads) {
@@ -591,7 +586,7 @@ TEST(TileStore, LayeredStoresKeepEveryField) {
   auto constant = [](float v) {
     return [v](int, int, int ww, int hh) -> Result<Grid<float>> { return Grid<float>(ww, hh, v); };
   };
-  std::vector<IngestSource> src = {bedrockFrom(syntheticReader(smallScene())),
+  std::vector<IngestSource> src = {bedrock(syntheticReader(smallScene())),
                                    {{"soil", LayerKind::Material, "soil"}, constant(2.0f)},
                                    {{"sand", LayerKind::Material, "sand"}, constant(0.5f)},
                                    {{"water", LayerKind::Water, ""}, constant(0.0f)}};

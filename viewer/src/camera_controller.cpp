@@ -2,13 +2,12 @@
 #include <cmath>
 #include <numbers>
 
+#include <strata/core/angles.hpp>
 #include <strata/viewer/camera_controller.hpp>
 
 namespace strata::viewer {
 
-namespace {
-constexpr double kDeg = std::numbers::pi / 180.0;
-}
+namespace {}
 
 CameraController::CameraController(const render::TerrainScene& scene, FlightParams params)
     : scene_(&scene), params_(params) {

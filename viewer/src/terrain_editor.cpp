@@ -3,6 +3,7 @@
 #include <cstring>
 #include <numbers>
 
+#include <strata/core/angles.hpp>
 #include <strata/gl/state.hpp>
 #include <strata/viewer/shader_slots.hpp>
 #include <strata/viewer/terrain_editor.hpp>
@@ -10,7 +11,6 @@
 namespace strata::viewer {
 
 namespace {
-constexpr double kDeg = std::numbers::pi / 180.0;
 constexpr const char* kToolNames[] = {"raise",  "lower",  "smooth", "flatten", "copy",      "paste",    "water",
                                       "spring", "region", "stamp",  "rain",    "material+", "material-"};
 constexpr const char* kBlendNames[] = {"add", "subtract", "multiply", "replace"};
