@@ -12,7 +12,8 @@
 # reaching one of toml++ 3.3.0's defects aborts instead of passing unnoticed). Each target starts
 # from its seeds and its regression inputs (every input that once crashed, run first, so a
 # regression fails at once); crashes land in build-fuzz/crashes/<target>/ and make the script
-# fail. CI runs `scripts/fuzz.sh 30`.
+# fail. The targets build and run side by side (below); each one's output is in
+# build-fuzz/<target>.build.log and .run.log, printed when it fails. CI runs `scripts/fuzz.sh 30`.
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 seconds=${1:-120}
@@ -97,9 +98,46 @@ for t in "${targets[@]}"; do
     *) echo "fuzz: unknown target '$t' (dem, manifest, scenario)" >&2; exit 2 ;;
   esac
   mkdir -p "$out/seeds/$t" "$out/corpus/$t" "$out/crashes/$t"
-  echo "fuzz: building $t" >&2
-  "build_$t"
-  "seed_$t" "$out/seeds/$t"
-  echo "fuzz: running $t for ${seconds}s" >&2
-  (cd "$out" && "run_$t")
 done
+
+# Waits for the jobs `pids` (one per target, in order); a job that failed has its log printed.
+# Returns 1 when any failed.
+wait_all() {
+  local what=$1 failed=0 i
+  for i in "${!pids[@]}"; do
+    if ! wait "${pids[$i]}"; then
+      echo "fuzz: $what ${targets[$i]} failed; its log, $out/${targets[$i]}.$what.log, ends:" >&2
+      tail -n 80 "$out/${targets[$i]}.$what.log" >&2
+      failed=1
+    fi
+  done
+  return $failed
+}
+
+# The targets build side by side (each build is one compiler process), then fuzz side by side:
+# each is given `seconds` of a core, so when targets outnumber cores each runs for
+# seconds x targets / cores of wall time (CI: 3 targets on 2 cores, 45 s each).
+echo "fuzz: building ${targets[*]}" >&2
+pids=()
+for t in "${targets[@]}"; do
+  "build_$t" > "$out/$t.build.log" 2>&1 &
+  pids+=($!)
+done
+wait_all build
+for t in "${targets[@]}"; do "seed_$t" "$out/seeds/$t"; done
+cores=$(nproc)
+n=${#targets[@]}
+[ "$n" -le "$cores" ] || seconds=$(((seconds * n + cores - 1) / cores))
+echo "fuzz: running ${targets[*]} side by side for ${seconds}s each" >&2
+pids=()
+for t in "${targets[@]}"; do
+  (cd "$out" && "run_$t") > "$out/$t.run.log" 2>&1 &
+  pids+=($!)
+done
+status=0
+wait_all run || status=1
+for t in "${targets[@]}"; do
+  echo "fuzz: $t: $(grep -h '^Done ' "$out/$t.run.log" | tail -n 1)" \
+    "($(grep -h 'stat::new_units_added' "$out/$t.run.log" | tail -n 1 | tr -s ' '))" >&2
+done
+exit $status
