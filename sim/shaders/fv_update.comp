@@ -2,13 +2,13 @@
 // Flood mode: W18 conservative update from the face fluxes, W23 centred bed-slope source,
 // W24 force noise floor, W25 outflow limits (corrector). final = 0: Heun predictor U1 = U0 - dt L(U0) into `stage`;
 // final = 1: U0 - dt (L(U0) + L(U1)) / 2 into stateOut (W22; the depth with compensation, W34),
-// then W19 Manning friction,
-// E5 sediment transport, E0 tilt; the corrector ends with the step's tail when fused (W36,
-// sim_tail.glsl).
+// then W19 Manning friction, E5 sediment transport, W12b the point sources' second halves, E0
+// tilt; the corrector ends with the step's tail when fused (W36, sim_tail.glsl).
 #include "sim.glsl"
 #include "sim_accum.glsl"
 #include "sim_limit.glsl"
 #include "sim_tail.glsl"
+#include "sim_pour.glsl"
 layout(local_size_x = SIM_GROUP_X, local_size_y = SIM_GROUP_Y) in;
 layout(std430, binding = SLOT_BED) readonly buffer Bed { float bed[]; };
 layout(std430, binding = SLOT_STATE_IN) readonly buffer StateIn { vec4 state[]; };
@@ -19,6 +19,7 @@ layout(std430, binding = SLOT_FACE_Y) readonly buffer FaceY { vec4 faceY[]; };
 layout(std430, binding = SLOT_TILT) writeonly buffer Tilt { float tilt[]; };
 layout(std430, binding = SLOT_MANNING) readonly buffer Manning { float manningN2[]; };  // n^2 per cell; < 0: P.manningN
 uniform int final_;
+uniform uint pours;  // W12b: the step has point sources (their second halves are in `pour`)
 vec4 stateAt(int which, int i) { return which == 0 ? state[i] : stage[i]; }
 #include "sim_fv.glsl"
 #include "sim_tilt.glsl"
@@ -113,6 +114,13 @@ bool updateCell(ivec2 p, out vec4 sOut) {
       const float denJ = max(state[j].x * Aj, outflowTotal(q) * dt);
       if (denJ > 0.0) sNew += state[j].y * Aj * (-volOut) / denJ / A;
     }
+  }
+  // W12b: the second half of the step's point source, into the new state (its first half came
+  // before the predictor's faces).
+  const float later = pours != 0u ? pour[i] : 0.0;
+  if (later != 0.0) {
+    hNew = addDepth(hNew, i, later);
+    pour[i] = 0.0;
   }
   sOut = vec4(hNew, sNew, huNew, hvNew);
   stateOut[i] = sOut;

@@ -18,6 +18,8 @@ layout(std430, binding = SLOT_MAX_SPEED) buffer MaxSpeed { uint maxSpeedBits; };
 layout(std430, binding = SLOT_SOURCES) buffer Sources { SourceEntry entries[]; };
 layout(std430, binding = SLOT_SERIES) readonly buffer Series { dvec2 samples[]; };
 layout(std430, binding = SLOT_TERMS) readonly buffer Terms { Term terms[]; };
+#define POUR_INTO_STATE
+#include "sim_pour.glsl"
 
 // core/src/time_series.cpp: straight lines between samples, the end values held.
 double seriesAt(uint first, uint count, double t) {
@@ -121,8 +123,7 @@ void main() {
   if (C.pointSources != 0u) {  // point_sources.comp's W12, each entry once (after its last term)
     for (uint k = 0u; k < C.termCount; ++k) {
       if (k + 1u < C.termCount && terms[k + 1u].entry == terms[k].entry) continue;
-      const SourceEntry e = entries[terms[k].entry];
-      state[e.cell].x = addDepth(state[e.cell].x, int(e.cell), pointSourceDepth(e));
+      pourPointSource(entries[terms[k].entry]);
     }
   }
   C.timeS = t1;

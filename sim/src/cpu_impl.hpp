@@ -230,9 +230,9 @@ struct Impl {
   void setRain(const gis::Grid<float>& mmPerHour);
 
   // ---- passes (cpu_water.cpp) ----
-  void sourcesPass(const std::vector<SourceEntry>& entries);
-  void rainPass(const BlockSet& set);                       // W11, W11b on the set's cells
-  void pointSources(std::span<const SourceEntry> entries);  // W12
+  void sourcesPass(const std::vector<SourceEntry>& entries, float share = 1.0f);
+  void rainPass(const BlockSet& set);                                           // W11, W11b on the set's cells
+  void pointSources(std::span<const SourceEntry> entries, float share = 1.0f);  // W12, W12b
   // W11 or W11b can change a cell: rain (uniform or a raster), evaporation or infiltration.
   bool rainOrLosses() const {
     return p.rainMmPerHour != 0.0f || !rain.empty() || p.evaporationMmPerHour != 0.0f || !infilKs.empty();

@@ -488,7 +488,7 @@ void Impl::step(const std::vector<SourceEntry>& entries, const std::vector<Level
     fvLimitPass();
     inertialUpdatePass();
   } else {
-    sourcesPass(entries);
+    sourcesPass(entries, 0.5f);  // W12b: half of the point sources before the faces
     fvFacePass(now(), false);
     fvUpdatePass(false);
     fvFacePass(stage, true);
@@ -497,6 +497,7 @@ void Impl::step(const std::vector<SourceEntry>& entries, const std::vector<Level
     fvUpdatePass(true);
   }
   cur = 1 - cur;
+  if (p.waterModel == WaterModel::kFiniteVolume && !inertial()) pointSources(entries, 0.5f);  // W12b: the other half
   if (!levels.empty()) levelPass(levels);
   if (p.erosionEnabled) erosionPass();
   if (p.thermalEnabled) {

@@ -67,9 +67,10 @@ STRATA_ROW_KERNEL void infiltrationRow(float* h, float* herr, float* sum, float*
 // sim/shaders/sources.comp: rain (W11), evaporation (W11), infiltration (W11b), then
 // point_sources.comp (W12). Without rain, evaporation or infiltration W11 and W11b change nothing
 // (adding 0 leaves a settled depth as it is) and are skipped, as the GL backend skips the pass.
-void Impl::sourcesPass(const std::vector<SourceEntry>& entries) {
+// `share` of each point source's step (W12b: the finite-volume scheme pours it in two halves).
+void Impl::sourcesPass(const std::vector<SourceEntry>& entries, float share) {
   if (rainOrLosses()) rainPass(sources);
-  pointSources(entries);
+  pointSources(entries, share);
 }
 
 void Impl::rainPass(const BlockSet& set) {
@@ -87,10 +88,10 @@ void Impl::rainPass(const BlockSet& set) {
   });
 }
 
-void Impl::pointSources(std::span<const SourceEntry> entries) {
+void Impl::pointSources(std::span<const SourceEntry> entries, float share) {
   for (const auto& e : entries) {
     const int y = int(e.cell / uint32_t(w)), x = int(e.cell % uint32_t(w));
-    addDepth(now().h.at(x, y), accum[kAccumDepthError].at(x, y), e.rateM3S * dt / rowArea[size_t(y)]);
+    addDepth(now().h.at(x, y), accum[kAccumDepthError].at(x, y), share * (e.rateM3S * dt / rowArea[size_t(y)]));
   }
 }
 

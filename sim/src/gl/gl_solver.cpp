@@ -47,7 +47,8 @@ struct GlSolver::Impl {
 
   gl::Buffer params, materials, rowDx, base, bed, layerBuf, stateA, stateB, stage, flux, fluxDiag, faceX, faceY, tilt,
       accum, rain, manning, infiltration, thermal, scour, sourceEntries, maxSpeed, floodStats, fvLimit, levelEntries,
-      clock, series, terms;  // W35's clock, the sources' samples and their shares of the entries
+      clock, series, terms,  // W35's clock, the sources' samples and their shares of the entries
+      pour;                  // W12b: what the finite-volume corrector adds of the point sources
   bool aIsCurrent = true;
   bool rasterRain = false;   // the rain raster has a cell that rains
   bool infiltrates = false;  // W11b: the input gave infiltration rates
@@ -94,6 +95,7 @@ struct GlSolver::Impl {
     clock.bind(slots::kClock);
     series.bind(slots::kSeries);
     terms.bind(slots::kTerms);
+    pour.bind(slots::kPour);
   }
 
   // A pass over `x` x `y` invocations of `shape`: directly, or in a device step as step_clock.comp
@@ -220,6 +222,7 @@ struct GlSolver::Impl {
       run(pFvLimit, kShapeGrid, w, h);
       barrier();
       pFvUpdate.set("final_", 1);
+      pFvUpdate.set("pours", sourceEntryCount > 0 ? 1u : 0u);  // W12b
       setTail(pFvUpdate, tailSpeed, tailStats, wetThresholdM);
       run(pFvUpdate, kShapeGrid, w, h);
       barrier();
@@ -518,6 +521,8 @@ Result<GlSolver> GlSolver::create(const SimInput& input, const SimParams& params
   s.faceY.fill(0u);
   s.fvLimit = gl::Buffer(flood ? 4 * n : 16);
   s.fvLimit.fill(0u);
+  s.pour = gl::Buffer(flood ? 4 * n : 16);
+  s.pour.fill(0u);
   s.tilt = gl::Buffer(4 * n);
   s.tilt.fill(0u);
   s.accum = gl::Buffer(sizeof(float) * kAccumPerCell * n);
