@@ -260,6 +260,7 @@ struct Impl {
   void inertialUpdatePass() { inertialUpdatePass(water); }
   void inertialUpdatePass(const BlockSet& set);
   float inertialFaceAt(int x, int y, bool alongX, float q0) const;
+  float inertialFaceAt(int x, int y, bool alongX, float q0, float ha, float hb) const;  // with these depths
   bool inPlace = false;  // inertialUpdatePass updates now() (W37), not next()
 
   // ---- local time steps (W37, cpu_local_steps.cpp) ----
@@ -267,17 +268,20 @@ struct Impl {
   /// or north of it and the cell east or south), and what it carries reaches the coarser cell
   /// each time the finer cell takes it.
   struct LevelFace {
-    int x, y;      // cell a
-    bool alongX;   // an x face (b = (x + 1, y)), else a y face (b = (x, y + 1))
-    bool fineIsA;  // a is the finer cell
-    int level;     // the finer cell's
+    int x, y;       // cell a
+    bool alongX;    // an x face (b = (x + 1, y)), else a y face (b = (x, y + 1))
+    bool fineIsA;   // a is the finer cell
+    int level;      // the finer cell's
+    size_t coarse;  // the coarser cell's LevelCell
   };
   /// A cell beside a finer block: its W25 limit over its own step, the volume it may still give
-  /// through its faces to finer cells, and its faces to finer cells (bits W, E, N, S).
+  /// through its faces to finer cells, its faces to finer cells (bits W, E, N, S), and the depth
+  /// it holds at the midpoint of its step beyond the depth it has then (W37's time interpolation).
   struct LevelCell {
     int x, y, level;
     float limit, budget;
     uint8_t finer;
+    float ahead;
   };
   std::vector<uint8_t> blockLevel;  // per block
   // Per block: max sqrt(g h), the sources' depth rate and the faces' inflow rate (m/s).

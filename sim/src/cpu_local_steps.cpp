@@ -164,7 +164,7 @@ void Impl::findLevelFaces() {
     const int la = levelOf(x, y), lb = levelOf(xb, yb);
     if (la == lb || !runs(x, y) || !runs(xb, yb)) return;
     const bool fineIsA = la < lb;
-    levelFaces.push_back(LevelFace{x, y, alongX, fineIsA, std::min(la, lb)});
+    levelFaces.push_back(LevelFace{x, y, alongX, fineIsA, std::min(la, lb), 0});
     if (fineIsA) {
       coarse.emplace_back(size_t(yb) * size_t(w) + size_t(xb), alongX ? kW : kN);
     } else {
@@ -189,7 +189,15 @@ void Impl::findLevelFaces() {
     uint8_t bits = 0;
     for (; i < coarse.size() && coarse[i].first == cell; ++i) bits = uint8_t(bits | coarse[i].second);
     const int x = int(cell % size_t(w)), y = int(cell / size_t(w));
-    levelCells.push_back(LevelCell{x, y, levelOf(x, y), 1.0f, 0.0f, bits});
+    levelCells.push_back(LevelCell{x, y, levelOf(x, y), 1.0f, 0.0f, bits, 0.0f});
+  }
+  for (auto& f : levelFaces) {  // levelCells are in the order of their cells
+    const int xc = f.fineIsA ? (f.alongX ? f.x + 1 : f.x) : f.x, yc = f.fineIsA ? (f.alongX ? f.y : f.y + 1) : f.y;
+    f.coarse = size_t(std::lower_bound(levelCells.begin(), levelCells.end(), std::pair{yc, xc},
+                                       [](const LevelCell& c, std::pair<int, int> at) {
+                                         return std::pair{c.y, c.x} < at;
+                                       }) -
+                      levelCells.begin());
   }
 }
 
@@ -259,15 +267,38 @@ void Impl::localStep(const std::vector<SourceEntry>& entries, const std::vector<
       dt = dtOf(m);
       inertialFacePass(levelWater[size_t(m)]);
     }
+    // Halfway through the coarser cell's step, its face to the finer cell sees it as it stands
+    // then (Berger and Oliger's time interpolation): its depth less what it holds ahead of that
+    // time (LevelCell::ahead).
     for (const auto& f : levelFaces) {
       if (!starts(f.level)) continue;
       dt = dtOf(f.level);
-      faceOf(f) = inertialFaceAt(f.x, f.y, f.alongX, f.fineIsA ? appliedA(f) : appliedB(f));
+      const LevelCell& c = levelCells[f.coarse];
+      const float hc = starts(f.level + 1) ? u.h.at(c.x, c.y) : maxOf(u.h.at(c.x, c.y) - c.ahead, 0.0f);
+      const float hf = f.fineIsA ? u.h.at(f.x, f.y) : u.h.at(f.alongX ? f.x + 1 : f.x, f.alongX ? f.y : f.y + 1);
+      faceOf(f) = inertialFaceAt(f.x, f.y, f.alongX, f.fineIsA ? appliedA(f) : appliedB(f), f.fineIsA ? hf : hc,
+                                 f.fineIsA ? hc : hf);
     }
     for (int m = 0; m <= M; ++m) {
       if (!starts(m)) continue;
       dt = dtOf(m);
+      for (auto& c : levelCells) {
+        if (c.level == m) c.ahead = u.h.at(c.x, c.y);
+      }
       if (rains) rainPass(levelRain[size_t(m)]);
+      // What a coarser cell holds at the midpoint of its step beyond the depth it has then: half
+      // of what W11 and W11b poured in at its start (W38), less half of what its faces to cells
+      // of its own level bring over the step (their flow is applied at its end).
+      for (auto& c : levelCells) {
+        if (c.level != m) continue;
+        const int x = c.x, y = c.y;
+        float in = 0.0f;  // m^3/s
+        if (!(c.finer & kW)) in += faceX.mass.at(x, y) * dy;
+        if (!(c.finer & kE)) in -= faceX.mass.at(x + 1, y) * dy;
+        if (!(c.finer & kN)) in += faceY.mass.at(x, y) * faceWidthY[size_t(y)];
+        if (!(c.finer & kS)) in -= faceY.mass.at(x, y + 1) * faceWidthY[size_t(y) + 1];
+        c.ahead = 0.5f * ((u.h.at(x, y) - c.ahead) - in * dt / rowArea[size_t(y)]);
+      }
       if (m == 0) pointSources(entries);  // a point source's block is level 0 (planLevels)
       fvLimitPass(levelWater[size_t(m)]);
     }
@@ -312,8 +343,7 @@ void Impl::localStep(const std::vector<SourceEntry>& entries, const std::vector<
       // same float term W34 added to the finer cell's depth (on rows of equal area).
       for (const auto& f : levelFaces) {
         if (f.level != m) continue;
-        const int xc = f.fineIsA ? (f.alongX ? f.x + 1 : f.x) : f.x;
-        const int yc = f.fineIsA ? (f.alongX ? f.y : f.y + 1) : f.y;
+        const int xc = levelCells[f.coarse].x, yc = levelCells[f.coarse].y;
         const float term = dt / rowArea[size_t(yc)] * ((f.fineIsA ? appliedA(f) : appliedB(f)) * widthOf(f));
         addDepth(u.h.at(xc, yc), accum[kAccumDepthError].at(xc, yc), f.fineIsA ? term : -term);
       }

@@ -984,14 +984,19 @@ void Impl::inertialFacePass(const BlockSet& set) {
 // between blocks of two levels with the finer cell's q0).
 float Impl::inertialFaceAt(int x, int y, bool alongX, float q0) const {
   const int xb = alongX ? x + 1 : x, yb = alongX ? y : y + 1;
-  const Water& u = now();
+  return inertialFaceAt(x, y, alongX, q0, now().h.at(x, y), now().h.at(xb, yb));
+}
+
+// The same with depths ha and hb for the two cells (W37: a coarser cell's midway through its step).
+float Impl::inertialFaceAt(int x, int y, bool alongX, float q0, float ha, float hb) const {
+  const int xb = alongX ? x + 1 : x, yb = alongX ? y : y + 1;
   const float n2u = p.manningN * p.manningN;
   const float n2 = manningN2.empty() ? n2u : 0.5f * (manningN2.at(x, y) + manningN2.at(xb, yb));
   // The faces across: north and south of both cells for an x face, west and east for a y face.
   const int t0 = alongX ? 2 : 0, t1 = alongX ? 3 : 1;
   const float qt = 0.25f * ((flux[t0].at(x, y) + flux[t1].at(x, y)) + (flux[t0].at(xb, yb) + flux[t1].at(xb, yb)));
-  return inertialFace(q0, qt, bed.at(x, y), u.h.at(x, y), bed.at(xb, yb), u.h.at(xb, yb),
-                      alongX ? rowDx[size_t(y)] : dy, dt * p.gravityMS2, n2, p.dryDepthM);
+  return inertialFace(q0, qt, bed.at(x, y), ha, bed.at(xb, yb), hb, alongX ? rowDx[size_t(y)] : dy, dt * p.gravityMS2,
+                      n2, p.dryDepthM);
 }
 
 // One row of the local-inertial update's inputs and outputs.
