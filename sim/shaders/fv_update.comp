@@ -19,7 +19,7 @@ layout(std430, binding = SLOT_FACE_Y) readonly buffer FaceY { vec4 faceY[]; };
 layout(std430, binding = SLOT_TILT) writeonly buffer Tilt { float tilt[]; };
 layout(std430, binding = SLOT_MANNING) readonly buffer Manning { float manningN2[]; };  // n^2 per cell; < 0: P.manningN
 uniform int final_;
-uniform uint pours;  // W12b: the step has point sources (their second halves are in `pour`)
+uniform uint pours;  // W12b: the step has point sources (their second halves wait in ACCUM_POUR)
 vec4 stateAt(int which, int i) { return which == 0 ? state[i] : stage[i]; }
 #include "sim_fv.glsl"
 #include "sim_tilt.glsl"
@@ -117,10 +117,10 @@ bool updateCell(ivec2 p, out vec4 sOut) {
   }
   // W12b: the second half of the step's point source, into the new state (its first half came
   // before the predictor's faces).
-  const float later = pours != 0u ? pour[i] : 0.0;
+  const float later = pours != 0u ? accum[pourAt(i)] : 0.0;
   if (later != 0.0) {
     hNew = addDepth(hNew, i, later);
-    pour[i] = 0.0;
+    accum[pourAt(i)] = 0.0;
   }
   sOut = vec4(hNew, sNew, huNew, hvNew);
   stateOut[i] = sOut;

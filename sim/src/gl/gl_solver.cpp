@@ -36,7 +36,8 @@ std::vector<gl::ShaderDefine> slots::kernelDefines() {
                      {"ACCUM_SEDIMENT_OUT", kAccumSedimentOut},
                      {"ACCUM_LEVEL", kAccumLevel},
                      {"ACCUM_INFILTRATED", kAccumInfiltrated},
-                     {"ACCUM_DEPTH_ERROR", kAccumDepthError}});
+                     {"ACCUM_DEPTH_ERROR", kAccumDepthError},
+                     {"ACCUM_POUR", kAccumPerCell}});  // W12b: a plane after the accumulators
   return d;
 }
 
@@ -47,8 +48,7 @@ struct GlSolver::Impl {
 
   gl::Buffer params, materials, rowDx, base, bed, layerBuf, stateA, stateB, stage, flux, fluxDiag, faceX, faceY, tilt,
       accum, rain, manning, infiltration, thermal, scour, sourceEntries, maxSpeed, floodStats, fvLimit, levelEntries,
-      clock, series, terms,  // W35's clock, the sources' samples and their shares of the entries
-      pour;                  // W12b: what the finite-volume corrector adds of the point sources
+      clock, series, terms;  // W35's clock, the sources' samples and their shares of the entries
   bool aIsCurrent = true;
   bool rasterRain = false;   // the rain raster has a cell that rains
   bool infiltrates = false;  // W11b: the input gave infiltration rates
@@ -95,7 +95,6 @@ struct GlSolver::Impl {
     clock.bind(slots::kClock);
     series.bind(slots::kSeries);
     terms.bind(slots::kTerms);
-    pour.bind(slots::kPour);
   }
 
   // A pass over `x` x `y` invocations of `shape`: directly, or in a device step as step_clock.comp
@@ -521,11 +520,10 @@ Result<GlSolver> GlSolver::create(const SimInput& input, const SimParams& params
   s.faceY.fill(0u);
   s.fvLimit = gl::Buffer(flood ? 4 * n : 16);
   s.fvLimit.fill(0u);
-  s.pour = gl::Buffer(flood ? 4 * n : 16);
-  s.pour.fill(0u);
   s.tilt = gl::Buffer(4 * n);
   s.tilt.fill(0u);
-  s.accum = gl::Buffer(sizeof(float) * kAccumPerCell * n);
+  // The accumulators' planes, then W12b's plane of point sources' second halves (ACCUM_POUR).
+  s.accum = gl::Buffer(sizeof(float) * (kAccumPerCell + 1) * n);
   s.accum.fill(0u);
   s.rain = gl::Buffer::from(std::span<const float>(rain));
   s.rasterRain = std::any_of(rain.begin(), rain.end(), [](float r) { return r != 0.0f; });

@@ -45,13 +45,11 @@ inline constexpr gl::Binding kInfiltration{"SLOT_INFILTRATION", kBuf, 26,
 inline constexpr gl::Binding kClock{"SLOT_CLOCK", kBuf, 27, "ClockBlock"};  ///< W35: GpuClock, the GPU's clock
 inline constexpr gl::Binding kSeries{"SLOT_SERIES", kBuf, 28, "Series"};    ///< W35: the sources' samples (t, q)
 inline constexpr gl::Binding kTerms{"SLOT_TERMS", kBuf, 29, "Terms"};       ///< W35: GpuTerm per source and entry
-inline constexpr gl::Binding kPour{"SLOT_POUR", kBuf, 30, "Pour"};          ///< W12b: point sources' second halves
 
 inline constexpr gl::Binding kAll[] = {
-    kParams,  kMaterials, kRowDx,        kBase,       kBed,     kLayers, kStateIn,  kStateOut,
-    kStage,   kFlux,      kFaceX,        kFaceY,      kTilt,    kAccum,  kRain,     kThermal,
-    kSources, kMaxSpeed,  kFluxDiag,     kFloodStats, kFvLimit, kLevels, kCopyGrid, kCopyPacked,
-    kScour,   kManning,   kInfiltration, kClock,      kSeries,  kTerms,  kPour};
+    kParams,  kMaterials, kRowDx,    kBase,       kBed,   kLayers,  kStateIn,      kStateOut, kStage,    kFlux,
+    kFaceX,   kFaceY,     kTilt,     kAccum,      kRain,  kThermal, kSources,      kMaxSpeed, kFluxDiag, kFloodStats,
+    kFvLimit, kLevels,    kCopyGrid, kCopyPacked, kScour, kManning, kInfiltration, kClock,    kSeries,   kTerms};
 
 /// What the kernels compile with: this table's slots and the accumulators' layout as
 /// ACCUM_PER_CELL, ACCUM_OUTFLOW, ... (sim::AccumOffset).
