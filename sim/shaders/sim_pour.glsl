@@ -6,7 +6,7 @@
 // what it added back to 0. A plane of a buffer these kernels bind already, not a block of its own:
 // a kernel may declare 16 storage blocks (GL_MAX_COMPUTE_SHADER_STORAGE_BLOCKS on llvmpipe and
 // NVIDIA; a 17th fails the link) and fv_update.comp declares 15. Needs sim_accum.glsl.
-bool splitsPour() { return P.waterModel == 1 && P.floodScheme == 0; }
+bool splitsPour() { return P.waterModel == 1 && P.floodScheme == 0; }  // flood mode, finite volumes
 uint pourAt(int cell) { return accumAt(cell, ACCUM_POUR); }
 #ifdef POUR_INTO_STATE
 // W12 for one entry (point_sources.comp, step_clock.comp); `state` is the step's state.

@@ -268,11 +268,13 @@ struct Impl {
   /// or north of it and the cell east or south), and what it carries reaches the coarser cell
   /// each time the finer cell takes it.
   struct LevelFace {
-    int x, y;       // cell a
-    bool alongX;    // an x face (b = (x + 1, y)), else a y face (b = (x, y + 1))
-    bool fineIsA;   // a is the finer cell
-    int level;      // the finer cell's
-    size_t coarse;  // the coarser cell's LevelCell
+    int x, y;                                      // cell a
+    bool alongX;                                   // an x face (b = (x + 1, y)), else a y face (b = (x, y + 1))
+    bool fineIsA;                                  // a is the finer cell
+    int level;                                     // the finer cell's
+    size_t coarse;                                 // the coarser cell's LevelCell
+    int xb() const { return alongX ? x + 1 : x; }  // cell b
+    int yb() const { return alongX ? y : y + 1; }
   };
   /// A cell beside a finer block: its W25 limit over its own step, the volume it may still give
   /// through its faces to finer cells, its faces to finer cells (bits W, E, N, S), and the depth

@@ -192,8 +192,8 @@ void Impl::findLevelFaces() {
     levelCells.push_back(LevelCell{x, y, levelOf(x, y), 1.0f, 0.0f, bits, 0.0f});
   }
   for (auto& f : levelFaces) {  // levelCells are in the order of their cells
-    const int xc = f.fineIsA ? (f.alongX ? f.x + 1 : f.x) : f.x, yc = f.fineIsA ? (f.alongX ? f.y : f.y + 1) : f.y;
-    f.coarse = size_t(std::lower_bound(levelCells.begin(), levelCells.end(), std::pair{yc, xc},
+    const auto cell = f.fineIsA ? std::pair{f.yb(), f.xb()} : std::pair{f.y, f.x};
+    f.coarse = size_t(std::lower_bound(levelCells.begin(), levelCells.end(), cell,
                                        [](const LevelCell& c, std::pair<int, int> at) {
                                          return std::pair{c.y, c.x} < at;
                                        }) -
@@ -273,11 +273,10 @@ void Impl::localStep(const std::vector<SourceEntry>& entries, const std::vector<
     for (const auto& f : levelFaces) {
       if (!starts(f.level)) continue;
       dt = dtOf(f.level);
-      const LevelCell& c = levelCells[f.coarse];
-      const float hc = starts(f.level + 1) ? u.h.at(c.x, c.y) : maxOf(u.h.at(c.x, c.y) - c.ahead, 0.0f);
-      const float hf = f.fineIsA ? u.h.at(f.x, f.y) : u.h.at(f.alongX ? f.x + 1 : f.x, f.alongX ? f.y : f.y + 1);
-      faceOf(f) = inertialFaceAt(f.x, f.y, f.alongX, f.fineIsA ? appliedA(f) : appliedB(f), f.fineIsA ? hf : hc,
-                                 f.fineIsA ? hc : hf);
+      float ha = u.h.at(f.x, f.y), hb = u.h.at(f.xb(), f.yb());
+      float& coarse = f.fineIsA ? hb : ha;
+      if (!starts(f.level + 1)) coarse = maxOf(coarse - levelCells[f.coarse].ahead, 0.0f);
+      faceOf(f) = inertialFaceAt(f.x, f.y, f.alongX, f.fineIsA ? appliedA(f) : appliedB(f), ha, hb);
     }
     for (int m = 0; m <= M; ++m) {
       if (!starts(m)) continue;
