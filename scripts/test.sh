@@ -33,7 +33,7 @@ if [ "${1:-}" = "--sanitize" ]; then
   # which a sanitized rank's stop may exceed; its report-first order is every run's.
   # SimCpu.TheDefaultThreads... times the thread tuner against one thread: a timing, not a code path
   # the sanitizers would check beyond what ResultsDoNotDependOnTheThreadCount runs.
-  # The 150,000-step balance tests (CPU 7 s, GL 190 s unsanitized) take W34's paths that every
+  # The 150,000-step balance tests (CPU 4 s, GL 95 s unsanitized) take W34's paths that every
   # flood and rain test here takes in a few hundred steps.
   # EA test 4's plain with local steps against one step (2.7 s unsanitized, 29 s sanitized) and
   # its fed cell in nine runs (4.9 s unsanitized): their local-step, point-source and

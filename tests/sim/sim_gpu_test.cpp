@@ -138,7 +138,7 @@ TEST_F(GlTest, SimRainAndSourcesBalance) {
 // BalanceHoldsOver150kFloat32Steps) close the budget to 1e-5 of the water with either scheme.
 TEST_F(GlTest, SimBalanceHoldsOver150kFloat32Steps) {
   for (auto scheme : {strata::sim::FloodScheme::kFiniteVolume, strata::sim::FloodScheme::kLocalInertial}) {
-    auto sim = GlSolver::create(test::sloshingBox(16), test::longRainParams(scheme));
+    auto sim = GlSolver::create(test::longRainBox(), test::longRainParams(scheme));
     ASSERT_TRUE(sim) << sim.message();
     ASSERT_TRUE(sim->addSource(test::longRainSpring()));
     const auto t0 = std::chrono::steady_clock::now();

@@ -199,7 +199,7 @@ TEST(SimWaterCpu, SourcesOutflowAndEvaporationBalance) {
 // to 1e-5 of the water, with either scheme (before W34: 1.5e-3 and 2.6e-3).
 TEST(SimWaterCpu, BalanceHoldsOver150kFloat32Steps) {
   for (auto scheme : {FloodScheme::kFiniteVolume, FloodScheme::kLocalInertial}) {
-    auto sim = CpuSolver::create(test::sloshingBox(16), test::longRainParams(scheme));
+    auto sim = CpuSolver::create(test::longRainBox(), test::longRainParams(scheme));
     ASSERT_TRUE(sim) << sim.message();
     ASSERT_TRUE(sim->addSource(test::longRainSpring()));
     sim->step(int(test::kLongRainSteps));
@@ -209,7 +209,8 @@ TEST(SimWaterCpu, BalanceHoldsOver150kFloat32Steps) {
                 int(scheme), st.steps, st.timeS, st.rainM3, st.inflowM3, st.initialWaterM3, st.storedWaterM3,
                 st.waterBalanceM3() / water);
     EXPECT_EQ(st.steps, test::kLongRainSteps);
-    EXPECT_NEAR(st.rainM3, 10.0 / 3.6e6 * 30000.0 * 80.0 * 80.0, 1e-6 * st.rainM3);
+    const double side = 5.0 * test::kLongRainCells;  // m
+    EXPECT_NEAR(st.rainM3, 10.0 / 3.6e6 * 30000.0 * side * side, 1e-6 * st.rainM3);
     EXPECT_LT(std::abs(st.waterBalanceM3()), 1e-5 * water) << int(scheme);
   }
 }
