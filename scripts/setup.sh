@@ -76,10 +76,11 @@ werror=${STRATA_WERROR:-OFF}
 # Configure only when the build folder is new or its settings changed (cmake re-runs itself
 # when a CMakeLists.txt changes).
 # The sanitizer build leaves the benchmarks out (no test runs them; the normal build compiles them)
-# and compiles at -O1 with line tables only (-g1: enough for symbolized reports), ASan's usual
-# level: its translation units compile 2.2-2.4x faster than at -O2 -g (scenario_domain_test.cpp
-# 18.4 -> 8.2 s, terrain_renderer.cpp 14.9 -> 6.2 s, measured side by side), which is most of
-# CI's time. The CPU kernels keep their own -O3 (sim/CMakeLists.txt).
+# and compiles at -Og with line tables only (-g1: enough for symbolized reports). Its compile is
+# most of CI's time: -Og took the sanitized tree 378 s against 572 s at -O1 (794 / 1,179 s of
+# compiler time; -O1 was itself 2.2-2.4x faster a file than -O2 -g), and its tests 578 s
+# against 530 s (2 cores, one after the other, 2026-11-29; docs/testing.md). The CPU kernels keep
+# their own -O3 (sim/CMakeLists.txt).
 # STRATA_LINE_TABLES=1 (set by .ci/run) gives the normal build line tables only, at -O2: a cold
 # build is a third of CI's time and -g1 compiles a third faster (terrain_render_test.cpp 22.0 -> 15.6 s,
 # cmd_generate.cpp 20.1 -> 14.4 s, side by side); backtraces still name file and line.
@@ -87,7 +88,7 @@ bench=ON
 opt_flags=()
 if [ -n "$sanitize" ]; then
   bench=OFF
-  opt_flags=(-DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG")
+  opt_flags=(-DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-Og -g1 -DNDEBUG")
 elif [ "${STRATA_LINE_TABLES:-0}" = "1" ]; then
   opt_flags=(-DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g1 -DNDEBUG")
 fi
