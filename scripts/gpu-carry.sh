@@ -7,10 +7,10 @@
 #   .gpub/  the stripped programs (benchmarks and GPU test binaries) as one xz tarball, and the
 #           Moon, Mars and Earth DEMs of ../shared/data (the Grand Canyon's go with .gpur)
 #   .gpur/  GDAL's library chain and PROJ/GDAL data as xz tarballs, the Grand Canyon DEMs
-#   .gpua/  OpenImageIO's chain (the render, scenario and viewer tests and `strata` need it)
-#           and the Rainier DEM
-# GDAL's and OpenImageIO's chains do not fit in one call together: carry .gpur first, then
-# .gpua in the next call while the machine is still warm (30 s); .gpu/libs.sh unpacks each once
+#   .gpua/  what `strata` and the render tests load beyond those (Open MPI's libraries; until
+#           2026-11-29 OpenImageIO's chain, which nothing carried loads now) and the Rainier DEM
+# Carry .gpur first, then .gpua in the next call while the machine is still warm (30 s): GDAL's
+# and OpenImageIO's chains did not fit in one call together; .gpu/libs.sh unpacks each once
 # into /tmp/sl there and keeps it for later calls on the same machine. For example:
 #   run(carry [.gl .gpu .gpur .gpub]): . .gpu/env.sh; . .gpu/libs.sh; ./.gpu/unpack-programs.sh;
 #       /tmp/tb/strata_bench_sim --benchmark_filter=/gl/

@@ -33,7 +33,9 @@ packages=(
   cmake ninja-build g++ pkg-config clang clang-format libclang-rt-14-dev
   # gis: raster I/O, CRS, reprojection, geodesy
   libgdal-dev gdal-bin libgeographiclib-dev
-  # images, float fields, tiled storage
+  # float fields, tiled storage (OpenEXR); OpenImageIO reads and writes test images only: its
+  # 260-library chain cost every process that loaded it 0.21 s of start-up (2026-11-29), so
+  # Strata's own PNGs go through GDAL's PNG driver and its EXRs through OpenEXR
   libopenimageio-dev openimageio-tools libopenexr-dev
   # GL 4.5 through EGL (Mesa llvmpipe without a GPU), windows through GLFW (X11 -> Xvfb in tests)
   libegl-dev libegl-mesa0 libgl1-mesa-dri libepoxy-dev libglfw3-dev libglm-dev xvfb xauth

@@ -1,7 +1,6 @@
 // strata generate SCRIPT -o OUT: procedural terrain from a generation script (docs/procgen.md),
 // one file per material layer: a GeoTIFF (gis::writeGeoTiff) when the script gives a
 // georeference, else a float EXR (no CRS to write).
-#include <OpenImageIO/imageio.h>
 
 #include <cstdio>
 #include <filesystem>
@@ -13,6 +12,7 @@
 #include <strata/gl/context.hpp>
 #include <strata/procgen/generator.hpp>
 #include <strata/procgen/script_file.hpp>
+#include <strata/render/image_io.hpp>
 
 #include "commands.hpp"
 
@@ -40,19 +40,15 @@ Status writeLayerGeoTiff(const std::filesystem::path& target, const gis::Grid<fl
 Status writeExr(const std::filesystem::path& target, const gis::Grid<float>& heights, const std::string& script,
                 uint32_t seed) {
   const auto temporary = temporaryPathFor(target);
-  auto out = OIIO::ImageOutput::create("openexr");
-  if (!out) return fail(target.string() + ": OpenImageIO has no EXR writer");
-  OIIO::ImageSpec spec(heights.width, heights.height, 1, OIIO::TypeDesc::FLOAT);
-  spec.channelnames = {"Y"};
-  spec.attribute("compression", "zip");
-  spec.attribute("strata:script", script);
-  spec.attribute("strata:seed", int(seed));
-  spec.attribute("strata:units", "m");
-  if (!out->open(temporary.string(), spec) || !out->write_image(OIIO::TypeDesc::FLOAT, heights.data.data()) ||
-      !out->close()) {
+  render::ExrExtras extras;
+  extras.channelNames = {"Y"};
+  extras.strings = {{"strata:script", script}, {"strata:units", "m"}};
+  extras.ints = {{"strata:seed", int(seed)}};
+  if (auto st = render::writeImageFloat(temporary.string(), heights.width, heights.height, 1, heights.data, extras);
+      !st) {
     std::error_code ec;
     std::filesystem::remove(temporary, ec);
-    return fail(target.string() + ": cannot write EXR: " + out->geterror());
+    return fail(target.string() + ": cannot write EXR: " + st.message());
   }
   return commitTemporary(temporary, target);
 }

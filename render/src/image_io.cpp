@@ -1,56 +1,73 @@
 #include <strata/render/image_io.hpp>
 
-#include <OpenImageIO/imageio.h>
+#include <OpenEXR/ImfChannelList.h>
+#include <OpenEXR/ImfFrameBuffer.h>
+#include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfIntAttribute.h>
+#include <OpenEXR/ImfOutputFile.h>
+#include <OpenEXR/ImfStringAttribute.h>
 
-#include <strata/core/files.hpp>
+#include <algorithm>
+#include <cctype>
+#include <exception>
 
 namespace strata::render {
 namespace {
 
-Status writeImage(const std::string& path, int width, int height, int channels, OIIO::TypeDesc type, const void* data) {
-  auto out = OIIO::ImageOutput::create(path);
-  if (!out) return fail(path + ": cannot create an image writer: " + OIIO::geterror());
-  OIIO::ImageSpec spec(width, height, channels, type);
-  if (type == OIIO::TypeDesc::FLOAT) spec.attribute("compression", "zip");
-  if (!out->open(path, spec)) return fail(path + ": cannot open for writing: " + out->geterror());
-  if (!out->write_image(type, data)) return fail(path + ": write failed: " + out->geterror());
-  if (!out->close()) return fail(path + ": close failed: " + out->geterror());
-  return {};
+std::string sizeText(int width, int height, int channels) {
+  return std::to_string(width) + "x" + std::to_string(height) + "x" + std::to_string(channels);
+}
+
+bool endsWithPng(const std::string& path) {
+  if (path.size() < 4) return false;
+  std::string ext = path.substr(path.size() - 4);
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  return ext == ".png";
 }
 
 }  // namespace
 
 Status writeImage8(const std::string& path, int width, int height, int channels, std::span<const uint8_t> pixels) {
-  if (pixels.size() != size_t(width) * size_t(height) * size_t(channels)) {
-    return fail(path + ": " + std::to_string(pixels.size()) + " bytes for a " + std::to_string(width) + "x" +
-                std::to_string(height) + "x" + std::to_string(channels) + " image");
-  }
-  return writeImage(path, width, height, channels, OIIO::TypeDesc::UINT8, pixels.data());
+  if (!endsWithPng(path)) return fail(path + ": colour images are written as PNG: name the file .png");
+  return gis::writePng8(path, width, height, channels, pixels);
 }
 
-Status writeImageFloat(const std::string& path, int width, int height, int channels, std::span<const float> pixels) {
-  if (pixels.size() != size_t(width) * size_t(height) * size_t(channels)) {
-    return fail(path + ": " + std::to_string(pixels.size()) + " floats for a " + std::to_string(width) + "x" +
-                std::to_string(height) + "x" + std::to_string(channels) + " image");
+Status writeImageFloat(const std::string& path, int width, int height, int channels, std::span<const float> pixels,
+                       const ExrExtras& extras) {
+  if (width <= 0 || height <= 0 || channels < 1 || channels > 4) {
+    return fail(path + ": an EXR here needs a size and 1-4 channels, not " + sizeText(width, height, channels));
   }
-  return writeImage(path, width, height, channels, OIIO::TypeDesc::FLOAT, pixels.data());
+  if (pixels.size() != size_t(width) * size_t(height) * size_t(channels)) {
+    return fail(path + ": " + std::to_string(pixels.size()) + " floats for a " + sizeText(width, height, channels) +
+                " image");
+  }
+  std::vector<std::string> names = extras.channelNames;
+  if (names.empty())
+    names = channels == 1 ? std::vector<std::string>{"Y"} : std::vector<std::string>{"R", "G", "B", "A"};
+  if (names.size() < size_t(channels)) return fail(path + ": " + std::to_string(channels) + " channels, fewer names");
+  names.resize(size_t(channels));
+  try {
+    Imf::Header header(width, height);
+    header.compression() = Imf::ZIP_COMPRESSION;
+    for (const auto& [key, value] : extras.strings) header.insert(key, Imf::StringAttribute(value));
+    for (const auto& [key, value] : extras.ints) header.insert(key, Imf::IntAttribute(value));
+    Imf::FrameBuffer frame;
+    const size_t xStride = sizeof(float) * size_t(channels), yStride = xStride * size_t(width);
+    for (int c = 0; c < channels; ++c) {
+      header.channels().insert(names[size_t(c)], Imf::Channel(Imf::FLOAT));
+      frame.insert(names[size_t(c)],
+                   Imf::Slice(Imf::FLOAT, const_cast<char*>(reinterpret_cast<const char*>(pixels.data() + c)), xStride,
+                              yStride));
+    }
+    Imf::OutputFile file(path.c_str(), header);
+    file.setFrameBuffer(frame);
+    file.writePixels(height);
+  } catch (const std::exception& e) {
+    return fail(path + ": cannot write the EXR: " + e.what());
+  }
+  return {};
 }
 
-Result<Image8> readImage8(const std::string& path) {
-  STRATA_TRY_STATUS(requireRegularFile(path, "an image"));
-  auto in = OIIO::ImageInput::open(path);
-  if (!in) return fail(path + ": cannot read: " + OIIO::geterror());
-  const auto& spec = in->spec();
-  Image8 img;
-  img.width = spec.width;
-  img.height = spec.height;
-  img.channels = spec.nchannels;
-  img.pixels.resize(size_t(img.width) * size_t(img.height) * size_t(img.channels));
-  if (!in->read_image(0, 0, 0, img.channels, OIIO::TypeDesc::UINT8, img.pixels.data())) {
-    return fail(path + ": read failed: " + in->geterror());
-  }
-  in->close();
-  return img;
-}
+Result<Image8> readImage8(const std::string& path) { return gis::readImage8(path); }
 
 }  // namespace strata::render

@@ -1,27 +1,38 @@
 #pragma once
-// Image files for renders and golden tests (OpenImageIO, kept out of other headers): PNG for
-// colour, EXR for float fields (depth, elevation).
+// Image files for renders and golden tests: PNG for colour (through GDAL, strata/gis/image8.hpp),
+// EXR for float fields (depth, elevation, generated heights; OpenEXR). Neither library's headers
+// reach the callers.
 
 #include <cstdint>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <strata/core/result.hpp>
+#include <strata/gis/image8.hpp>
 
 namespace strata::render {
 
 /// An 8-bit image, rows top first, channels interleaved.
-struct Image8 {
-  int width = 0, height = 0, channels = 0;
-  std::vector<uint8_t> pixels;
+using Image8 = gis::Image8;
+
+/// Writes 8-bit pixels (rows top first, 1-4 channels) to a PNG; `path` must end in .png.
+Status writeImage8(const std::string& path, int width, int height, int channels, std::span<const uint8_t> pixels);
+
+/// What an EXR carries besides its pixels: channel names (default: "Y" for one channel, else
+/// R, G, B, A) and string and integer header attributes (e.g. "strata:seed").
+struct ExrExtras {
+  std::vector<std::string> channelNames;
+  std::vector<std::pair<std::string, std::string>> strings;
+  std::vector<std::pair<std::string, int>> ints;
 };
 
-/// Writes 8-bit pixels (rows top first) to a PNG (or any format OIIO picks from the extension).
-Status writeImage8(const std::string& path, int width, int height, int channels, std::span<const uint8_t> pixels);
-/// Writes float pixels (rows top first) to an EXR.
-Status writeImageFloat(const std::string& path, int width, int height, int channels, std::span<const float> pixels);
-/// Reads an image as 8-bit.
+/// Writes float pixels (rows top first, 1-4 channels interleaved) to a ZIP-compressed EXR.
+Status writeImageFloat(const std::string& path, int width, int height, int channels, std::span<const float> pixels,
+                       const ExrExtras& extras = {});
+
+/// Reads an 8-bit image (PNG, JPEG, an 8-bit TIFF, ...).
 Result<Image8> readImage8(const std::string& path);
 
 }  // namespace strata::render
