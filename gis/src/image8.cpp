@@ -1,12 +1,18 @@
 #include <strata/gis/image8.hpp>
 
 #include <cpl_conv.h>
+#include <strings.h>
+
+#include <filesystem>
 
 #include "gdal_util.hpp"
 
 namespace strata::gis {
 
-Status writePng8(const std::string& path, int width, int height, int channels, std::span<const uint8_t> pixels) {
+Status writeImage8(const std::string& path, int width, int height, int channels, std::span<const uint8_t> pixels) {
+  if (strcasecmp(std::filesystem::path(path).extension().c_str(), ".png") != 0) {
+    return fail(path + ": colour images are written as PNG: name the file .png");
+  }
   if (width <= 0 || height <= 0 || channels < 1 || channels > 4) {
     return fail(path + ": a PNG needs a size and 1-4 channels, not " + std::to_string(width) + "x" +
                 std::to_string(height) + "x" + std::to_string(channels));
@@ -39,7 +45,6 @@ Status writePng8(const std::string& path, int width, int height, int channels, s
 }
 
 Result<Image8> readImage8(const std::string& path) {
-  CPLConfigOptionSetter noPam("GDAL_PAM_ENABLED", "NO", true);
   STRATA_TRY(detail::DatasetPtr ds, detail::openRaster(path));
   detail::GdalErrorCapture errors;
   Image8 img;

@@ -7,8 +7,6 @@
 #include <OpenEXR/ImfOutputFile.h>
 #include <OpenEXR/ImfStringAttribute.h>
 
-#include <algorithm>
-#include <cctype>
 #include <exception>
 
 namespace strata::render {
@@ -18,19 +16,7 @@ std::string sizeText(int width, int height, int channels) {
   return std::to_string(width) + "x" + std::to_string(height) + "x" + std::to_string(channels);
 }
 
-bool endsWithPng(const std::string& path) {
-  if (path.size() < 4) return false;
-  std::string ext = path.substr(path.size() - 4);
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-  return ext == ".png";
-}
-
 }  // namespace
-
-Status writeImage8(const std::string& path, int width, int height, int channels, std::span<const uint8_t> pixels) {
-  if (!endsWithPng(path)) return fail(path + ": colour images are written as PNG: name the file .png");
-  return gis::writePng8(path, width, height, channels, pixels);
-}
 
 Status writeImageFloat(const std::string& path, int width, int height, int channels, std::span<const float> pixels,
                        const ExrExtras& extras) {
@@ -67,7 +53,5 @@ Status writeImageFloat(const std::string& path, int width, int height, int chann
   }
   return {};
 }
-
-Result<Image8> readImage8(const std::string& path) { return gis::readImage8(path); }
 
 }  // namespace strata::render

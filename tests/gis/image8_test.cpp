@@ -29,7 +29,7 @@ TEST(Image8, PngRoundTripsEveryByteWithOneToFourChannels) {
     std::vector<uint8_t> pixels(size_t(w) * h * channels);
     for (auto& p : pixels) p = uint8_t(rng());
     const std::string path = (dir / ("c" + std::to_string(channels) + ".png")).string();
-    ASSERT_TRUE(writePng8(path, w, h, channels, pixels));
+    ASSERT_TRUE(writeImage8(path, w, h, channels, pixels));
     {
       std::ifstream f(path, std::ios::binary);
       char sig[8] = {};
@@ -62,10 +62,10 @@ TEST(Image8, BadSizesAndNonByteRastersAreRefusedNamingTheFile) {
   const auto dir = strata::test::tempDir("image8-bad");
   const std::string png = (dir / "x.png").string();
   const std::vector<uint8_t> three(3);
-  auto st = writePng8(png, 2, 2, 1, three);  // 3 bytes for 4 pixels
+  auto st = writeImage8(png, 2, 2, 1, three);  // 3 bytes for 4 pixels
   ASSERT_FALSE(st);
   EXPECT_NE(st.message().find("x.png: 3 bytes for a 2x2x1 image"), std::string::npos) << st.message();
-  EXPECT_FALSE(writePng8(png, 1, 1, 5, std::vector<uint8_t>(5)));
+  EXPECT_FALSE(writeImage8(png, 1, 1, 5, std::vector<uint8_t>(5)));
   EXPECT_FALSE(fs::exists(png));
   // A float DEM is not an image: refused naming its sample type (the viewer's stamp then reads
   // it as heights).

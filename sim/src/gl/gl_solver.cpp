@@ -23,6 +23,10 @@ namespace strata::sim {
 
 namespace {
 constexpr size_t kParamsDtOffset = offsetof(GpuSimParams, dtS);
+// The accumulators' buffer: AccumOffset's planes, then W12b's plane of the point sources' second
+// halves (ACCUM_POUR; GPU-only, 0 between steps, so never moved to or from a CellBlock).
+constexpr int kAccumPour = kAccumPerCell;
+constexpr int kAccumPlanes = kAccumPour + 1;
 
 void barrier() { gl::memoryBarrier(gl::Barrier::kStorage); }
 void readBarrier() { gl::memoryBarrier(gl::Barrier::kBufferUpdate); }
@@ -37,7 +41,7 @@ std::vector<gl::ShaderDefine> slots::kernelDefines() {
                      {"ACCUM_LEVEL", kAccumLevel},
                      {"ACCUM_INFILTRATED", kAccumInfiltrated},
                      {"ACCUM_DEPTH_ERROR", kAccumDepthError},
-                     {"ACCUM_POUR", kAccumPerCell}});  // W12b: a plane after the accumulators
+                     {"ACCUM_POUR", kAccumPour}});
   return d;
 }
 
@@ -522,8 +526,7 @@ Result<GlSolver> GlSolver::create(const SimInput& input, const SimParams& params
   s.fvLimit.fill(0u);
   s.tilt = gl::Buffer(4 * n);
   s.tilt.fill(0u);
-  // The accumulators' planes, then W12b's plane of point sources' second halves (ACCUM_POUR).
-  s.accum = gl::Buffer(sizeof(float) * (kAccumPerCell + 1) * n);
+  s.accum = gl::Buffer(sizeof(float) * kAccumPlanes * n);
   s.accum.fill(0u);
   s.rain = gl::Buffer::from(std::span<const float>(rain));
   s.rasterRain = std::any_of(rain.begin(), rain.end(), [](float r) { return r != 0.0f; });

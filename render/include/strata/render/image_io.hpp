@@ -14,11 +14,10 @@
 
 namespace strata::render {
 
-/// An 8-bit image, rows top first, channels interleaved.
-using Image8 = gis::Image8;
-
-/// Writes 8-bit pixels (rows top first, 1-4 channels) to a PNG; `path` must end in .png.
-Status writeImage8(const std::string& path, int width, int height, int channels, std::span<const uint8_t> pixels);
+/// 8-bit images: PNG out, any 8-bit raster in (gis/image8.hpp).
+using gis::Image8;
+using gis::readImage8;
+using gis::writeImage8;
 
 /// What an EXR carries besides its pixels: channel names (default: "Y" for one channel, else
 /// R, G, B, A) and string and integer header attributes (e.g. "strata:seed").
@@ -31,8 +30,5 @@ struct ExrExtras {
 /// Writes float pixels (rows top first, 1-4 channels interleaved) to a ZIP-compressed EXR.
 Status writeImageFloat(const std::string& path, int width, int height, int channels, std::span<const float> pixels,
                        const ExrExtras& extras = {});
-
-/// Reads an 8-bit image (PNG, JPEG, an 8-bit TIFF, ...).
-Result<Image8> readImage8(const std::string& path);
 
 }  // namespace strata::render
